@@ -1,0 +1,23 @@
+// The `upd` subcommands. Each takes its arguments (after the subcommand name), returns the
+// process exit code and throws on error; main prints the message.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace upd::app {
+
+struct Command {
+  const char* name;
+  const char* summary;
+  const char* usage;
+  int (*run)(const std::vector<std::string>& args);
+};
+
+int runAnalyze(const std::vector<std::string>& args);
+int runScene(const std::vector<std::string>& args);
+
+extern const char* const kAnalyzeUsage;
+extern const char* const kSceneUsage;
+
+}  // namespace upd::app

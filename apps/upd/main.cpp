@@ -1,0 +1,56 @@
+// upd: the UPD-Nav command-line tool. Subcommands are listed in kCommands; errors from any of
+// them are caught here and printed as one line, with a non-zero exit code.
+#include "cli.h"
+#include "commands.h"
+
+#include <cstring>
+#include <iostream>
+
+namespace {
+
+using upd::app::Command;
+
+const Command kCommands[] = {
+    {"analyze", "score a point cloud file (.pcd, .ply, .xyz) with the UPD",
+     upd::app::kAnalyzeUsage, upd::app::runAnalyze},
+    {"scene", "write a generated test scene (the paper's experiments) as PLY",
+     upd::app::kSceneUsage, upd::app::runScene},
+};
+
+void printHelp(std::ostream& os) {
+  os << "upd: terrain traversability with the Unevenness Point Descriptor (UPD-Nav)\n\n"
+        "usage: upd COMMAND [ARGS...]   (upd COMMAND --help for its options)\n\ncommands:\n";
+  for (const auto& c : kCommands) os << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
+      !std::strcmp(argv[1], "help")) {
+    printHelp(std::cout);
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string name = argv[1];
+  const std::vector<std::string> args(argv + 2, argv + argc);
+  for (const auto& c : kCommands) {
+    if (name != c.name) continue;
+    for (const auto& a : args) {
+      if (a == "--help" || a == "-h") {
+        std::cout << c.usage;
+        return 0;
+      }
+    }
+    try {
+      return c.run(args);
+    } catch (const upd::app::UsageError& e) {
+      std::cerr << "upd " << name << ": " << e.what() << " (see 'upd " << name << " --help')\n";
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << "upd " << name << ": error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  std::cerr << "upd: unknown command '" << name << "' (see 'upd --help')\n";
+  return 2;
+}

@@ -1,0 +1,81 @@
+// A point cloud as a structure of float arrays: the one data type every UPD algorithm reads.
+//
+// x, y, z are separate float vectors (as MRPT point maps and depth images give them), so
+// algorithms can view the caller's buffers without copying. Colour is optional (empty vectors
+// when absent). An organized cloud keeps its image layout (width x height, row-major) and marks
+// invalid pixels with NaN coordinates; nothing is dropped. The sensor origin is where the rays
+// start, in the cloud's frame: range cut-off and normal orientation use it.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace upd {
+
+struct PointCloud {
+  std::vector<float> x, y, z;
+  std::vector<std::uint8_t> r, g, b;  ///< empty, or one entry per point
+  std::size_t width = 0;              ///< columns when organized; else size()
+  std::size_t height = 1;             ///< rows when organized; 1 when not
+  Eigen::Vector3f sensor_origin = Eigen::Vector3f::Zero();  ///< [m], cloud frame
+
+  std::size_t size() const { return x.size(); }
+  bool empty() const { return x.empty(); }
+  bool hasColor() const { return !r.empty() && r.size() == x.size(); }
+  /// Invariant of an organized cloud: height > 1 and width * height == size().
+  bool isOrganized() const { return height > 1 && width * height == x.size(); }
+
+  Eigen::Vector3f point(std::size_t i) const { return {x[i], y[i], z[i]}; }
+  bool isFinite(std::size_t i) const {
+    return std::isfinite(x[i]) && std::isfinite(y[i]) && std::isfinite(z[i]);
+  }
+
+  void reserve(std::size_t n) {
+    x.reserve(n);
+    y.reserve(n);
+    z.reserve(n);
+  }
+  void push_back(float px, float py, float pz) {
+    x.push_back(px);
+    y.push_back(py);
+    z.push_back(pz);
+    width = x.size();
+    height = 1;
+  }
+  void push_back(float px, float py, float pz, std::uint8_t cr, std::uint8_t cg, std::uint8_t cb) {
+    push_back(px, py, pz);
+    r.push_back(cr);
+    g.push_back(cg);
+    b.push_back(cb);
+  }
+  /// Makes the cloud an organized width x height image of NaN points (colour dropped).
+  void resizeOrganized(std::size_t w, std::size_t h) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    x.assign(w * h, nan);
+    y.assign(w * h, nan);
+    z.assign(w * h, nan);
+    r.clear();
+    g.clear();
+    b.clear();
+    width = w;
+    height = h;
+  }
+  /// Number of points with finite coordinates.
+  std::size_t countFinite() const {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < size(); ++i) n += isFinite(i) ? 1 : 0;
+    return n;
+  }
+};
+
+/// Per-point ground truth and classification labels (values are stable: written to PLY files).
+enum class Label : std::uint8_t { Traversable = 0, NonTraversable = 1, Unknown = 2 };
+
+const char* toString(Label l);
+
+}  // namespace upd

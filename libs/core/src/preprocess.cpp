@@ -1,0 +1,216 @@
+#include "upd/core/preprocess.h"
+
+#include "upd/core/kdtree.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+namespace upd {
+
+void PreprocessParams::validate() const {
+  requireParam(std::isfinite(range_min_m) && range_min_m >= 0, "PreprocessParams", "range_min_m",
+               range_min_m, "must be >= 0");
+  requireParam(range_max_m > range_min_m, "PreprocessParams", "range_max_m", range_max_m,
+               "must be > range_min_m");
+  requireParam((box_max_m - box_min_m).minCoeff() > 0, "PreprocessParams", "box_max_m",
+               box_max_m, "must be > box_min_m on every axis");
+  requireParam(std::isfinite(voxel_m) && voxel_m > 0, "PreprocessParams", "voxel_m", voxel_m,
+               "must be > 0");
+  requireParam(outlier_k >= 1, "PreprocessParams", "outlier_k", outlier_k, "must be >= 1");
+  requireParam(std::isfinite(outlier_std_mul) && outlier_std_mul >= 0, "PreprocessParams",
+               "outlier_std_mul", outlier_std_mul, "must be >= 0");
+}
+
+namespace {
+
+// Keeps the points where keep[i]: an organized cloud keeps its layout (others become NaN),
+// an unorganized one is compacted.
+PointCloud selectPoints(const PointCloud& in, const std::vector<char>& keep) {
+  PointCloud out;
+  out.sensor_origin = in.sensor_origin;
+  const bool colour = in.hasColor();
+  if (in.isOrganized()) {
+    out = in;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (std::size_t i = 0; i < in.size(); ++i) {
+      if (!keep[i]) out.x[i] = out.y[i] = out.z[i] = nan;
+    }
+    return out;
+  }
+  out.reserve(in.size());
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (!keep[i]) continue;
+    if (colour) {
+      out.push_back(in.x[i], in.y[i], in.z[i], in.r[i], in.g[i], in.b[i]);
+    } else {
+      out.push_back(in.x[i], in.y[i], in.z[i]);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+PointCloud dropNonFinite(const PointCloud& in) {
+  std::vector<char> keep(in.size());
+  for (std::size_t i = 0; i < in.size(); ++i) keep[i] = in.isFinite(i);
+  PointCloud unorganized = in;
+  unorganized.width = in.size();
+  unorganized.height = 1;
+  return selectPoints(unorganized, keep);
+}
+
+PointCloud cropRange(const PointCloud& in, const PreprocessParams& p) {
+  std::vector<char> keep(in.size(), 0);
+  const double rmin2 = p.range_min_m * p.range_min_m, rmax2 = p.range_max_m * p.range_max_m;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (!in.isFinite(i)) continue;
+    const Eigen::Vector3f q = in.point(i);
+    bool ok = true;
+    if (p.range_enabled) {
+      const double d2 = (q - in.sensor_origin).cast<double>().squaredNorm();
+      ok = d2 >= rmin2 && d2 <= rmax2;
+    }
+    if (ok && p.box_enabled) {
+      ok = (q.array() >= p.box_min_m.array()).all() && (q.array() <= p.box_max_m.array()).all();
+    }
+    keep[i] = ok;
+  }
+  return selectPoints(in, keep);
+}
+
+PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
+  requireParam(std::isfinite(voxel_m) && voxel_m > 0, "PreprocessParams", "voxel_m", voxel_m,
+               "must be > 0");
+  PointCloud out;
+  out.sensor_origin = in.sensor_origin;
+  // Voxel keys and centroids relative to the first finite point: exact far from the origin.
+  std::size_t first = 0;
+  while (first < in.size() && !in.isFinite(first)) ++first;
+  if (first == in.size()) return out;
+  const Eigen::Vector3d ref = in.point(first).cast<double>();
+  const double inv = 1.0 / voxel_m;
+  struct Acc {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double r = 0, g = 0, b = 0;
+    std::uint32_t n = 0;
+    std::uint32_t order = 0;
+  };
+  std::unordered_map<std::uint64_t, Acc> voxels;
+  voxels.reserve(in.size() / 4 + 16);
+  const bool colour = in.hasColor();
+  const std::int64_t bias = std::int64_t(1) << 20;
+  for (std::size_t i = first; i < in.size(); ++i) {
+    if (!in.isFinite(i)) continue;
+    const Eigen::Vector3d d = in.point(i).cast<double>() - ref;
+    std::uint64_t key = 0;
+    for (int a = 0; a < 3; ++a) {
+      const auto c = static_cast<std::int64_t>(std::floor(d[a] * inv)) + bias;
+      if (c < 0 || c >= (std::int64_t(1) << 21)) {
+        throw std::invalid_argument(
+            "PreprocessParams.voxel_m = " + std::to_string(voxel_m) +
+            ": the cloud spans more than 2^20 voxels along an axis; use a larger voxel or a "
+            "range cut-off");
+      }
+      key |= static_cast<std::uint64_t>(c) << (21 * a);
+    }
+    auto [it, inserted] = voxels.try_emplace(key);
+    Acc& acc = it->second;
+    if (inserted) acc.order = static_cast<std::uint32_t>(voxels.size() - 1);
+    acc.sum += d;
+    ++acc.n;
+    if (colour) {
+      acc.r += in.r[i];
+      acc.g += in.g[i];
+      acc.b += in.b[i];
+    }
+  }
+  // Output in order of first appearance: deterministic whatever the hash map's layout.
+  std::vector<const Acc*> ordered(voxels.size());
+  for (const auto& kv : voxels) ordered[kv.second.order] = &kv.second;
+  out.reserve(ordered.size());
+  for (const Acc* acc : ordered) {
+    const Eigen::Vector3d c = ref + acc->sum / acc->n;
+    if (colour) {
+      const auto avg = [&](double s) {
+        return static_cast<std::uint8_t>(std::lround(s / acc->n));
+      };
+      out.push_back(static_cast<float>(c.x()), static_cast<float>(c.y()),
+                    static_cast<float>(c.z()), avg(acc->r), avg(acc->g), avg(acc->b));
+    } else {
+      out.push_back(static_cast<float>(c.x()), static_cast<float>(c.y()),
+                    static_cast<float>(c.z()));
+    }
+  }
+  return out;
+}
+
+PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul) {
+  requireParam(k >= 1, "PreprocessParams", "outlier_k", k, "must be >= 1");
+  const KdTree tree(in);
+  std::vector<double> mean_dist(in.size(), std::numeric_limits<double>::quiet_NaN());
+#pragma omp parallel
+  {
+    std::vector<std::uint32_t> nb;
+    std::vector<float> d2;
+#pragma omp for schedule(dynamic, 512)
+    for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(in.size()); ++ii) {
+      const auto i = static_cast<std::size_t>(ii);
+      if (!in.isFinite(i)) continue;
+      tree.knnSearch(in.point(i), k + 1, nb, &d2);  // the point itself comes first
+      if (nb.size() < 2) continue;
+      double s = 0;
+      for (std::size_t j = 1; j < d2.size(); ++j) s += std::sqrt(static_cast<double>(d2[j]));
+      mean_dist[i] = s / static_cast<double>(d2.size() - 1);
+    }
+  }
+  double s = 0, s2 = 0;
+  std::size_t n = 0;
+  for (const double d : mean_dist) {
+    if (std::isnan(d)) continue;
+    s += d;
+    s2 += d * d;
+    ++n;
+  }
+  std::vector<char> keep(in.size(), 0);
+  if (n == 0) return selectPoints(in, keep);
+  const double mu = s / n;
+  const double sigma = std::sqrt(std::max(0.0, s2 / n - mu * mu));
+  const double limit = mu + std_mul * sigma;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    // A point alone has no neighbour distance: it is an outlier by definition.
+    keep[i] = !std::isnan(mean_dist[i]) && mean_dist[i] <= limit;
+  }
+  return selectPoints(in, keep);
+}
+
+PointCloud preprocess(const PointCloud& in, const PreprocessParams& p, PreprocessStats* stats) {
+  p.validate();
+  PreprocessStats st;
+  st.points_in = in.size();
+  const std::size_t finite = in.countFinite();
+  st.non_finite = in.size() - finite;
+  const bool any = p.range_enabled || p.box_enabled || p.voxel_enabled || p.outlier_enabled;
+  if (!any) {
+    st.after_voxel = st.points_out = in.size();
+    if (stats) *stats = st;
+    return in;
+  }
+  PointCloud cloud = (p.range_enabled || p.box_enabled) ? cropRange(in, p) : in;
+  const std::size_t after_crop = cloud.countFinite();
+  st.range_removed = finite - after_crop;
+  if (p.voxel_enabled) cloud = voxelDownsample(cloud, p.voxel_m);
+  st.after_voxel = cloud.countFinite();
+  if (p.outlier_enabled && !cloud.empty()) {
+    cloud = removeStatisticalOutliers(cloud, p.outlier_k, p.outlier_std_mul);
+    st.outliers_removed = st.after_voxel - cloud.countFinite();
+  }
+  if (!cloud.isOrganized()) cloud = dropNonFinite(cloud);
+  st.points_out = cloud.size();
+  if (stats) *stats = st;
+  return cloud;
+}
+
+}  // namespace upd
