@@ -10,7 +10,7 @@ function(upd_add_test)
   add_executable(${T_NAME} ${T_SOURCES})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${T_NAME} PRIVATE
-    UPD_SHARED_DATA_DIR="${UPD_SHARED_DATA_DIR}")
+    UPD_SHARED_DATA_DIR="${UPD_SHARED_DATA_DIR}" UPD_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   upd_set_warnings(${T_NAME})
   include(GoogleTest)
   gtest_discover_tests(${T_NAME} DISCOVERY_TIMEOUT 60

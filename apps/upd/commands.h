@@ -16,8 +16,10 @@ struct Command {
 
 int runAnalyze(const std::vector<std::string>& args);
 int runScene(const std::vector<std::string>& args);
+int runParams(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
 extern const char* const kSceneUsage;
+extern const char* const kParamsUsage;
 
 }  // namespace upd::app

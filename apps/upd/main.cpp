@@ -15,6 +15,8 @@ const Command kCommands[] = {
      upd::app::kAnalyzeUsage, upd::app::runAnalyze},
     {"scene", "write a generated test scene (the paper's experiments) as PLY",
      upd::app::kSceneUsage, upd::app::runScene},
+    {"params", "list every parameter with its ini section, default and unit",
+     upd::app::kParamsUsage, upd::app::runParams},
 };
 
 void printHelp(std::ostream& os) {

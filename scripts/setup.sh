@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages UPD-Nav needs (only those missing), then configures and
+# builds the project into build/. Sourced by the quick-start scripts; safe to run repeatedly.
+set -euo pipefail
+
+UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+UPD_BUILD="${UPD_BUILD:-$UPD_ROOT/build}"
+PACKAGES=(build-essential cmake pkg-config
+          libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
+          libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+cmake -S "$UPD_ROOT" -B "$UPD_BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$UPD_BUILD" -j"$(nproc)"

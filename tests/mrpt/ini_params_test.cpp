@@ -1,0 +1,133 @@
+// Parameters load from MRPT ini files strictly: values land in the structs (degrees converted),
+// and a missing file, an unknown section or key, or a bad value stops with a message naming the
+// file, section, key and value.
+#include "upd/core/pipeline.h"
+#include "upd/mrpt/ini_params.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace upd::mrptbridge {
+namespace {
+
+class IniFile : public ::testing::Test {
+ protected:
+  std::string write(const std::string& text) {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("upd_ini_test_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    path_ = (dir / (std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+                    ".ini")).string();
+    std::ofstream(path_) << text;
+    return path_;
+  }
+  std::string errorOf(const std::string& text) {
+    const std::string p = write(text);
+    try {
+      PipelineParams params;
+      loadPipelineParams(p, params);
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    return "";
+  }
+  std::string path_;
+};
+
+TEST_F(IniFile, ValuesLandInTheStructsAndDegreesBecomeRadians) {
+  const std::string p = write(
+      "[PipelineParams]\nup = 0,-1,0\n"
+      "[UpdParams]\nradius_m = 1.0   // tractor\n"
+      "[ClassifyParams]\nmax_slope_deg = 30\nzeta_min = 0.9\n"
+      "[PreprocessParams]\nvoxel_enabled = false\nrange_max_m = 8\n");
+  PipelineParams params;
+  loadPipelineParams(p, params);
+  EXPECT_EQ(params.up, Eigen::Vector3f(0, -1, 0));
+  EXPECT_DOUBLE_EQ(params.upd.radius_m, 1.0);
+  EXPECT_NEAR(params.classify.max_slope_rad, 30.0 * M_PI / 180.0, 1e-12);
+  EXPECT_DOUBLE_EQ(params.classify.zeta_min, 0.9);
+  EXPECT_FALSE(params.preprocess.voxel_enabled);
+  EXPECT_DOUBLE_EQ(params.preprocess.range_max_m, 8.0);
+  // Keys absent from the file keep their defaults.
+  EXPECT_DOUBLE_EQ(params.normals.radius_m, NormalParams{}.radius_m);
+}
+
+TEST_F(IniFile, MissingFileNamesIt) {
+  PipelineParams params;
+  try {
+    loadPipelineParams("/nonexistent/dune.ini", params);
+    FAIL() << "no error";
+  } catch (const std::exception& e) {
+    EXPECT_EQ(std::string(e.what()), "config file /nonexistent/dune.ini: not found");
+  }
+}
+
+TEST_F(IniFile, UnknownSectionIsNamed) {
+  const std::string e = errorOf("[UpdParam]\nradius_m = 0.5\n");
+  EXPECT_NE(e.find(path_), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown section [UpdParam]"), std::string::npos) << e;
+}
+
+TEST_F(IniFile, UnknownKeyIsNamed) {
+  const std::string e = errorOf("[UpdParams]\nradius = 0.5\n");
+  EXPECT_NE(e.find(path_), std::string::npos) << e;
+  EXPECT_NE(e.find("[UpdParams] unknown key 'radius'"), std::string::npos) << e;
+}
+
+TEST_F(IniFile, UnparsableValueNamesKeyAndValue) {
+  const std::string e = errorOf("[UpdParams]\nradius_m = half a metre\n");
+  EXPECT_NE(e.find("[UpdParams] radius_m = 'half a metre': not a number"), std::string::npos)
+      << e;
+  EXPECT_NE(errorOf("[PreprocessParams]\nvoxel_enabled = maybe\n").find("not a boolean"),
+            std::string::npos);
+  EXPECT_NE(errorOf("[PipelineParams]\nup = 0,0\n").find("not three numbers"), std::string::npos);
+}
+
+TEST_F(IniFile, OutOfRangeValueNamesFileSectionFieldAndValue) {
+  const std::string e = errorOf("[UpdParams]\nradius_m = -0.5\n");
+  EXPECT_NE(e.find(path_), std::string::npos) << e;
+  EXPECT_NE(e.find("UpdParams.radius_m = -0.5: must be > 0"), std::string::npos) << e;
+  EXPECT_NE(errorOf("[PipelineParams]\nup = 0,0,0\n").find("PipelineParams.up = 0,0,0"),
+            std::string::npos);
+}
+
+TEST_F(IniFile, TheFileIsNeverRewritten) {
+  const std::string text = "[UpdParams]\nradius_m = 0.7\n";
+  const std::string p = write(text);
+  {
+    PipelineParams params;
+    loadPipelineParams(p, params);
+  }
+  std::ifstream in(p);
+  const std::string after((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(after, text);
+}
+
+TEST(ShippedConfigs, EveryConfigFileLoadsStrictly) {
+  std::size_t n = 0;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(UPD_SOURCE_DIR) + "/config")) {
+    if (e.path().extension() != ".ini" || e.path().filename().string().rfind("ptg", 0) == 0) {
+      continue;
+    }
+    PipelineParams params;
+    EXPECT_NO_THROW(loadPipelineParams(e.path().string(), params)) << e.path();
+    ++n;
+  }
+  EXPECT_GE(n, 3u);
+}
+
+TEST(ShippedConfigs, DuneUsesTheSmallRoverRadius) {
+  PipelineParams params;
+  loadPipelineParams(std::string(UPD_SOURCE_DIR) + "/config/dune-kinect.ini", params);
+  EXPECT_DOUBLE_EQ(params.upd.radius_m, 0.5);
+  PipelineParams tractor;
+  loadPipelineParams(std::string(UPD_SOURCE_DIR) + "/config/tractor-stereo.ini", tractor);
+  EXPECT_DOUBLE_EQ(tractor.upd.radius_m, 1.0);
+  EXPECT_NEAR(params.classify.max_slope_rad, 25.0 * M_PI / 180.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace upd::mrptbridge
