@@ -29,7 +29,7 @@ int runScene(const std::vector<std::string>& argv) {
   SceneParams params;
   if (const auto v = args.number("--noise-m")) params.noise_m = *v;
   if (const auto v = args.number("--spacing-m")) params.spacing_m = *v;
-  if (const auto v = args.integer("--seed")) params.seed = static_cast<std::uint32_t>(*v);
+  if (const auto v = args.integer("--seed")) params.seed = *v;
   const Scene scene = makeScene(args.positionals()[0], params);
   io::writePly(*out, scene.cloud, &scene.truth);
   std::printf("%s: %zu points -> %s\n", scene.name.c_str(), scene.cloud.size(), out->c_str());

@@ -1,0 +1,125 @@
+// Reading and writing point clouds: PCD (through PCL), PLY (own reader and writer) and XYZ text,
+// and the scored PLY that holds the per-point UPD results.
+//
+// This is the one place where cloud file formats are parsed, so every app and test loads a
+// cloud the same way. Readers keep what the file says: an organized PCD stays width x height
+// with its NaN pixels (nothing is dropped: the pipeline counts them), the PCD viewpoint becomes
+// PointCloud::sensor_origin, and colour is kept when the file has it. Every failure (missing
+// file, unknown extension, corrupt or truncated data, a cloud without x/y/z) is a
+// std::runtime_error with a one-line message that names the file and what is wrong.
+// Writers go through writeFileAtomically (see atomic_file.h).
+//
+// The scored PLY (writeScoredPly) carries every per-point result as a vertex property, so
+// CloudCompare and MeshLab can colour by zeta or filter by label. Its writer takes views
+// (pointer + length) rather than a PipelineResult, so a caller that keeps points and results in
+// other buffers (the MRPT observer views a CPointsMap's x, y, z vectors) writes the same file
+// without copying. The property order is the format's contract: x y z nx ny nz rx ry rz zeta
+// label cost, then red green blue when there is colour (all float except the uchar label and
+// colour).
+#pragma once
+
+#include "upd/core/pipeline.h"
+#include "upd/core/point_cloud.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace upd::io {
+
+/// Reads a cloud, choosing the format by the extension (case-insensitive): .pcd, .ply,
+/// .xyz or .txt (XYZ text). Any other extension throws std::runtime_error naming the file
+/// and the supported extensions.
+PointCloud readCloud(const std::string& path);
+
+/// PCD of any DATA kind (ascii, binary, binary_compressed). Fields x, y, z are required (any
+/// numeric type); colour is read from `rgb` (float-packed) or `rgba` (uint32); other fields are
+/// ignored. sensor_origin is the VIEWPOINT translation (its rotation is not kept).
+PointCloud readPcd(const std::string& path);
+
+/// PLY `format ascii 1.0`, `binary_little_endian 1.0` or `binary_big_endian 1.0`. Reads the
+/// vertex element's x, y, z (any numeric type) and red, green, blue when present (uchar; other
+/// integer types are clamped to 0..255, float types are taken as 0..1); every other property
+/// and element (faces with list properties included) is skipped.
+PointCloud readPly(const std::string& path);
+
+/// XYZ text: one point per line, `x y z` or `x y z r g b` (r, g, b in 0..255), separated by
+/// whitespace and/or commas. `#` starts a comment; blank lines are ignored; a first line with
+/// no number at all (a column header such as `x,y,z`) is skipped. Every point line must have
+/// the column count of the first one. A bad line throws, naming the file and the line number.
+PointCloud readXyz(const std::string& path);
+
+/// Options of the PLY writers.
+struct PlyWriteOptions {
+  /// Skip points with a NaN or infinite coordinate (some viewers handle them badly). Off by
+  /// default: then vertex i is point i, so the file lines up with the cloud and its results.
+  bool drop_non_finite_xyz = false;
+  /// Extra header comment lines (e.g. the command line that made the file).
+  std::vector<std::string> comments;
+};
+
+/// Writes a binary little-endian PLY with vertex properties `x y z`, then `label` (uchar, the
+/// Label values) when labels is given, then `red green blue` (uchar) when the cloud has
+/// colour. labels, when given, must hold one entry per point (else std::invalid_argument).
+void writePly(const std::string& path, const PointCloud& cloud,
+              const std::vector<Label>* labels = nullptr, const PlyWriteOptions& options = {});
+
+/// Writes XYZ text (`x y z` or `x y z r g b` per line); the floats are written in their
+/// shortest exact form, so readXyz gives back the same values.
+void writeXyz(const std::string& path, const PointCloud& cloud);
+
+/// Writes a binary PCD (fields x y z, plus rgb when the cloud has colour) with width x height
+/// kept for an organized cloud and the VIEWPOINT set from sensor_origin.
+void writePcd(const std::string& path, const PointCloud& cloud);
+
+/// A read-only view of n contiguous values (pre-C++20 std::span). Builds implicitly from a
+/// std::vector; empty means "absent".
+template <class T>
+struct ArrayView {
+  const T* data = nullptr;
+  std::size_t size = 0;
+
+  ArrayView() = default;
+  ArrayView(const T* d, std::size_t n) : data(d), size(n) {}
+  ArrayView(const std::vector<T>& v) : data(v.data()), size(v.size()) {}  // NOLINT: implicit
+
+  bool empty() const { return size == 0; }
+  const T& operator[](std::size_t i) const { return data[i]; }
+};
+
+/// Per-point arrays to write. x, y, z are required and set the point count n; every other view
+/// is empty (absent) or holds n values. Absent floats are written as NaN, an absent label as
+/// Label::Unknown; colour is written only when r, g and b are all present.
+struct ScoredPoints {
+  ArrayView<float> x, y, z;
+  ArrayView<float> nx, ny, nz;        ///< unit normal
+  ArrayView<float> rx, ry, rz, zeta;  ///< UPD vector r (eq. 6) and zeta (eq. 8)
+  ArrayView<Label> label;
+  ArrayView<float> cost;              ///< traversal cost in [0, 1]
+  ArrayView<std::uint8_t> r, g, b;    ///< colour
+
+  std::size_t size() const { return x.size; }
+  /// Throws std::invalid_argument naming the first view whose size is neither 0 nor n (x, y,
+  /// z must all be n), or when only some of r, g, b are present.
+  void validate() const;
+};
+
+/// Views of a pipeline result (its scored cloud, normals, UPD and classes). The result must
+/// outlive the returned views.
+ScoredPoints scoredPointsOf(const PipelineResult& result);
+
+/// Writes a binary little-endian PLY with the properties listed in the header comment.
+/// Throws std::invalid_argument for inconsistent sizes, std::runtime_error for I/O failures.
+void writeScoredPly(const std::string& path, const ScoredPoints& points,
+                    const PlyWriteOptions& options = {});
+void writeScoredPly(const std::string& path, const PipelineResult& result,
+                    const PlyWriteOptions& options = {});
+
+/// The vertex property names writeScoredPly writes, in order (colour not included).
+const std::vector<std::string>& scoredPlyProperties();
+
+/// Lower-cased extension of path including the dot (".pcd"), or "" when it has none.
+std::string lowerExtension(const std::string& path);
+
+}  // namespace upd::io

@@ -1,0 +1,174 @@
+#include "upd/io/json_io.h"
+
+#include "upd/io/atomic_file.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <ostream>
+#include <stdexcept>
+
+namespace upd::io {
+
+namespace {
+
+using nlohmann::json;
+
+/// A float as the double with the same shortest decimal form, so 0.1f is written as 0.1 and
+/// not 0.10000000149011612. Non-finite values become null.
+json floatValue(float f) {
+  if (!std::isfinite(f)) return nullptr;
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf - 1, f);
+  *r.ptr = '\0';
+  return std::strtod(buf, nullptr);
+}
+
+json doubleValue(double d) {
+  if (!std::isfinite(d)) return nullptr;
+  return d;
+}
+
+/// Collects a params struct's fields through its visit(); the generic overload covers any
+/// further field type a struct may add (as long as nlohmann can serialize it).
+struct JsonParamVisitor {
+  json& out;
+
+  void operator()(const char* key, double& v, const char* /*doc*/) { out[key] = doubleValue(v); }
+  void operator()(const char* key, float& v, const char* /*doc*/) { out[key] = floatValue(v); }
+  void operator()(const char* key, int& v, const char* /*doc*/) { out[key] = v; }
+  void operator()(const char* key, bool& v, const char* /*doc*/) { out[key] = v; }
+  void operator()(const char* key, Eigen::Vector3f& v, const char* /*doc*/) {
+    out[key] = json::array({floatValue(v.x()), floatValue(v.y()), floatValue(v.z())});
+  }
+  template <class T>
+  void operator()(const char* key, T& v, const char* /*doc*/) {
+    out[key] = v;
+  }
+  void angleDeg(const char* key, double& radians, const char* /*doc*/) {
+    out[key] = doubleValue(radians * kRadToDeg);
+  }
+};
+
+template <class P>
+json visitToJson(P p) {  // by value: visit() is non-const because loaders write through it
+  json j = json::object();
+  JsonParamVisitor v{j};
+  p.visit(v);
+  return j;
+}
+
+}  // namespace
+
+json histogramJson(const std::vector<float>& values, double lo, double hi, int bins) {
+  if (bins <= 0) throw std::invalid_argument("histogramJson: bins must be > 0");
+  if (!(lo < hi)) throw std::invalid_argument("histogramJson: need lo < hi");
+  const double width = (hi - lo) / bins;
+  json edges = json::array();
+  for (int i = 0; i <= bins; ++i) {
+    // Rounded to 1e-9 so edges print as 0.715, not 0.7150000000000001.
+    edges.push_back(std::round((lo + i * width) * 1e9) / 1e9);
+  }
+  std::vector<std::size_t> counts(static_cast<std::size_t>(bins), 0);
+  for (float v : values) {
+    if (!std::isfinite(v)) continue;
+    const double bin = std::floor((v - lo) / width);
+    const int b = static_cast<int>(std::clamp(bin, 0.0, static_cast<double>(bins - 1)));
+    ++counts[static_cast<std::size_t>(b)];
+  }
+  return json{{"edges", edges}, {"counts", counts}};
+}
+
+json paramsJson(const PipelineParams& params) {
+  json j = json::object();
+  j["up"] = json::array(
+      {floatValue(params.up.x()), floatValue(params.up.y()), floatValue(params.up.z())});
+  j["preprocess"] = visitToJson(params.preprocess);
+  j["normals"] = visitToJson(params.normals);
+  j["upd"] = visitToJson(params.upd);
+  j["classify"] = visitToJson(params.classify);
+  return j;
+}
+
+json summaryJson(const PipelineResult& result, const PipelineParams& params,
+                 std::size_t points_in) {
+  const std::vector<float>& zeta = result.upd.zeta;
+  std::size_t scored = 0;
+  double sum = 0.0;
+  float zmin = std::numeric_limits<float>::infinity();
+  float zmax = -std::numeric_limits<float>::infinity();
+  for (float z : zeta) {
+    if (!std::isfinite(z)) continue;
+    ++scored;
+    sum += z;
+    zmin = std::min(zmin, z);
+    zmax = std::max(zmax, z);
+  }
+  // Scored-cloud points without a zeta, including points scored while non-finite (when
+  // pre-processing kept them). zeta may be shorter than the cloud if a stage did not run.
+  const std::size_t cloud_n = result.cloud.size();
+  const std::size_t unscored = cloud_n > scored ? cloud_n - scored : 0;
+  // PreprocessStats.non_finite counts the non-finite input points; those still in the scored
+  // cloud are already among the unscored ones, only the dropped ones are added.
+  std::size_t kept_non_finite = 0;
+  for (std::size_t i = 0; i < cloud_n; ++i) kept_non_finite += result.cloud.isFinite(i) ? 0 : 1;
+  const std::size_t non_finite = result.preprocess_stats.non_finite;
+  const std::size_t dropped_non_finite =
+      non_finite > kept_non_finite ? non_finite - kept_non_finite : 0;
+
+  std::size_t traversable = 0, non_traversable = 0, unknown = 0;
+  for (Label l : result.classes.label) {
+    switch (l) {
+      case Label::Traversable: ++traversable; break;
+      case Label::NonTraversable: ++non_traversable; break;
+      case Label::Unknown: ++unknown; break;
+    }
+  }
+
+  json z = json::object();
+  z["min"] = scored ? floatValue(zmin) : json(nullptr);
+  z["mean"] = scored ? doubleValue(sum / static_cast<double>(scored)) : json(nullptr);
+  z["max"] = scored ? floatValue(zmax) : json(nullptr);
+  z["histogram"] =
+      histogramJson(zeta, kZetaHistogramMin, kZetaHistogramMax, kZetaHistogramBins);
+
+  const StageTimings& t = result.timings;
+  const PreprocessStats& s = result.preprocess_stats;
+  json j = json::object();
+  j["points_in"] = points_in;
+  j["points_scored"] = scored;
+  j["points_invalid"] = unscored + dropped_non_finite;
+  j["points_after_preprocess"] = cloud_n;
+  j["radius_m"] = doubleValue(params.upd.radius_m);
+  j["zeta"] = z;
+  j["labels"] = {{"traversable", traversable},
+                 {"non_traversable", non_traversable},
+                 {"unknown", unknown}};
+  j["timing_ms"] = {{"preprocess", doubleValue(t.preprocess_ms)},
+                    {"index", doubleValue(t.index_ms)},
+                    {"normals", doubleValue(t.normals_ms)},
+                    {"upd", doubleValue(t.upd_ms)},
+                    {"classify", doubleValue(t.classify_ms)},
+                    {"total", doubleValue(t.total_ms)}};
+  j["preprocess"] = {{"points_in", s.points_in},
+                     {"non_finite", s.non_finite},
+                     {"range_removed", s.range_removed},
+                     {"after_voxel", s.after_voxel},
+                     {"outliers_removed", s.outliers_removed},
+                     {"points_out", s.points_out}};
+  j["normals_invalid"] = result.normals.invalid;
+  j["params"] = paramsJson(params);
+  return j;
+}
+
+void writeJsonAtomically(const std::string& path, const nlohmann::json& j) {
+  // replace: a file name with invalid UTF-8 must not make the whole summary unwritable.
+  const std::string text = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  writeFileAtomically(path, [&](std::ostream& os) {
+    os.write(text.data(), static_cast<std::streamsize>(text.size()));
+  });
+}
+
+}  // namespace upd::io

@@ -1,0 +1,319 @@
+// PCD through PCL's untyped reader (pcl::PCLPointCloud2): the file's own fields are read by
+// their offsets, so no PCL point type (and none of its template instantiations) is involved.
+#include "upd/io/atomic_file.h"
+#include "upd/io/cloud_io.h"
+
+#include "io_detail.h"
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/console/print.h>
+#include <pcl/io/pcd_io.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <ostream>
+
+namespace upd::io {
+
+namespace {
+
+using detail::fileError;
+
+/// PCL prints its own errors to stderr; a library must not print, so PCL is silenced while we
+/// call it and its failures are reported through our exceptions instead. PCL's verbosity is
+/// one process-wide setting: concurrent loads may leave it silenced, never louder.
+class QuietPclConsole {
+ public:
+  QuietPclConsole() : saved_(pcl::console::getVerbosityLevel()) {
+    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+  }
+  ~QuietPclConsole() { pcl::console::setVerbosityLevel(saved_); }
+  QuietPclConsole(const QuietPclConsole&) = delete;
+  QuietPclConsole& operator=(const QuietPclConsole&) = delete;
+
+ private:
+  pcl::console::VERBOSITY_LEVEL saved_;
+};
+
+const pcl::PCLPointField* findField(const pcl::PCLPointCloud2& blob, const char* name) {
+  for (const auto& f : blob.fields) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
+std::string fieldNames(const pcl::PCLPointCloud2& blob) {
+  std::string s;
+  for (const auto& f : blob.fields) s += (s.empty() ? "" : " ") + f.name;
+  return s.empty() ? "none" : s;
+}
+
+bool isNumericType(std::uint8_t t) {
+  return t >= pcl::PCLPointField::INT8 && t <= pcl::PCLPointField::FLOAT64;
+}
+
+/// Value of one numeric field (PCL stores the data in host byte order).
+float readAsFloat(const std::uint8_t* p, std::uint8_t datatype) {
+  auto load = [p](auto v) {
+    std::memcpy(&v, p, sizeof v);
+    return static_cast<float>(v);
+  };
+  switch (datatype) {
+    case pcl::PCLPointField::INT8: return load(std::int8_t{});
+    case pcl::PCLPointField::UINT8: return load(std::uint8_t{});
+    case pcl::PCLPointField::INT16: return load(std::int16_t{});
+    case pcl::PCLPointField::UINT16: return load(std::uint16_t{});
+    case pcl::PCLPointField::INT32: return load(std::int32_t{});
+    case pcl::PCLPointField::UINT32: return load(std::uint32_t{});
+    case pcl::PCLPointField::FLOAT32: return load(float{});
+    case pcl::PCLPointField::FLOAT64: return load(double{});
+    default: return 0.f;  // unreachable: callers check isNumericType
+  }
+}
+
+/// Checks that the data section the header promises is really in the file before PCL reads
+/// it: PCL maps the file into memory, and reading past the end of a truncated file would crash
+/// the process (SIGBUS) instead of failing.
+void requireCompleteBody(const std::string& path, const pcl::PCLPointCloud2& header,
+                         int data_type, unsigned int data_idx) {
+  const std::uintmax_t file_size = std::filesystem::file_size(path);
+  const std::uintmax_t points = std::uintmax_t{header.width} * header.height;
+  if (data_type == 1) {  // binary
+    const std::uintmax_t need = data_idx + points * header.point_step;
+    if (file_size < need) {
+      throw fileError(path, "truncated PCD: DATA binary needs " + std::to_string(need) +
+                                " bytes for " + std::to_string(points) + " points, the file has " +
+                                std::to_string(file_size));
+    }
+  } else if (data_type == 2) {  // binary_compressed: two uint32 sizes, then the LZF block
+    if (file_size < std::uintmax_t{data_idx} + 8) {
+      throw fileError(path, "truncated PCD: the binary_compressed block header is missing");
+    }
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(data_idx);
+    unsigned char sizes[8];
+    if (!in.read(reinterpret_cast<char*>(sizes), 8)) {
+      throw fileError(path, "cannot read the binary_compressed block header");
+    }
+    std::uint32_t compressed = 0;
+    for (int i = 3; i >= 0; --i) compressed = (compressed << 8) | sizes[i];  // little-endian
+    const std::uintmax_t need = std::uintmax_t{data_idx} + 8 + compressed;
+    if (file_size < need) {
+      throw fileError(path, "truncated PCD: the binary_compressed block needs " +
+                                std::to_string(need) + " bytes, the file has " +
+                                std::to_string(file_size));
+    }
+  }
+}
+
+/// PCL's ascii parser reads a malformed number as 0 without a word; check every value of
+/// the body first so a damaged ascii file fails instead of giving wrong points.
+void requireValidAsciiBody(const std::string& path, const pcl::PCLPointCloud2& header,
+                           unsigned int data_idx) {
+  std::size_t per_point = 0;
+  for (const auto& f : header.fields) per_point += f.count;
+  const std::size_t points = std::size_t{header.width} * header.height;
+
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  std::size_t line_no = 0;
+  // Count the header's lines so errors give the line number in the file.
+  std::size_t consumed = 0;
+  while (consumed < data_idx && std::getline(in, line)) {
+    ++line_no;
+    consumed += line.size() + 1;
+  }
+  std::size_t seen = 0;
+  while (seen < points && std::getline(in, line)) {
+    ++line_no;
+    std::size_t values = 0;
+    std::size_t pos = 0;
+    while (true) {
+      pos = line.find_first_not_of(" \t\r", pos);
+      if (pos == std::string::npos) break;
+      const std::size_t end = std::min(line.find_first_of(" \t\r", pos), line.size());
+      const char* first = line.data() + pos;
+      const char* last = line.data() + end;
+      if (first != last && *first == '+') ++first;  // from_chars rejects a leading '+'
+      double v;
+      const auto r = std::from_chars(first, last, v);
+      if (r.ec != std::errc() || r.ptr != last) {
+        throw fileError(path, "line " + std::to_string(line_no) + ": '" +
+                                  line.substr(pos, std::min<std::size_t>(end - pos, 40)) +
+                                  "' is not a number");
+      }
+      ++values;
+      pos = end;
+    }
+    if (values == 0) continue;
+    if (values != per_point) {
+      throw fileError(path, "line " + std::to_string(line_no) + ": " + std::to_string(values) +
+                                " values, the FIELDS/COUNT header says " +
+                                std::to_string(per_point));
+    }
+    ++seen;
+  }
+  if (seen < points) {
+    throw fileError(path, "truncated PCD: " + std::to_string(seen) + " of " +
+                              std::to_string(points) + " points in the DATA ascii section");
+  }
+}
+
+}  // namespace
+
+PointCloud readPcd(const std::string& path) {
+  detail::requireReadableFile(path);
+  const QuietPclConsole quiet;
+  pcl::PCDReader reader;
+  pcl::PCLPointCloud2 blob;
+  Eigen::Vector4f origin = Eigen::Vector4f::Zero();
+  Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
+  int version = 0;
+  int data_type = 0;
+  unsigned int data_idx = 0;
+
+  int rc = -1;
+  try {
+    rc = reader.readHeader(path, blob, origin, orientation, version, data_type, data_idx);
+  } catch (const std::exception& e) {
+    throw fileError(path, std::string("invalid PCD header: ") + e.what());
+  }
+  if (rc < 0) throw fileError(path, "invalid PCD header (not a PCD file, or a corrupt header)");
+
+  if (blob.fields.empty()) throw fileError(path, "not a PCD file (no FIELDS in the header)");
+  const pcl::PCLPointField* fx = findField(blob, "x");
+  const pcl::PCLPointField* fy = findField(blob, "y");
+  const pcl::PCLPointField* fz = findField(blob, "z");
+  if (!fx || !fy || !fz) {
+    throw fileError(path, "has no x/y/z fields (fields: " + fieldNames(blob) +
+                              "), so it is not a point cloud");
+  }
+  for (const pcl::PCLPointField* f : {fx, fy, fz}) {
+    if (!isNumericType(f->datatype)) {
+      throw fileError(path, "field '" + f->name + "' has an unsupported type");
+    }
+  }
+  requireCompleteBody(path, blob, data_type, data_idx);
+  if (data_type == 0) requireValidAsciiBody(path, blob, data_idx);
+
+  try {
+    rc = reader.read(path, blob, origin, orientation, version);
+  } catch (const std::exception& e) {
+    throw fileError(path, std::string("corrupt PCD data: ") + e.what());
+  }
+  const std::size_t n = std::size_t{blob.width} * blob.height;
+  if (rc < 0 || blob.data.size() < n * blob.point_step) {
+    throw fileError(path, "corrupt or truncated PCD data (" + std::to_string(n) +
+                              " points declared)");
+  }
+  // The body may carry different field offsets than the header said (PCL re-derives them);
+  // look them up again.
+  fx = findField(blob, "x");
+  fy = findField(blob, "y");
+  fz = findField(blob, "z");
+  if (!fx || !fy || !fz) throw fileError(path, "has no x/y/z fields after reading");
+
+  // rgb is a float whose bits are the packed colour, rgba a uint32: either way the 4 bytes are
+  // 0xAARRGGBB in host order. A colour field of another size is not a colour we know; it is
+  // ignored rather than misread.
+  const pcl::PCLPointField* fc = findField(blob, "rgb");
+  if (!fc) fc = findField(blob, "rgba");
+  if (fc && pcl::getFieldSize(fc->datatype) != 4) fc = nullptr;
+
+  PointCloud cloud;
+  cloud.x.resize(n);
+  cloud.y.resize(n);
+  cloud.z.resize(n);
+  if (fc) {
+    cloud.r.resize(n);
+    cloud.g.resize(n);
+    cloud.b.resize(n);
+  }
+  const std::uint8_t* data = blob.data.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t* p = data + i * blob.point_step;
+    cloud.x[i] = readAsFloat(p + fx->offset, fx->datatype);
+    cloud.y[i] = readAsFloat(p + fy->offset, fy->datatype);
+    cloud.z[i] = readAsFloat(p + fz->offset, fz->datatype);
+    if (fc) {
+      std::uint32_t c;
+      std::memcpy(&c, p + fc->offset, 4);
+      cloud.r[i] = static_cast<std::uint8_t>((c >> 16) & 0xff);
+      cloud.g[i] = static_cast<std::uint8_t>((c >> 8) & 0xff);
+      cloud.b[i] = static_cast<std::uint8_t>(c & 0xff);
+    }
+  }
+  if (blob.height > 1) {
+    cloud.width = blob.width;
+    cloud.height = blob.height;
+  } else {
+    cloud.width = n;
+    cloud.height = 1;
+  }
+  cloud.sensor_origin = origin.head<3>();
+  return cloud;
+}
+
+void writePcd(const std::string& path, const PointCloud& cloud) {
+  const std::size_t n = cloud.size();
+  if (cloud.y.size() != n || cloud.z.size() != n) {
+    throw std::invalid_argument("writePcd: x, y, z of the cloud differ in size");
+  }
+  const bool color = cloud.hasColor();
+
+  pcl::PCLPointCloud2 blob;
+  const char* names[] = {"x", "y", "z", "rgb"};
+  const int nfields = color ? 4 : 3;
+  for (int i = 0; i < nfields; ++i) {
+    pcl::PCLPointField f;
+    f.name = names[i];
+    f.offset = static_cast<pcl::uindex_t>(4 * i);
+    f.datatype = pcl::PCLPointField::FLOAT32;
+    f.count = 1;
+    blob.fields.push_back(f);
+  }
+  blob.point_step = static_cast<pcl::uindex_t>(4 * nfields);
+  if (cloud.isOrganized()) {
+    blob.width = static_cast<pcl::uindex_t>(cloud.width);
+    blob.height = static_cast<pcl::uindex_t>(cloud.height);
+  } else {
+    blob.width = static_cast<pcl::uindex_t>(n);
+    blob.height = 1;
+  }
+  blob.row_step = blob.point_step * blob.width;
+  blob.is_dense = false;
+
+  // The header comes from PCL so the file is exactly what PCL expects; the body is the packed
+  // records, built here so the whole file goes through writeFileAtomically.
+  std::string body;
+  body.reserve(n * blob.point_step);
+  for (std::size_t i = 0; i < n; ++i) {
+    detail::appendLittleEndian(body, cloud.x[i]);
+    detail::appendLittleEndian(body, cloud.y[i]);
+    detail::appendLittleEndian(body, cloud.z[i]);
+    if (color) {
+      const std::uint32_t c = (std::uint32_t{cloud.r[i]} << 16) |
+                              (std::uint32_t{cloud.g[i]} << 8) | std::uint32_t{cloud.b[i]};
+      float packed;
+      std::memcpy(&packed, &c, 4);
+      detail::appendLittleEndian(body, packed);
+    }
+  }
+  Eigen::Vector4f origin = Eigen::Vector4f::Zero();
+  origin.head<3>() = cloud.sensor_origin;
+  // generateHeaderBinary stops after POINTS; the DATA line is the caller's (as in PCL's own
+  // PCDWriter::writeBinary).
+  const std::string header =
+      pcl::PCDWriter().generateHeaderBinary(blob, origin, Eigen::Quaternionf::Identity()) +
+      "DATA binary\n";
+  writeFileAtomically(path, [&](std::ostream& os) {
+    os << header;
+    os.write(body.data(), static_cast<std::streamsize>(body.size()));
+  });
+}
+
+}  // namespace upd::io

@@ -1,0 +1,30 @@
+// The binary little-endian PLY writer shared by writePly and writeScoredPly (not installed):
+// one routine writes every PLY the project produces, so their headers cannot drift apart.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace upd::io::detail {
+
+/// One vertex property: float or uchar, read from data (n values) or, when data is null,
+/// the fill value for every vertex.
+struct PlyColumn {
+  std::string name;
+  bool is_uchar = false;
+  const float* f = nullptr;
+  const std::uint8_t* u8 = nullptr;
+  float fill_f = std::numeric_limits<float>::quiet_NaN();
+  std::uint8_t fill_u8 = 0;
+};
+
+/// Writes n vertices with the given columns (in order) atomically. With drop_non_finite_xyz
+/// the first three columns must be x, y, z and vertices with a non-finite coordinate are
+/// skipped. comments go into the header, one `comment` line each (newlines become spaces).
+void writeBinaryPly(const std::string& path, std::size_t n, const std::vector<PlyColumn>& columns,
+                    const std::vector<std::string>& comments, bool drop_non_finite_xyz);
+
+}  // namespace upd::io::detail

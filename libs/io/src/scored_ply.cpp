@@ -1,0 +1,113 @@
+#include "upd/io/cloud_io.h"
+
+#include "ply_detail.h"
+
+#include <stdexcept>
+
+namespace upd::io {
+
+namespace {
+
+template <class T>
+void requireSize(const ArrayView<T>& v, const char* name, std::size_t n, bool optional) {
+  if (v.size != 0 && v.data == nullptr) {
+    throw std::invalid_argument(std::string("ScoredPoints.") + name + " has a size but no data");
+  }
+  if ((optional && v.empty()) || v.size == n) return;
+  throw std::invalid_argument(std::string("ScoredPoints.") + name + " has " +
+                              std::to_string(v.size) + " values; expected " +
+                              (optional ? "0 or " : "") + std::to_string(n));
+}
+
+}  // namespace
+
+void ScoredPoints::validate() const {
+  const std::size_t n = size();
+  requireSize(x, "x", n, false);
+  requireSize(y, "y", n, false);
+  requireSize(z, "z", n, false);
+  requireSize(nx, "nx", n, true);
+  requireSize(ny, "ny", n, true);
+  requireSize(nz, "nz", n, true);
+  requireSize(rx, "rx", n, true);
+  requireSize(ry, "ry", n, true);
+  requireSize(rz, "rz", n, true);
+  requireSize(zeta, "zeta", n, true);
+  requireSize(label, "label", n, true);
+  requireSize(cost, "cost", n, true);
+  requireSize(r, "r", n, true);
+  requireSize(g, "g", n, true);
+  requireSize(b, "b", n, true);
+  if (r.empty() != g.empty() || r.empty() != b.empty()) {
+    throw std::invalid_argument("ScoredPoints.r/g/b must be all present or all absent");
+  }
+}
+
+ScoredPoints scoredPointsOf(const PipelineResult& result) {
+  ScoredPoints s;
+  const PointCloud& c = result.cloud;
+  s.x = c.x;
+  s.y = c.y;
+  s.z = c.z;
+  s.nx = result.normals.nx;
+  s.ny = result.normals.ny;
+  s.nz = result.normals.nz;
+  s.rx = result.upd.rx;
+  s.ry = result.upd.ry;
+  s.rz = result.upd.rz;
+  s.zeta = result.upd.zeta;
+  s.label = result.classes.label;
+  s.cost = result.classes.cost;
+  if (c.hasColor()) {
+    s.r = c.r;
+    s.g = c.g;
+    s.b = c.b;
+  }
+  return s;
+}
+
+const std::vector<std::string>& scoredPlyProperties() {
+  static const std::vector<std::string> kNames = {"x",  "y",  "z",    "nx",    "ny",  "nz",
+                                                  "rx", "ry", "rz", "zeta", "label", "cost"};
+  return kNames;
+}
+
+void writeScoredPly(const std::string& path, const ScoredPoints& p,
+                    const PlyWriteOptions& options) {
+  p.validate();
+  using detail::PlyColumn;
+  auto floatColumn = [](const char* name, const ArrayView<float>& v) {
+    PlyColumn c{name, false};
+    c.f = v.empty() ? nullptr : v.data;
+    return c;
+  };
+  auto byteColumn = [](const char* name, const std::uint8_t* data, std::uint8_t fill) {
+    PlyColumn c{name, true};
+    c.u8 = data;
+    c.fill_u8 = fill;
+    return c;
+  };
+  std::vector<PlyColumn> cols = {
+      floatColumn("x", p.x),   floatColumn("y", p.y),   floatColumn("z", p.z),
+      floatColumn("nx", p.nx), floatColumn("ny", p.ny), floatColumn("nz", p.nz),
+      floatColumn("rx", p.rx), floatColumn("ry", p.ry), floatColumn("rz", p.rz),
+      floatColumn("zeta", p.zeta),
+      // Label is a uint8_t enum; reading it through unsigned char is allowed aliasing.
+      byteColumn("label",
+                 p.label.empty() ? nullptr : reinterpret_cast<const std::uint8_t*>(p.label.data),
+                 static_cast<std::uint8_t>(Label::Unknown)),
+      floatColumn("cost", p.cost)};
+  if (!p.r.empty()) {
+    cols.push_back(byteColumn("red", p.r.data, 0));
+    cols.push_back(byteColumn("green", p.g.data, 0));
+    cols.push_back(byteColumn("blue", p.b.data, 0));
+  }
+  detail::writeBinaryPly(path, p.size(), cols, options.comments, options.drop_non_finite_xyz);
+}
+
+void writeScoredPly(const std::string& path, const PipelineResult& result,
+                    const PlyWriteOptions& options) {
+  writeScoredPly(path, scoredPointsOf(result), options);
+}
+
+}  // namespace upd::io

@@ -1,0 +1,51 @@
+// Writing the traversability grid as images: a colour PNG with a legend for people, and the
+// PGM + YAML pair of ROS map_server for planners.
+//
+// Every file is written atomically (temporary file in the same directory, then renamed); on
+// failure a one-line std::runtime_error names the file and no temporary file is left behind.
+#pragma once
+
+#include "upd/maps/traversability_grid.h"
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace upd::maps {
+
+/// Colour of a probability of being non-traversable: green (0) -> yellow (0.5) -> red (1); grey
+/// (128, 128, 128) for NaN (unknown). Returned as {r, g, b}.
+std::array<std::uint8_t, 3> traversabilityColourRgb(float p_nontrav);
+inline constexpr std::array<std::uint8_t, 3> kUnknownColourRgb{128, 128, 128};
+
+/// Where writeColourPng put things: the map occupies rows [0, map_height_px) (north up, row 0 is
+/// y max) and columns [0, map_width_px); the legend occupies rows
+/// [legend_top_px, image_height_px) over the full width.
+struct ColourPngLayout {
+  int pixels_per_cell = 1;
+  int map_width_px = 0;
+  int map_height_px = 0;
+  int legend_top_px = 0;
+  int image_width_px = 0;
+  int image_height_px = 0;
+};
+
+/// Writes the grid as a colour PNG (north up) with a legend below it: a colour bar from
+/// "traversable" to "non-traversable", an "unknown" swatch, the cell size and a scale bar.
+/// pixels_per_cell = 0 picks a scale that makes the map about 600 px wide (1..8 px per cell).
+ColourPngLayout writeColourPng(const TraversabilityGrid& grid, const std::string& path,
+                               int pixels_per_cell = 0);
+
+/// Values of the trinary PGM written by writeRosMap.
+inline constexpr std::uint8_t kRosOccupied = 0;
+inline constexpr std::uint8_t kRosFree = 254;
+inline constexpr std::uint8_t kRosUnknown = 205;
+
+/// Writes path_without_ext + ".pgm" and ".yaml" in ROS map_server's format: a binary P5 PGM,
+/// north up (image row 0 is y max), 0 = non-traversable, 254 = traversable, 205 = unknown (from
+/// labelOf, so the thresholds of GridParams decide), and a YAML with image (the PGM's file name,
+/// relative), resolution, origin [x_min, y_min, 0.0] (the lower-left corner of the lower-left
+/// pixel), negate 0, occupied_thresh 0.65, free_thresh 0.196, mode trinary.
+void writeRosMap(const TraversabilityGrid& grid, const std::string& path_without_ext);
+
+}  // namespace upd::maps

@@ -1,0 +1,513 @@
+#include "upd/maps/traversability_octree.h"
+
+#include "upd/io/atomic_file.h"
+#include "upd/maps/grid_export.h"
+
+#include <octomap/AbstractOcTree.h>
+#include <octomap/ColorOcTree.h>
+#include <octomap/Pointcloud.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <istream>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace upd::maps {
+
+namespace {
+
+bool sameFloat(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+// Larger of two log-odds / costs where NaN means "no evidence".
+float maxEvidence(float a, float b) {
+  if (std::isnan(a)) return b;
+  if (std::isnan(b)) return a;
+  return std::max(a, b);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Node
+
+TraversabilityOcTreeNode::TraversabilityOcTreeNode(const TraversabilityOcTreeNode& rhs)
+    : OcTreeNode(rhs),
+      trav_logodds_(rhs.trav_logodds_),
+      zeta_min_(rhs.zeta_min_),
+      cost_mean_(rhs.cost_mean_),
+      observations_(rhs.observations_) {}
+
+bool TraversabilityOcTreeNode::operator==(const TraversabilityOcTreeNode& rhs) const {
+  return rhs.value == value && sameFloat(rhs.trav_logodds_, trav_logodds_) &&
+         sameFloat(rhs.zeta_min_, zeta_min_) && sameFloat(rhs.cost_mean_, cost_mean_) &&
+         rhs.observations_ == observations_;
+}
+
+void TraversabilityOcTreeNode::copyData(const TraversabilityOcTreeNode& from) {
+  OcTreeNode::copyData(from);
+  trav_logodds_ = from.trav_logodds_;
+  zeta_min_ = from.zeta_min_;
+  cost_mean_ = from.cost_mean_;
+  observations_ = from.observations_;
+}
+
+void TraversabilityOcTreeNode::setTraversability(float logodds, float zeta_min, float cost_mean,
+                                                 std::uint16_t observations) {
+  trav_logodds_ = logodds;
+  zeta_min_ = zeta_min;
+  cost_mean_ = cost_mean;
+  observations_ = observations;
+}
+
+void TraversabilityOcTreeNode::updateTraversabilityChildren() {
+  if (children == nullptr) return;
+  float logodds = std::numeric_limits<float>::quiet_NaN();
+  float zeta_min = std::numeric_limits<float>::quiet_NaN();
+  float cost = std::numeric_limits<float>::quiet_NaN();
+  std::uint16_t observations = 0;
+  for (int i = 0; i < 8; ++i) {
+    const auto* c = static_cast<const TraversabilityOcTreeNode*>(children[i]);
+    if (c == nullptr) continue;
+    logodds = maxEvidence(logodds, c->trav_logodds_);
+    zeta_min = std::fmin(zeta_min, c->zeta_min_);
+    cost = maxEvidence(cost, c->cost_mean_);
+    observations = std::max(observations, c->observations_);
+  }
+  setTraversability(logodds, zeta_min, cost, observations);
+}
+
+std::ostream& TraversabilityOcTreeNode::writeData(std::ostream& s) const {
+  s.write(reinterpret_cast<const char*>(&value), sizeof(value));
+  s.write(reinterpret_cast<const char*>(&trav_logodds_), sizeof(trav_logodds_));
+  s.write(reinterpret_cast<const char*>(&zeta_min_), sizeof(zeta_min_));
+  s.write(reinterpret_cast<const char*>(&cost_mean_), sizeof(cost_mean_));
+  s.write(reinterpret_cast<const char*>(&observations_), sizeof(observations_));
+  return s;
+}
+
+std::istream& TraversabilityOcTreeNode::readData(std::istream& s) {
+  s.read(reinterpret_cast<char*>(&value), sizeof(value));
+  s.read(reinterpret_cast<char*>(&trav_logodds_), sizeof(trav_logodds_));
+  s.read(reinterpret_cast<char*>(&zeta_min_), sizeof(zeta_min_));
+  s.read(reinterpret_cast<char*>(&cost_mean_), sizeof(cost_mean_));
+  s.read(reinterpret_cast<char*>(&observations_), sizeof(observations_));
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parameters
+
+void OctreeParams::validate() const {
+  requireParam(std::isfinite(resolution_m) && resolution_m > 0, "OctreeParams", "resolution_m",
+               resolution_m, "must be > 0");
+  requireParam(std::isfinite(max_range_m), "OctreeParams", "max_range_m", max_range_m,
+               "must be finite (<= 0 for no limit)");
+  requireParam(prob_hit > 0.5 && prob_hit < 1, "OctreeParams", "prob_hit", prob_hit,
+               "must be in (0.5, 1)");
+  requireParam(prob_miss > 0 && prob_miss < 0.5, "OctreeParams", "prob_miss", prob_miss,
+               "must be in (0, 0.5)");
+  requireParam(prob_clamp_min > 0 && prob_clamp_min < 0.5, "OctreeParams", "prob_clamp_min",
+               prob_clamp_min, "must be in (0, 0.5)");
+  requireParam(prob_clamp_max > 0.5 && prob_clamp_max < 1, "OctreeParams", "prob_clamp_max",
+               prob_clamp_max, "must be in (0.5, 1)");
+  requireParam(std::isfinite(extent_m) && extent_m >= 2 * resolution_m, "OctreeParams", "extent_m",
+               extent_m, "must be at least two voxels");
+  requireParam(std::isfinite(height_m) && height_m >= 2 * resolution_m, "OctreeParams", "height_m",
+               height_m, "must be at least two voxels");
+  requireParam(std::isfinite(center_x_m), "OctreeParams", "center_x_m", center_x_m,
+               "must be finite");
+  requireParam(std::isfinite(center_y_m), "OctreeParams", "center_y_m", center_y_m,
+               "must be finite");
+  requireParam(std::isfinite(center_z_m), "OctreeParams", "center_z_m", center_z_m,
+               "must be finite");
+  requireParam(recenter_fraction > 0 && recenter_fraction < 0.5, "OctreeParams",
+               "recenter_fraction", recenter_fraction, "must be in (0, 0.5)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Tree
+
+TraversabilityOcTree::StaticMemberInitializer
+    TraversabilityOcTree::traversability_octree_member_init_;
+
+TraversabilityOcTree::StaticMemberInitializer::StaticMemberInitializer() {
+  // The factory keeps this prototype for the life of the process (OctoMap's pattern).
+  auto* tree = new TraversabilityOcTree(0.1);
+  tree->clearKeyRays();
+  octomap::AbstractOcTree::registerTreeType(tree);
+}
+
+TraversabilityOcTree::TraversabilityOcTree(double resolution_m)
+    : octomap::OccupancyOcTreeBase<TraversabilityOcTreeNode>(resolution_m) {
+  traversability_octree_member_init_.ensureLinking();
+}
+
+TraversabilityOcTree::TraversabilityOcTree(const OctreeParams& params)
+    : TraversabilityOcTree((params.validate(), params.resolution_m)) {
+  setProbHit(params.prob_hit);
+  setProbMiss(params.prob_miss);
+  setClampingThresMin(params.prob_clamp_min);
+  setClampingThresMax(params.prob_clamp_max);
+}
+
+TraversabilityOcTreeNode* TraversabilityOcTree::integrateTraversability(
+    const octomap::OcTreeKey& key, std::size_t n_nontrav, std::size_t n_trav, float zeta_min,
+    float cost_mean, const FusionParams& params) {
+  const double update = frameLogOddsUpdate(n_nontrav, n_trav, params);
+  if (update == 0.0) return nullptr;
+  TraversabilityOcTreeNode* n = search(key);
+  if (n == nullptr) return nullptr;
+  const float logodds = fuseLogOdds(n->trav_logodds_, update, params);
+  float cost = n->cost_mean_;
+  if (!std::isnan(cost_mean)) {
+    // Running mean over the frames that scored the voxel (each frame counts once).
+    cost = std::isnan(cost) ? cost_mean
+                            : (cost * n->observations_ + cost_mean) / (n->observations_ + 1.0f);
+  }
+  const auto observations = static_cast<std::uint16_t>(
+      std::min<unsigned>(n->observations_ + 1u, std::numeric_limits<std::uint16_t>::max()));
+  n->setTraversability(logodds, std::fmin(n->zeta_min_, zeta_min), cost, observations);
+  return n;
+}
+
+void TraversabilityOcTree::updateInnerOccupancy() {
+  if (root != nullptr) updateInnerOccupancyRecurs(root, 0);
+}
+
+void TraversabilityOcTree::updateInnerOccupancyRecurs(TraversabilityOcTreeNode* node,
+                                                      unsigned int depth) {
+  if (!nodeHasChildren(node)) return;
+  if (depth < tree_depth) {
+    for (unsigned int i = 0; i < 8; ++i) {
+      if (nodeChildExists(node, i)) updateInnerOccupancyRecurs(getNodeChild(node, i), depth + 1);
+    }
+  }
+  node->updateOccupancyChildren();
+  node->updateTraversabilityChildren();
+}
+
+void TraversabilityOcTree::cropToKeyBox(const octomap::OcTreeKey& min_key,
+                                        const octomap::OcTreeKey& max_key) {
+  if (root == nullptr) return;
+  const octomap::OcTreeKey root_key(tree_max_val, tree_max_val, tree_max_val);
+  if (cropRecurs(root, root_key, 0, min_key, max_key)) {
+    clear();
+    return;
+  }
+  tree_size = calcNumNodes();
+  size_changed = true;
+  updateInnerOccupancy();
+}
+
+bool TraversabilityOcTree::cropRecurs(TraversabilityOcTreeNode* node, const octomap::OcTreeKey& key,
+                                      unsigned int depth, const octomap::OcTreeKey& min_key,
+                                      const octomap::OcTreeKey& max_key) {
+  // Keys covered by the node: a leaf covers its own key; a node at depth d < tree_depth covers
+  // [key - half, key + half - 1] with half = tree_max_val >> d (children at key +- half / 2).
+  bool inside = true;
+  for (int a = 0; a < 3; ++a) {
+    long lo = key[a], hi = key[a];
+    if (depth < tree_depth) {
+      const long half = static_cast<long>(tree_max_val >> depth);
+      lo = key[a] - half;
+      hi = key[a] + half - 1;
+    }
+    if (hi < min_key[a] || lo > max_key[a]) return true;  // entirely outside
+    if (lo < min_key[a] || hi > max_key[a]) inside = false;
+  }
+  if (inside) return false;
+  if (!nodeHasChildren(node)) {
+    // A pruned node straddling the box: split it so the part inside survives.
+    expandNode(node);
+  }
+  const octomap::key_type offset = static_cast<octomap::key_type>(tree_max_val >> (depth + 1));
+  for (unsigned int i = 0; i < 8; ++i) {
+    if (!nodeChildExists(node, i)) continue;
+    octomap::OcTreeKey child_key;
+    octomap::computeChildKey(i, offset, key, child_key);
+    TraversabilityOcTreeNode* child = getNodeChild(node, i);
+    if (cropRecurs(child, child_key, depth + 1, min_key, max_key)) {
+      deleteNodeRecurs(child);
+      node->children[i] = nullptr;
+    }
+  }
+  if (!nodeHasChildren(node)) {
+    delete[] node->children;
+    node->children = nullptr;
+    return true;
+  }
+  return false;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Insertion
+
+namespace {
+
+struct FrameVoxel {
+  std::uint32_t n_nontrav = 0, n_trav = 0;
+  float zeta_min = std::numeric_limits<float>::quiet_NaN();
+  double cost_sum = 0;
+  std::uint32_t n_cost = 0;
+};
+
+// Key of a coordinate, clamped to the tree's key range (box corners may lie beyond it). OctoMap's
+// occupancy trees have 16 levels: keys 0..65535, the world origin at key 32768 (tree_max_val).
+octomap::OcTreeKey clampedKey(const TraversabilityOcTree& tree, const octomap::point3d& p) {
+  constexpr double kTreeMaxVal = 32768.0;
+  octomap::OcTreeKey k;
+  for (int a = 0; a < 3; ++a) {
+    const double v = std::floor(p(a) / tree.getResolution()) + kTreeMaxVal;
+    k[a] = static_cast<octomap::key_type>(std::clamp(v, 0.0, 2.0 * kTreeMaxVal - 1.0));
+  }
+  return k;
+}
+
+// Sets (and crops to) the update box; returns true when it moved.
+bool updateBox(TraversabilityOcTree& tree, const Eigen::Vector3d& sensor,
+               const OctreeParams& params) {
+  const Eigen::Vector3d size(params.extent_m, params.extent_m, params.height_m);
+  const Eigen::Vector3d initial(params.center_x_m, params.center_y_m, params.center_z_m);
+  Eigen::Vector3d center = initial;
+  if (tree.bbxSet()) {
+    const octomap::point3d c = tree.getBBXCenter();
+    center = Eigen::Vector3d(c.x(), c.y(), c.z());
+  }
+  bool recenter = false;
+  if (params.follow_robot) {
+    const Eigen::Vector3d off = (sensor - center).cwiseAbs();
+    recenter = (off.array() > params.recenter_fraction * size.array()).any();
+  } else {
+    // The box is kept in float: only a change of more than half a voxel is a new box.
+    recenter = tree.bbxSet() &&
+               (center - initial).cwiseAbs().maxCoeff() > 0.5 * tree.getResolution();
+    center = initial;
+  }
+  if (tree.bbxSet() && !recenter) return false;
+  if (recenter && params.follow_robot) {
+    // Snapped to the voxel grid: the box does not jitter with the sensor.
+    const double r = tree.getResolution();
+    center = ((sensor / r).array().floor() + 0.5).matrix() * r;
+  }
+  octomap::point3d bmin(static_cast<float>(center.x() - 0.5 * size.x()),
+                        static_cast<float>(center.y() - 0.5 * size.y()),
+                        static_cast<float>(center.z() - 0.5 * size.z()));
+  octomap::point3d bmax(static_cast<float>(center.x() + 0.5 * size.x()),
+                        static_cast<float>(center.y() + 0.5 * size.y()),
+                        static_cast<float>(center.z() + 0.5 * size.z()));
+  tree.setBBXMin(bmin);
+  tree.setBBXMax(bmax);
+  tree.useBBXLimit(true);
+  tree.cropToKeyBox(clampedKey(tree, bmin), clampedKey(tree, bmax));
+  return true;
+}
+
+}  // namespace
+
+OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& points,
+                             const Eigen::Vector3d& sensor_origin_world, const OctreeParams& params,
+                             const FusionParams& fusion) {
+  params.validate();
+  fusion.validate();
+  points.validate();
+  requireParam(std::abs(tree.getResolution() - params.resolution_m) <= 1e-9 * params.resolution_m,
+               "insertScan", "OctreeParams.resolution_m", params.resolution_m,
+               "differs from the tree's resolution");
+  requireParam(sensor_origin_world.allFinite(), "insertScan", "sensor_origin_world",
+               std::to_string(sensor_origin_world.x()) + "," +
+                   std::to_string(sensor_origin_world.y()) + "," +
+                   std::to_string(sensor_origin_world.z()),
+               "must be finite");
+  OctreeInsertStats stats;
+  stats.window_moved = updateBox(tree, sensor_origin_world, params);
+
+  const octomap::point3d origin(static_cast<float>(sensor_origin_world.x()),
+                                static_cast<float>(sensor_origin_world.y()),
+                                static_cast<float>(sensor_origin_world.z()));
+  const double max_range = params.max_range_m > 0 ? params.max_range_m : -1.0;
+  octomap::Pointcloud cloud;
+  cloud.reserve(points.size);
+  std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash> frame;
+  for (std::size_t i = 0; i < points.size; ++i) {
+    const float x = points.x[i], y = points.y[i], z = points.z[i];
+    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+      ++stats.points_invalid;
+      continue;
+    }
+    cloud.push_back(x, y, z);
+    ++stats.points_inserted;
+    const Label label = points.label[i];
+    if (label != Label::Traversable && label != Label::NonTraversable) {
+      ++stats.points_unknown;
+      continue;
+    }
+    // The voxels OctoMap marks as hit: within range and inside the box (as computeUpdate).
+    const octomap::point3d p(x, y, z);
+    if (max_range > 0 && (p - origin).norm() > max_range) continue;
+    if (tree.bbxSet() && !tree.inBBX(p)) continue;
+    octomap::OcTreeKey key;
+    if (!tree.coordToKeyChecked(p, key)) continue;
+    FrameVoxel& v = frame[key];
+    if (label == Label::NonTraversable) {
+      ++v.n_nontrav;
+    } else {
+      ++v.n_trav;
+    }
+    if (points.zeta != nullptr && std::isfinite(points.zeta[i])) {
+      v.zeta_min = std::fmin(v.zeta_min, points.zeta[i]);
+    }
+    if (points.cost != nullptr && std::isfinite(points.cost[i])) {
+      v.cost_sum += points.cost[i];
+      ++v.n_cost;
+    }
+  }
+
+  tree.insertPointCloud(cloud, origin, max_range, /*lazy_eval=*/true);
+  for (const auto& [key, v] : frame) {
+    const float cost = v.n_cost > 0 ? static_cast<float>(v.cost_sum / v.n_cost)
+                                    : std::numeric_limits<float>::quiet_NaN();
+    if (tree.integrateTraversability(key, v.n_nontrav, v.n_trav, v.zeta_min, cost, fusion)) {
+      ++stats.voxels_traversability;
+    }
+  }
+  tree.updateInnerOccupancy();
+  return stats;
+}
+
+OctreeStats computeStats(const TraversabilityOcTree& tree) {
+  OctreeStats s;
+  s.nodes = tree.size();
+  s.memory_bytes = tree.memoryUsage();
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    ++s.leaves;
+    if (tree.isNodeOccupied(*it)) ++s.occupied_leaves;
+    if (it->hasTraversability()) {
+      ++s.traversability_leaves;
+      if (it->getNonTraversableProbability() >= 0.5f) ++s.non_traversable_leaves;
+    }
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Files
+
+namespace {
+
+// A ColorOcTree that can be built node by node from another tree (needs the protected root).
+class ColourCopy : public octomap::ColorOcTree {
+ public:
+  explicit ColourCopy(double resolution) : ColorOcTree(resolution) {}
+
+  void copyFrom(const TraversabilityOcTree& src) {
+    clear();
+    if (src.getRoot() == nullptr) return;
+    root = new octomap::ColorOcTreeNode();
+    ++tree_size;
+    copyRecurs(src, src.getRoot(), root);
+    size_changed = true;
+  }
+
+ private:
+  void copyRecurs(const TraversabilityOcTree& src, const TraversabilityOcTreeNode* from,
+                  octomap::ColorOcTreeNode* to) {
+    to->setLogOdds(from->getLogOdds());
+    const auto rgb = traversabilityColourRgb(from->getNonTraversableProbability());
+    to->setColor(rgb[0], rgb[1], rgb[2]);
+    if (!src.nodeHasChildren(from)) return;
+    for (unsigned int i = 0; i < 8; ++i) {
+      if (src.nodeChildExists(from, i)) {
+        copyRecurs(src, src.getNodeChild(from, i), createNodeChild(to, i));
+      }
+    }
+  }
+};
+
+}  // namespace
+
+void writeTraversabilityOt(const TraversabilityOcTree& tree, const std::string& path) {
+  io::writeFileAtomically(path, [&](std::ostream& out) {
+    if (!tree.write(out)) {
+      throw std::runtime_error("cannot write '" + path + "': OctoMap failed to write the tree");
+    }
+  });
+}
+
+void writeOccupancyBt(const TraversabilityOcTree& tree, const std::string& path) {
+  io::writeFileAtomically(path, [&](std::ostream& out) {
+    // AbstractOccupancyOcTree::writeBinaryConst's header, but with id OcTree: the binary data
+    // is occupancy only, so every reader (octovis, octomap_server) takes it as a plain OcTree.
+    out << "# Octomap OcTree binary file\n"
+        << "# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
+        << "id OcTree\n"
+        << "size " << tree.size() << "\n"
+        << "res " << tree.getResolution() << "\n"
+        << "data\n";
+    tree.writeBinaryData(out);
+  });
+}
+
+void writeColourOt(const TraversabilityOcTree& tree, const std::string& path) {
+  ColourCopy colour(tree.getResolution());
+  colour.copyFrom(tree);
+  io::writeFileAtomically(path, [&](std::ostream& out) {
+    if (!colour.write(out)) {
+      throw std::runtime_error("cannot write '" + path + "': OctoMap failed to write the tree");
+    }
+  });
+}
+
+std::unique_ptr<TraversabilityOcTree> readTraversabilityOt(const std::string& path) {
+  // The header is parsed here (as AbstractOcTree::readHeader does) rather than through
+  // AbstractOcTree::read, so that a wrong file gives one clear exception instead of OctoMap's
+  // messages on stderr.
+  const auto fail = [&](const std::string& why) {
+    return std::runtime_error("cannot read octree '" + path + "': " + why);
+  };
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw fail("cannot open the file");
+  std::string line;
+  std::getline(in, line);
+  if (line.rfind("# Octomap OcTree file", 0) != 0) {
+    throw fail("not an OctoMap .ot file (first line '" + line.substr(0, 40) + "')");
+  }
+  std::string id;
+  double res = 0;
+  long long size = -1;
+  bool data = false;
+  std::string token;
+  while (!data && in >> token) {
+    if (token == "data") {
+      data = true;
+    } else if (token == "id") {
+      in >> id;
+    } else if (token == "res") {
+      in >> res;
+    } else if (token == "size") {
+      in >> size;
+    }
+    if (token == "data" || token.rfind('#', 0) == 0 || token == "id" || token == "res" ||
+        token == "size") {
+      std::getline(in, line);  // rest of the line (comments; the newline before the data)
+    }
+  }
+  if (!data) throw fail("the header has no 'data' line");
+  if (id != "TraversabilityOcTree") {
+    throw fail("it holds a " + (id.empty() ? std::string("tree of no type") : id) +
+               ", not a TraversabilityOcTree");
+  }
+  if (!(res > 0) || size < 0) throw fail("the header has no valid 'res' and 'size'");
+  auto tree = std::make_unique<TraversabilityOcTree>(res);
+  if (size > 0) tree->readData(in);
+  if (!in || static_cast<long long>(tree->size()) != size) {
+    throw fail("truncated or corrupt data (" + std::to_string(tree->size()) + " of " +
+               std::to_string(size) + " nodes read)");
+  }
+  return tree;
+}
+
+}  // namespace upd::maps

@@ -1,0 +1,402 @@
+// The OctoMap tree with traversability: insertion, worst-child inner nodes, .ot / .bt files that
+// OctoMap reloads, the update box that bounds memory, and a real OctoMap file.
+#include "maps/frames.h"
+#include "test_data.h"
+#include "upd/maps/traversability_octree.h"
+
+#include <gtest/gtest.h>
+#include <octomap/AbstractOcTree.h>
+#include <octomap/ColorOcTree.h>
+#include <octomap/OcTree.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+
+using upd::Label;
+using upd::maps::FusionParams;
+using upd::maps::OctreeParams;
+using upd::maps::TraversabilityOcTree;
+using upd::maps::TraversabilityOcTreeNode;
+using upd::test::Frame;
+using upd::test::TempDir;
+
+namespace {
+
+using LeafId = std::tuple<int, int, int, unsigned>;  // key x, y, z, depth
+
+const Eigen::Vector3d kSensor(0.0, 0.0, 1.0);
+const octomap::point3d kObstacle(3.05f, 0.05f, 0.35f);
+const octomap::point3d kGround(2.05f, 0.05f, 0.05f);
+
+OctreeParams fixedParams() {
+  OctreeParams p;
+  p.resolution_m = 0.1;
+  p.follow_robot = false;
+  p.extent_m = 20.0;
+  p.height_m = 6.0;
+  return p;
+}
+
+// Ground at z in [0, 0.1) over x in [1, 4), y in [-1, 1), traversable; a box face at x in
+// [3, 3.1), y in [-0.2, 0.2), z in [0.1, 0.6), non-traversable. Points at voxel centres.
+Frame scene() {
+  Frame f;
+  for (int i = 10; i < 40; ++i) {
+    for (int j = -10; j < 10; ++j) {
+      f.add((i + 0.5f) * 0.1f, (j + 0.5f) * 0.1f, 0.05f, Label::Traversable, 1.0f, 0.0f, 0.1f);
+    }
+  }
+  for (int j = -2; j < 2; ++j) {
+    for (int k = 1; k < 6; ++k) {
+      f.add(3.05f, (j + 0.5f) * 0.1f, (k + 0.5f) * 0.1f, Label::NonTraversable, 0.8f, 1.2f, 1.0f);
+    }
+  }
+  f.add(2.55f, 1.55f, 0.05f, Label::Unknown, NAN, NAN, NAN);  // beside the ground: occupancy only
+  return f;
+}
+
+std::unique_ptr<TraversabilityOcTree> sceneTree(int frames = 3) {
+  const OctreeParams p = fixedParams();
+  auto tree = std::make_unique<TraversabilityOcTree>(p);
+  const Frame f = scene();
+  for (int k = 0; k < frames; ++k)
+    upd::maps::insertScan(*tree, f.view(), kSensor, p, FusionParams{});
+  return tree;
+}
+
+bool sameFloat(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+
+struct LeafData {
+  float logodds, trav, zeta, cost;
+  unsigned observations;
+  bool operator==(const LeafData& o) const {
+    return logodds == o.logodds && sameFloat(trav, o.trav) && sameFloat(zeta, o.zeta) &&
+           sameFloat(cost, o.cost) && observations == o.observations;
+  }
+};
+
+std::map<LeafId, LeafData> leavesOf(const TraversabilityOcTree& t) {
+  std::map<LeafId, LeafData> out;
+  for (auto it = t.begin_leafs(), end = t.end_leafs(); it != end; ++it) {
+    const auto k = it.getKey();
+    out[{k[0], k[1], k[2], it.getDepth()}] = {it->getLogOdds(), it->getTraversabilityLogOdds(),
+                                              it->getZetaMin(), it->getCostMean(),
+                                              it->getObservations()};
+  }
+  return out;
+}
+
+template <class Tree>
+std::set<LeafId> occupiedLeaves(const Tree& t) {
+  std::set<LeafId> out;
+  for (auto it = t.begin_leafs(), end = t.end_leafs(); it != end; ++it) {
+    if (!t.isNodeOccupied(*it)) continue;
+    const auto k = it.getKey();
+    out.insert({k[0], k[1], k[2], it.getDepth()});
+  }
+  return out;
+}
+
+bool noTemporaryFiles(const TempDir& dir) {
+  for (const auto& name : dir.listing()) {
+    if (name.find(".tmp") != std::string::npos) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST(TraversabilityOctree, StoresTraversabilityBesideOccupancy) {
+  const auto tree = sceneTree();
+  const TraversabilityOcTreeNode* obstacle = tree->search(kObstacle);
+  ASSERT_NE(obstacle, nullptr);
+  EXPECT_TRUE(tree->isNodeOccupied(obstacle));
+  EXPECT_NEAR(obstacle->getTraversabilityLogOdds(), 3 * 0.85, 1e-5);  // one update per frame
+  EXPECT_GT(obstacle->getNonTraversableProbability(), 0.9f);
+  EXPECT_FLOAT_EQ(obstacle->getZetaMin(), 0.8f);
+  EXPECT_FLOAT_EQ(obstacle->getCostMean(), 1.0f);
+  EXPECT_EQ(obstacle->getObservations(), 3u);
+
+  const TraversabilityOcTreeNode* ground = tree->search(kGround);
+  ASSERT_NE(ground, nullptr);
+  EXPECT_TRUE(tree->isNodeOccupied(ground));
+  EXPECT_LT(ground->getNonTraversableProbability(), 0.3f);
+  EXPECT_FLOAT_EQ(ground->getZetaMin(), 1.0f);
+  EXPECT_NEAR(ground->getCostMean(), 0.1f, 1e-6);
+
+  // Unknown points make occupancy only.
+  const TraversabilityOcTreeNode* unknown = tree->search(2.55, 1.55, 0.05);
+  ASSERT_NE(unknown, nullptr);
+  EXPECT_TRUE(tree->isNodeOccupied(unknown));
+  EXPECT_FALSE(unknown->hasTraversability());
+  EXPECT_TRUE(std::isnan(unknown->getNonTraversableProbability()));
+
+  // A voxel the rays cross is free and has no traversability.
+  const TraversabilityOcTreeNode* free_voxel = tree->search(1.05, 0.05, 0.55);
+  ASSERT_NE(free_voxel, nullptr);
+  EXPECT_FALSE(tree->isNodeOccupied(free_voxel));
+  EXPECT_FALSE(free_voxel->hasTraversability());
+
+  const auto stats = upd::maps::computeStats(*tree);
+  EXPECT_EQ(stats.traversability_leaves, 30u * 20u + 4u * 5u);  // ground + box face
+  EXPECT_EQ(stats.non_traversable_leaves, 4u * 5u);
+  EXPECT_EQ(stats.occupied_leaves, 30u * 20u + 4u * 5u + 1u);  // + the Unknown point
+}
+
+TEST(TraversabilityOctree, InnerNodesHoldTheWorstChild) {
+  const auto tree = sceneTree();
+  float max_trav = -INFINITY, min_zeta = INFINITY, max_cost = -INFINITY;
+  for (auto it = tree->begin_leafs(), end = tree->end_leafs(); it != end; ++it) {
+    if (!it->hasTraversability()) continue;
+    max_trav = std::max(max_trav, it->getTraversabilityLogOdds());
+    min_zeta = std::min(min_zeta, it->getZetaMin());
+    max_cost = std::max(max_cost, it->getCostMean());
+  }
+  const TraversabilityOcTreeNode* root = tree->getRoot();
+  ASSERT_NE(root, nullptr);
+  EXPECT_FLOAT_EQ(root->getTraversabilityLogOdds(), max_trav);
+  EXPECT_FLOAT_EQ(root->getZetaMin(), min_zeta);
+  EXPECT_FLOAT_EQ(root->getCostMean(), max_cost);
+  // A coarse node (1.6 m) that holds both the obstacle and some ground reports the obstacle.
+  const TraversabilityOcTreeNode* coarse = tree->search(kObstacle, 12);
+  ASSERT_NE(coarse, nullptr);
+  EXPECT_GT(coarse->getNonTraversableProbability(), 0.9f);
+}
+
+TEST(TraversabilityOctree, OtReloadsAsTraversabilityOcTreeWithTheSameLeaves) {
+  const auto tree = sceneTree();
+  TempDir dir("ot");
+  const std::string path = dir.file("map.ot");
+  upd::maps::writeTraversabilityOt(*tree, path);
+  EXPECT_TRUE(noTemporaryFiles(dir));
+
+  std::unique_ptr<octomap::AbstractOcTree> read(octomap::AbstractOcTree::read(path));
+  ASSERT_NE(read, nullptr);
+  EXPECT_EQ(read->getTreeType(), "TraversabilityOcTree");
+  auto* reloaded = dynamic_cast<TraversabilityOcTree*>(read.get());
+  ASSERT_NE(reloaded, nullptr);
+  EXPECT_DOUBLE_EQ(reloaded->getResolution(), tree->getResolution());
+  EXPECT_EQ(reloaded->size(), tree->size());
+  const auto a = leavesOf(*tree);
+  const auto b = leavesOf(*reloaded);
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a == b);
+  EXPECT_FLOAT_EQ(reloaded->getRoot()->getTraversabilityLogOdds(),
+                  tree->getRoot()->getTraversabilityLogOdds());
+
+  const auto again = upd::maps::readTraversabilityOt(path);
+  EXPECT_TRUE(leavesOf(*again) == a);
+
+  // A truncated file is an error, not a smaller map.
+  const auto full = std::filesystem::file_size(path);
+  std::filesystem::resize_file(path, full / 2);
+  try {
+    upd::maps::readTraversabilityOt(path);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+TEST(TraversabilityOctree, BtReloadsAsOcTreeWithTheSameOccupiedLeaves) {
+  const auto tree = sceneTree();
+  TempDir dir("bt");
+  const std::string path = dir.file("map.bt");
+  upd::maps::writeOccupancyBt(*tree, path);
+  EXPECT_TRUE(noTemporaryFiles(dir));
+  std::ifstream in(path);
+  std::string first, line;
+  std::getline(in, first);
+  EXPECT_EQ(first, "# Octomap OcTree binary file");
+  bool has_id = false;
+  while (std::getline(in, line) && line != "data") has_id |= line == "id OcTree";
+  EXPECT_TRUE(has_id);
+
+  octomap::OcTree reloaded(path);
+  EXPECT_DOUBLE_EQ(reloaded.getResolution(), tree->getResolution());
+  EXPECT_EQ(reloaded.size(), tree->size());
+  const auto occ = occupiedLeaves(*tree);
+  EXPECT_GT(occ.size(), 600u);
+  EXPECT_EQ(occupiedLeaves(reloaded), occ);
+  // Writing the .bt does not change the tree (no max-likelihood conversion, no pruning).
+  EXPECT_NEAR(tree->search(kObstacle)->getTraversabilityLogOdds(), 3 * 0.85, 1e-5);
+  EXPECT_THROW(upd::maps::readTraversabilityOt(path), std::runtime_error);
+}
+
+TEST(TraversabilityOctree, ColourOtIsAColorOcTreeColouredByTraversability) {
+  const auto tree = sceneTree();
+  TempDir dir("colour");
+  const std::string path = dir.file("colour.ot");
+  upd::maps::writeColourOt(*tree, path);
+  std::unique_ptr<octomap::AbstractOcTree> read(octomap::AbstractOcTree::read(path));
+  ASSERT_NE(read, nullptr);
+  auto* colour = dynamic_cast<octomap::ColorOcTree*>(read.get());
+  ASSERT_NE(colour, nullptr);
+  EXPECT_EQ(occupiedLeaves(*colour), occupiedLeaves(*tree));
+  const auto red = colour->search(kObstacle)->getColor();
+  EXPECT_GT(red.r, 200);
+  EXPECT_LT(red.g, 60);
+  const auto green = colour->search(kGround)->getColor();
+  EXPECT_LT(green.r, 150);
+  EXPECT_GT(green.g, 200);
+  const auto grey = colour->search(2.55, 1.55, 0.05)->getColor();
+  EXPECT_EQ(grey.r, 128);
+  EXPECT_EQ(grey.g, 128);
+  // It is not a traversability tree.
+  try {
+    upd::maps::readTraversabilityOt(path);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("ColorOcTree"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TraversabilityOctree, RealOctomapFileLoadsAndRoundTrips) {
+  UPD_REQUIRE_SHARED_FILE(path, "octomap/geb079.bt");
+  octomap::OcTree reference(path);
+  ASSERT_GT(reference.size(), 0u);
+  TraversabilityOcTree tree(0.1);
+  ASSERT_TRUE(tree.readBinary(path));
+  EXPECT_DOUBLE_EQ(tree.getResolution(), reference.getResolution());
+  EXPECT_EQ(tree.size(), reference.size());
+  const auto occ = occupiedLeaves(reference);
+  EXPECT_GT(occ.size(), 1000u);
+  EXPECT_EQ(occupiedLeaves(tree), occ);
+  EXPECT_EQ(upd::maps::computeStats(tree).traversability_leaves, 0u);
+
+  TempDir dir("geb");
+  upd::maps::writeOccupancyBt(tree, dir.file("geb.bt"));
+  octomap::OcTree again(dir.file("geb.bt"));
+  EXPECT_EQ(occupiedLeaves(again), occ);
+  upd::maps::writeTraversabilityOt(tree, dir.file("geb.ot"));
+  EXPECT_EQ(occupiedLeaves(*upd::maps::readTraversabilityOt(dir.file("geb.ot"))), occ);
+}
+
+TEST(TraversabilityOctree, UpdateBoxFollowsTheRobotAndBoundsMemory) {
+  OctreeParams p;
+  p.resolution_m = 0.2;
+  p.max_range_m = 6.0;
+  p.follow_robot = true;
+  p.extent_m = 12.0;
+  p.height_m = 4.0;
+  TraversabilityOcTree tree(p);
+  std::size_t nodes_at_100m = 0, max_nodes = 0;
+  int moves = 0;
+  for (int step = 0; step <= 1000; ++step) {
+    const double x = step;  // 1 m per frame along x for 1 km
+    Frame f;
+    for (int u = 0; u < 20; ++u) {
+      for (int v = 0; v < 11; ++v) {
+        f.add(static_cast<float>(x + 1.1 + 0.2 * u), static_cast<float>(-1.1 + 0.2 * v), 0.1f,
+              (u * 11 + v) % 13 == 0 ? Label::NonTraversable : Label::Traversable);
+      }
+    }
+    const auto s = upd::maps::insertScan(tree, f.view(), {x, 0.0, 0.5}, p, FusionParams{});
+    moves += s.window_moved ? 1 : 0;
+    max_nodes = std::max(max_nodes, tree.size());
+    if (step == 100) nodes_at_100m = tree.size();
+  }
+  EXPECT_GT(moves, 100);
+  ASSERT_GT(nodes_at_100m, 0u);
+  EXPECT_LT(max_nodes, 2 * nodes_at_100m);  // no growth with distance
+  EXPECT_EQ(tree.calcNumNodes(), tree.size());
+  // Every leaf lies inside the current box.
+  const octomap::point3d bmin = tree.getBBXMin(), bmax = tree.getBBXMax();
+  const double tol = p.resolution_m;
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    const double half = 0.5 * it.getSize();
+    ASSERT_GE(it.getX() + half, bmin.x() - tol);
+    ASSERT_LE(it.getX() - half, bmax.x() + tol);
+    ASSERT_GE(it.getY() + half, bmin.y() - tol);
+    ASSERT_LE(it.getY() - half, bmax.y() + tol);
+  }
+  // The start is gone, the robot's surroundings are mapped.
+  EXPECT_EQ(tree.search(1.2, 0.0, 0.1), nullptr);
+  const TraversabilityOcTreeNode* ahead = tree.search(1002.2, 0.1, 0.1);
+  ASSERT_NE(ahead, nullptr);
+  EXPECT_TRUE(ahead->hasTraversability());
+}
+
+TEST(TraversabilityOctree, FixedBoxKeepsTheTreeInside) {
+  OctreeParams p;
+  p.resolution_m = 0.1;
+  p.follow_robot = false;
+  p.extent_m = 4.0;
+  p.height_m = 2.0;
+  TraversabilityOcTree tree(p);
+  Frame f;
+  f.add(1.05f, 0.05f, 0.05f, Label::NonTraversable);
+  f.add(5.05f, 0.05f, 0.05f, Label::NonTraversable);  // outside the box
+  upd::maps::insertScan(tree, f.view(), {0.0, 0.0, 0.5}, p, FusionParams{});
+  ASSERT_NE(tree.search(1.05, 0.05, 0.05), nullptr);
+  EXPECT_TRUE(tree.search(1.05, 0.05, 0.05)->hasTraversability());
+  EXPECT_EQ(tree.search(5.05, 0.05, 0.05), nullptr);
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    EXPECT_LE(std::abs(it.getX()), 2.0 + 1e-6);
+  }
+}
+
+TEST(TraversabilityOctree, CroppingDeletesOutsideAndSplitsStraddlingNodes) {
+  TraversabilityOcTree tree(0.1);
+  // A pruned 0.8 m block of identical free voxels, then crop through its middle.
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 8; ++j) {
+      for (int k = 0; k < 8; ++k)
+        tree.updateNode((i + 0.5) * 0.1, (j + 0.5) * 0.1, (k + 0.5) * 0.1, false);
+    }
+  }
+  tree.prune();
+  ASSERT_EQ(tree.getNumLeafNodes(), 1u);
+  tree.cropToKeyBox(tree.coordToKey(0.05, 0.05, 0.05), tree.coordToKey(0.35, 0.75, 0.75));
+  // The 0.8 m leaf straddled the box: split into eight 0.4 m blocks, the four inside kept.
+  EXPECT_EQ(tree.getNumLeafNodes(), 4u);
+  EXPECT_EQ(tree.calcNumNodes(), tree.size());
+  EXPECT_NE(tree.search(0.35, 0.75, 0.75), nullptr);
+  EXPECT_EQ(tree.search(0.45, 0.05, 0.05), nullptr);
+  tree.cropToKeyBox(tree.coordToKey(5.0, 5.0, 5.0), tree.coordToKey(6.0, 6.0, 6.0));
+  EXPECT_EQ(tree.size(), 0u);
+}
+
+TEST(TraversabilityOctree, WritesFailCleanlyAndParametersAreChecked) {
+  const auto tree = sceneTree(1);
+  TempDir dir("octree_missing");
+  const std::string missing = dir.file("nowhere");
+  for (const auto& [name, write] :
+       std::map<std::string, void (*)(const TraversabilityOcTree&, const std::string&)>{
+           {"map.ot", upd::maps::writeTraversabilityOt},
+           {"map.bt", upd::maps::writeOccupancyBt},
+           {"colour.ot", upd::maps::writeColourOt}}) {
+    const std::string target = missing + "/" + name;
+    try {
+      write(*tree, target);
+      ADD_FAILURE() << "no exception for " << target;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(target), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(dir.listing().empty());
+  EXPECT_THROW(upd::maps::readTraversabilityOt(missing + "/map.ot"), std::runtime_error);
+
+  OctreeParams other = fixedParams();
+  other.resolution_m = 0.2;
+  const Frame f = scene();
+  TraversabilityOcTree t(0.1);
+  EXPECT_THROW(upd::maps::insertScan(t, f.view(), kSensor, other, FusionParams{}),
+               std::invalid_argument);
+  OctreeParams bad = fixedParams();
+  bad.prob_hit = 0.3;
+  try {
+    bad.validate();
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("OctreeParams.prob_hit = 0.3"), std::string::npos);
+  }
+}
