@@ -1,0 +1,199 @@
+// The `upd` command as a user runs it: every cloud file in ../shared/data and every generated
+// scene is analysed; bad input stops with one line naming the file, option or value, a
+// non-zero exit, and no output file (not even half of one).
+#include "test_data.h"
+#include "upd/io/cloud_io.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sys/wait.h>
+
+namespace upd {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CmdResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+CmdResult runUpd(const std::string& args) {
+  const std::string cmd = std::string(UPD_BINARY) + " " + args + " 2>&1";
+  CmdResult r;
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), pipe.get())) r.output += buf.data();
+  const int status = pclose(pipe.release());
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("upd_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::size_t filesInDir() const {
+    return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir_), {}));
+  }
+  fs::path dir_;
+};
+
+TEST_F(Cli, HelpListsTheCommands) {
+  const CmdResult r = runUpd("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* c : {"analyze", "scene", "params"}) {
+    EXPECT_NE(r.output.find(c), std::string::npos) << c;
+  }
+  const CmdResult a = runUpd("analyze --help");
+  EXPECT_EQ(a.exit_code, 0);
+  EXPECT_NE(a.output.find("--radius-m"), std::string::npos);
+}
+
+TEST_F(Cli, EveryGeneratedSceneIsAnalysed) {
+  for (const char* scene : {"corner", "ramp", "step", "stairs", "ditch", "rocks"}) {
+    SCOPED_TRACE(scene);
+    const std::string ply = path(std::string(scene) + ".ply");
+    const CmdResult s = runUpd(std::string("scene ") + scene + " --spacing-m 0.03 --noise-m 0.001 " +
+                         "--output " + ply);
+    ASSERT_EQ(s.exit_code, 0) << s.output;
+    const PointCloud scene_cloud = io::readCloud(ply);
+    const CmdResult a = runUpd("analyze " + ply + " --no-preprocess --output " + path("out.ply") +
+                         " --stats-json " + path("out.json"));
+    ASSERT_EQ(a.exit_code, 0) << a.output;
+    const auto j = nlohmann::json::parse(std::ifstream(path("out.json")));
+    EXPECT_EQ(j["points_in"], scene_cloud.size());
+    EXPECT_EQ(j["labels"]["traversable"].get<std::size_t>() +
+                  j["labels"]["non_traversable"].get<std::size_t>() +
+                  j["labels"]["unknown"].get<std::size_t>(),
+              scene_cloud.size());
+    for (const char* key : {"points_scored", "points_invalid", "radius_m", "zeta", "labels",
+                            "timing_ms"}) {
+      EXPECT_TRUE(j.contains(key)) << key;
+    }
+    for (const char* key : {"preprocess", "normals", "upd", "classify", "total"}) {
+      EXPECT_TRUE(j["timing_ms"].contains(key)) << key;
+    }
+    EXPECT_EQ(io::readCloud(path("out.ply")).size(), scene_cloud.size());
+  }
+}
+
+TEST_F(Cli, EveryCloudFileInSharedDataIsAnalysedOrRefusedClearly) {
+  const auto data = test::sharedDataDir();
+  if (!fs::is_directory(data)) GTEST_SKIP() << data << " not found; skipped";
+  std::size_t analysed = 0;
+  for (const auto& e : fs::recursive_directory_iterator(data)) {
+    const std::string ext = e.path().extension().string();
+    if (ext != ".pcd" && ext != ".ply" && ext != ".xyz") continue;
+    SCOPED_TRACE(e.path().string());
+    const CmdResult r = runUpd("analyze " + e.path().string() + " --stats-json " + path("s.json"));
+    if (e.path().filename().string().rfind("stereo_", 0) == 0) {
+      // A stereo pair's grey images stored as PCD: no geometry to score.
+      EXPECT_EQ(r.exit_code, 1);
+      EXPECT_NE(r.output.find(e.path().string()), std::string::npos) << r.output;
+      EXPECT_NE(r.output.find("x/y/z"), std::string::npos) << r.output;
+      continue;
+    }
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto j = nlohmann::json::parse(std::ifstream(path("s.json")));
+    EXPECT_GT(j["points_in"].get<std::size_t>(), 0u);
+    ++analysed;
+  }
+  EXPECT_GE(analysed, 7u);
+}
+
+TEST_F(Cli, MissingInputNamesTheFileAndWritesNothing) {
+  const CmdResult r = runUpd("analyze " + path("nope.pcd") + " --output " + path("o.ply"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find(path("nope.pcd")), std::string::npos) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_EQ(filesInDir(), 0u);
+}
+
+TEST_F(Cli, CorruptInputNamesTheFileAndWritesNothing) {
+  std::ofstream(path("bad.ply")) << "ply\nformat binary_little_endian 1.0\nelement vertex 1000\n"
+                                    "property float x\nproperty float y\nproperty float z\n"
+                                    "end_header\n\x01\x02";
+  const CmdResult r = runUpd("analyze " + path("bad.ply") + " --output " + path("o.ply") +
+                       " --stats-json " + path("o.json"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find(path("bad.ply")), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("o.ply")));
+  EXPECT_FALSE(fs::exists(path("o.json")));
+  EXPECT_EQ(filesInDir(), 1u);  // the input only: no temporary files left behind
+}
+
+TEST_F(Cli, BadParametersNameTheFieldAndValue) {
+  ASSERT_EQ(runUpd("scene corner --spacing-m 0.05 --output " + path("c.ply")).exit_code, 0);
+  const std::string in = path("c.ply");
+  struct Case {
+    std::string args, expected;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"--radius-m -1", "UpdParams.radius_m = -1: must be > 0"},
+           {"--voxel-m 0", "PreprocessParams.voxel_m = 0: must be > 0"},
+           {"--up 0,0,0", "PipelineParams.up = 0,0,0"},
+           {"--radius-m abc", "--radius-m = 'abc': not a number"},
+           {"--up 1,2", "--up = '1,2': expected three numbers"},
+           {"--frobnicate 3", "unknown option --frobnicate"},
+           {"--config " + path("missing.ini"), "config file " + path("missing.ini") + ": not found"},
+       }) {
+    SCOPED_TRACE(c.args);
+    const CmdResult r = runUpd("analyze " + in + " " + c.args + " --output " + path("o.ply"));
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_FALSE(fs::exists(path("o.ply")));
+  }
+}
+
+TEST_F(Cli, BadConfigValueNamesFileKeyAndValue) {
+  ASSERT_EQ(runUpd("scene step --spacing-m 0.05 --output " + path("s.ply")).exit_code, 0);
+  std::ofstream(path("bad.ini")) << "[UpdParams]\nradius_m = 0.5m\n";
+  const CmdResult r = runUpd("analyze " + path("s.ply") + " --config " + path("bad.ini"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find(path("bad.ini") + ": [UpdParams] radius_m = '0.5m': not a number"),
+            std::string::npos)
+      << r.output;
+}
+
+TEST_F(Cli, NaNAndEmptyCloudsAreHandled) {
+  std::ofstream(path("nan.xyz")) << "nan nan nan\n0 0 0\n0.01 0 0\n";
+  const CmdResult r = runUpd("analyze " + path("nan.xyz") + " --no-preprocess --stats-json " +
+                       path("n.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(std::ifstream(path("n.json")));
+  EXPECT_EQ(j["points_in"], 3);
+  EXPECT_EQ(j["points_scored"], 0);
+  EXPECT_EQ(j["points_invalid"], 3);
+  std::ofstream(path("empty.xyz")) << "# nothing\n";
+  const CmdResult e = runUpd("analyze " + path("empty.xyz") + " --stats-json " + path("e.json"));
+  ASSERT_EQ(e.exit_code, 0) << e.output;
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(path("e.json")))["points_in"], 0);
+}
+
+TEST_F(Cli, ParamsMarkdownMatchesTheDocs) {
+  const CmdResult r = runUpd("params --markdown");
+  ASSERT_EQ(r.exit_code, 0);
+  std::ifstream doc(std::string(UPD_SOURCE_DIR) + "/docs/PARAMETERS.md");
+  const std::string text((std::istreambuf_iterator<char>(doc)), std::istreambuf_iterator<char>());
+  // docs/PARAMETERS.md embeds `upd params --markdown` verbatim: regenerate it when this fails.
+  EXPECT_NE(text.find(r.output), std::string::npos)
+      << "docs/PARAMETERS.md is out of date; regenerate with scripts/gen-docs.sh";
+}
+
+}  // namespace
+}  // namespace upd
