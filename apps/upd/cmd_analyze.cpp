@@ -5,7 +5,7 @@
 #include "upd/core/pipeline.h"
 #include "upd/io/cloud_io.h"
 #include "upd/io/json_io.h"
-#include "upd/mrpt/ini_params.h"
+#include "run_config.h"
 
 #include <cstdio>
 #include <iostream>
@@ -37,7 +37,7 @@ int runAnalyze(const std::vector<std::string>& argv) {
   const std::string input = args.positionals()[0];
 
   PipelineParams params;
-  if (const auto cfg = args.str("--config")) mrptbridge::loadPipelineParams(*cfg, params);
+  if (const auto cfg = args.str("--config")) params = loadRunConfig(*cfg).observer.pipeline;
   if (const auto v = args.number("--radius-m")) params.upd.radius_m = *v;
   if (const auto v = args.number("--normal-radius-m")) params.normals.radius_m = *v;
   if (const auto v = args.integer("--knn")) params.normals.knn = params.upd.knn = *v;

@@ -4,8 +4,7 @@
 #include "cli.h"
 #include "commands.h"
 
-#include "upd/core/baselines.h"
-#include "upd/core/pipeline.h"
+#include "run_config.h"
 
 #include <cstdio>
 #include <iostream>
@@ -45,40 +44,19 @@ struct Printer {
   }
 };
 
-struct UpSection {
-  Eigen::Vector3f up;
-  template <class V>
-  void visit(V& v) {
-    v("up", up, "gravity-up direction x,y,z in the cloud frame (any length)");
-  }
-};
-
-template <class P>
-void section(std::ostream& os, bool markdown, const char* name, const char* what, P params) {
-  if (markdown) {
-    os << "\n### [" << name << "]\n\n" << what << "\n\n| key | default | meaning |\n|---|---|---|\n";
-  } else {
-    os << "\n[" << name << "]\n";
-  }
-  Printer p{os, markdown};
-  params.visit(p);
-}
-
 }  // namespace
 
 void printAllParams(std::ostream& os, bool markdown) {
-  const PipelineParams d;
-  section(os, markdown, "PipelineParams", "Frames of the UPD pipeline.", UpSection{d.up});
-  section(os, markdown, "PreprocessParams",
-          "Pre-processing (paper section 3): range cut-off, voxel down-sampling, outlier removal.",
-          d.preprocess);
-  section(os, markdown, "NormalParams", "PCA normals (paper eqs. 4-5).", d.normals);
-  section(os, markdown, "UpdParams", "The Unevenness Point Descriptor (paper eqs. 6-8).", d.upd);
-  section(os, markdown, "ClassifyParams", "Traversability labels and cost from the UPD.",
-          d.classify);
-  section(os, markdown, "BaselineParams",
-          "The paper's baselines (roughness and inclination index), for comparison.",
-          BaselineParams{});
+  RunConfig defaults;
+  forEachSection(defaults, [&](const char* name, const char* what, auto& params) {
+    if (markdown) {
+      os << "\n### [" << name << "]\n\n" << what << "\n\n| key | default | meaning |\n|---|---|---|\n";
+    } else {
+      os << "\n[" << name << "]\n";
+    }
+    Printer p{os, markdown};
+    params.visit(p);
+  });
 }
 
 int runParams(const std::vector<std::string>& argv) {

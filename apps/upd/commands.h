@@ -17,9 +17,13 @@ struct Command {
 int runAnalyze(const std::vector<std::string>& args);
 int runScene(const std::vector<std::string>& args);
 int runParams(const std::vector<std::string>& args);
+int runSimulate(const std::vector<std::string>& args);
+int runPlayback(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
 extern const char* const kSceneUsage;
 extern const char* const kParamsUsage;
+extern const char* const kSimulateUsage;
+extern const char* const kPlaybackUsage;
 
 }  // namespace upd::app

@@ -15,6 +15,10 @@ const Command kCommands[] = {
      upd::app::kAnalyzeUsage, upd::app::runAnalyze},
     {"scene", "write a generated test scene (the paper's experiments) as PLY",
      upd::app::kSceneUsage, upd::app::runScene},
+    {"simulate", "record a simulated robot run through a generated world as a rawlog",
+     upd::app::kSimulateUsage, upd::app::runSimulate},
+    {"playback", "replay a rawlog: UPD per frame, fused traversability maps, exports",
+     upd::app::kPlaybackUsage, upd::app::runPlayback},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };

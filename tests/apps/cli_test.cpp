@@ -185,6 +185,22 @@ TEST_F(Cli, NaNAndEmptyCloudsAreHandled) {
   EXPECT_EQ(nlohmann::json::parse(std::ifstream(path("e.json")))["points_in"], 0);
 }
 
+// Every shipped robot config loads strictly (an unknown section or key would stop the run).
+TEST_F(Cli, EveryShippedConfigLoads) {
+  ASSERT_EQ(runUpd("scene step --spacing-m 0.05 --output " + path("s.ply")).exit_code, 0);
+  std::size_t n = 0;
+  for (const auto& e : fs::directory_iterator(std::string(UPD_SOURCE_DIR) + "/config")) {
+    const std::string name = e.path().filename().string();
+    if (e.path().extension() != ".ini" || name.rfind("ptg", 0) == 0 || name.find("-nav") != std::string::npos) {
+      continue;  // navigator (PTG) files have their own format
+    }
+    const CmdResult r = runUpd("analyze " + path("s.ply") + " --config " + e.path().string());
+    EXPECT_EQ(r.exit_code, 0) << name << ": " << r.output;
+    ++n;
+  }
+  EXPECT_GE(n, 3u);
+}
+
 TEST_F(Cli, ParamsMarkdownMatchesTheDocs) {
   const CmdResult r = runUpd("params --markdown");
   ASSERT_EQ(r.exit_code, 0);

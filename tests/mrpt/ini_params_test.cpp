@@ -106,28 +106,5 @@ TEST_F(IniFile, TheFileIsNeverRewritten) {
   EXPECT_EQ(after, text);
 }
 
-TEST(ShippedConfigs, EveryConfigFileLoadsStrictly) {
-  std::size_t n = 0;
-  for (const auto& e : std::filesystem::directory_iterator(std::string(UPD_SOURCE_DIR) + "/config")) {
-    if (e.path().extension() != ".ini" || e.path().filename().string().rfind("ptg", 0) == 0) {
-      continue;
-    }
-    PipelineParams params;
-    EXPECT_NO_THROW(loadPipelineParams(e.path().string(), params)) << e.path();
-    ++n;
-  }
-  EXPECT_GE(n, 3u);
-}
-
-TEST(ShippedConfigs, DuneUsesTheSmallRoverRadius) {
-  PipelineParams params;
-  loadPipelineParams(std::string(UPD_SOURCE_DIR) + "/config/dune-kinect.ini", params);
-  EXPECT_DOUBLE_EQ(params.upd.radius_m, 0.5);
-  PipelineParams tractor;
-  loadPipelineParams(std::string(UPD_SOURCE_DIR) + "/config/tractor-stereo.ini", tractor);
-  EXPECT_DOUBLE_EQ(tractor.upd.radius_m, 1.0);
-  EXPECT_NEAR(params.classify.max_slope_rad, 25.0 * M_PI / 180.0, 1e-12);
-}
-
 }  // namespace
 }  // namespace upd::mrptbridge

@@ -1,0 +1,20 @@
+#include "run_config.h"
+
+#include "upd/mrpt/ini_params.h"
+
+namespace upd::app {
+
+RunConfig loadRunConfig(const std::string& path) {
+  RunConfig c;
+  mrptbridge::IniReader ini(path);
+  forEachSection(c, [&](const char* name, const char*, auto& params) { ini.read(name, params); });
+  ini.checkAllKeysKnown();
+  try {
+    c.observer.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("config file " + path + ": " + e.what());
+  }
+  return c;
+}
+
+}  // namespace upd::app

@@ -1,0 +1,99 @@
+// The UPD observer: one MRPT observation and the robot pose in, per-point UPD, traversability
+// labels and costs in the WORLD frame out.
+//
+// The observation becomes a cloud in the robot frame (observation_cloud.h), the whole UPD chain
+// (upd::runPipeline: pre-processing, PCA normals, UPD eqs. 4-8, classification) runs there, and
+// the scored points, their normals and UPD vectors r are then moved to the world frame by
+// pose_world_robot. Scoring in the robot frame keeps the voxel grid and the range cut-off tied to
+// the sensor and the float coordinates small wherever the robot is. Gravity-up for the slope is
+// the world's +z expressed in the robot frame, which is the robot's +z for any planar pose
+// (odometry); a robot tilted in 3D (a ground-truth pose) still measures slope against gravity.
+//
+// The observer holds only its parameters: observe() is const and may run on several threads.
+#pragma once
+
+#include "upd/core/pipeline.h"
+#include "upd/mrpt/observation_cloud.h"
+
+#include <Eigen/Geometry>
+
+#include <string>
+
+namespace mrpt::obs {
+class CObservation;
+}
+namespace mrpt::poses {
+class CPose3D;
+}
+
+namespace upd::mrptbridge {
+
+class IniReader;
+
+struct ObserverParams {
+  /// The UPD chain. pipeline.up must stay 0,0,1: clouds are scored in the robot frame (z up)
+  /// and gravity comes from the robot pose.
+  PipelineParams pipeline;
+  SourceParams source;  ///< how observations become clouds
+
+  /// Throws std::invalid_argument naming the field and value.
+  void validate() const;
+};
+
+/// Reads [PipelineParams] (key `up`, must be 0,0,1), [PreprocessParams], [NormalParams],
+/// [UpdParams], [ClassifyParams], [SourceParams] and [StereoMatchParams] from ini (absent
+/// sections and keys keep their defaults) and validates. It does not call
+/// ini.checkAllKeysKnown(): the file may hold other components' sections; the caller checks once
+/// everything is read.
+void loadObserverParams(IniReader& ini, ObserverParams& params);
+/// The same from a file that holds only these sections (unknown sections or keys are errors).
+void loadObserverParams(const std::string& ini_path, ObserverParams& params);
+
+struct ObserverTimings {
+  double convert_ms = 0;   ///< observation -> cloud in the robot frame
+  StageTimings pipeline;   ///< upd::runPipeline stages
+  double to_world_ms = 0;  ///< moving the results to the world frame
+  double total_ms = 0;
+};
+
+struct ObserverResult {
+  std::string source_class;    ///< short MRPT class name of the observation
+  std::string skipped_reason;  ///< non-empty: the observation gave no cloud, and why
+  bool ok() const { return skipped_reason.empty(); }
+
+  Eigen::Isometry3d pose_world_robot = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d pose_world_sensor = Eigen::Isometry3d::Identity();
+  bool organized_input = false;  ///< the converted cloud kept an image layout
+  std::size_t points_input = 0;  ///< finite points of the converted cloud
+
+  /// The scored (pre-processed) points in the world frame [m]; sensor_origin = the sensor's
+  /// position in the world. Every vector below has one entry per point, in the same order.
+  PointCloud points_in_world;
+  Normals normals_in_world;  ///< unit normals, world frame; NaN where none
+  UpdResult upd_in_world;    ///< r rotated into the world frame; zeta and k are frame-free
+  Classification classes;    ///< label, cost [0, 1] and slope against gravity [rad]
+  PreprocessStats preprocess_stats;
+  ObserverTimings timings;
+
+  std::size_t size() const { return points_in_world.size(); }
+};
+
+class UpdObserver {
+ public:
+  /// Validates params (throws std::invalid_argument).
+  explicit UpdObserver(const ObserverParams& params = ObserverParams());
+  const ObserverParams& params() const { return params_; }
+
+  ObserverResult observe(const mrpt::obs::CObservation& obs,
+                         const mrpt::poses::CPose3D& pose_world_robot) const;
+  ObserverResult observe(const mrpt::obs::CObservation& obs,
+                         const Eigen::Isometry3d& pose_world_robot) const;
+  /// For clouds already in the robot frame (e.g. stereoToCloud moved by the camera pose).
+  ObserverResult observeCloud(const ObservationCloud& cloud,
+                              const Eigen::Isometry3d& pose_world_robot) const;
+
+ private:
+  ObserverParams params_;
+};
+
+}  // namespace upd::mrptbridge

@@ -1,0 +1,216 @@
+// The UPD observer: MRPT observation + robot pose in, scored points in the world frame out.
+#include "upd/mrpt/upd_observer.h"
+#include "test_data.h"
+#include "upd/mrpt/ini_params.h"
+#include "upd/mrpt/pose_source.h"
+#include "upd/mrpt/rawlog_reader.h"
+
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+namespace {
+
+using upd::Label;
+using upd::mrptbridge::ObserverParams;
+using upd::mrptbridge::ObserverResult;
+using upd::mrptbridge::UpdObserver;
+
+std::shared_ptr<mrpt::obs::CObservation> groundScan() {
+  const std::string path = upd::test::sharedFile("mrpt/test-3d-obs-ground.rawlog");
+  if (path.empty()) return nullptr;
+  upd::mrptbridge::RawlogReader reader(path);
+  upd::mrptbridge::RawlogEntry e;
+  return reader.next(e) ? e.observation : nullptr;
+}
+
+#define REQUIRE_GROUND_SCAN(var)                                      \
+  const auto var = groundScan();                                      \
+  if (!var) {                                                         \
+    GTEST_SKIP() << "mrpt/test-3d-obs-ground.rawlog not found under " \
+                 << upd::test::sharedDataDir();                       \
+  }
+
+void expectConsistentSizes(const ObserverResult& r) {
+  const std::size_t n = r.size();
+  EXPECT_EQ(r.normals_in_world.size(), n);
+  EXPECT_EQ(r.upd_in_world.size(), n);
+  EXPECT_EQ(r.upd_in_world.rx.size(), n);
+  EXPECT_EQ(r.classes.label.size(), n);
+  EXPECT_EQ(r.classes.cost.size(), n);
+  EXPECT_EQ(r.classes.slope_rad.size(), n);
+  EXPECT_EQ(r.classes.traversable + r.classes.non_traversable + r.classes.unknown, n);
+}
+
+TEST(UpdObserver, FloorIsTraversableAtTheRobotsWorldPosition) {
+  REQUIRE_GROUND_SCAN(obs);
+  const UpdObserver observer;
+  const mrpt::poses::CPose3D robot(12.0, -3.0, 0.25, 30.0 * M_PI / 180.0, 0, 0);
+  const ObserverResult r = observer.observe(*obs, robot);
+  ASSERT_TRUE(r.ok()) << r.skipped_reason;
+  EXPECT_EQ(r.source_class, "CObservation3DRangeScan");
+  EXPECT_TRUE(r.organized_input);
+  EXPECT_NEAR(static_cast<double>(r.points_input), 37662.0, 200.0);
+  ASSERT_GT(r.size(), 1000u);
+  expectConsistentSizes(r);
+  // Every scored point is on the floor, now at the robot's z in the world, near the robot.
+  std::size_t on_floor = 0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const Eigen::Vector3f p = r.points_in_world.point(i);
+    on_floor += std::abs(p.z() - 0.25f) < 0.05f ? 1 : 0;
+    EXPECT_LT((p.head<2>() - Eigen::Vector2f(12.f, -3.f)).norm(), 3.f);
+  }
+  EXPECT_GT(on_floor, r.size() * 9 / 10);
+  // Normals point up in the world; the floor is traversable with zeta close to 1.
+  std::size_t up = 0, valid = 0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    if (!r.normals_in_world.isValid(i)) continue;
+    ++valid;
+    up += r.normals_in_world.nz[i] > 0.95f ? 1 : 0;
+  }
+  EXPECT_GT(up, valid * 9 / 10);
+  EXPECT_GT(r.classes.traversable, r.size() * 8 / 10);
+  // The sensor, 1.27 m above the robot origin, is 1.52 m above the world origin.
+  EXPECT_NEAR(r.pose_world_sensor.translation().z(), 1.273 + 0.25, 0.01);
+  EXPECT_TRUE(r.points_in_world.sensor_origin.isApprox(
+      r.pose_world_sensor.translation().cast<float>(), 1e-5f));
+  EXPECT_GE(r.timings.total_ms, r.timings.convert_ms);
+}
+
+// Moving or turning the robot on the ground changes nothing but where the points are.
+TEST(UpdObserver, ScoresDoNotDependOnThePlanarRobotPose) {
+  REQUIRE_GROUND_SCAN(obs);
+  const UpdObserver observer;
+  const Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d b =
+      upd::mrptbridge::toIsometry(mrpt::poses::CPose3D(5000.0, -7000.0, 2.0, 2.5, 0, 0));
+  const ObserverResult ra = observer.observe(*obs, a);
+  const ObserverResult rb = observer.observe(*obs, b);
+  ASSERT_EQ(ra.size(), rb.size());
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    ASSERT_EQ(ra.classes.label[i], rb.classes.label[i]);
+    if (ra.upd_in_world.isValid(i)) {
+      ASSERT_EQ(ra.upd_in_world.zeta[i], rb.upd_in_world.zeta[i]);
+      const Eigen::Vector3f r_rotated = b.linear().cast<float>() * ra.upd_in_world.r(i);
+      ASSERT_TRUE(r_rotated.isApprox(rb.upd_in_world.r(i), 1e-4f));
+    }
+    const Eigen::Vector3d moved = b * ra.points_in_world.point(i).cast<double>();
+    ASSERT_LT((moved - rb.points_in_world.point(i).cast<double>()).norm(), 2e-3);
+  }
+}
+
+// A robot pitched 10 deg in the world sees its own floor tilted: slope measured against gravity.
+TEST(UpdObserver, SlopeIsMeasuredAgainstGravity) {
+  REQUIRE_GROUND_SCAN(obs);
+  ObserverParams params;
+  params.pipeline.classify.max_slope_rad = 25.0 * M_PI / 180.0;
+  const UpdObserver observer(params);
+  const double pitch = 10.0 * M_PI / 180.0;
+  const ObserverResult flat = observer.observe(*obs, Eigen::Isometry3d::Identity());
+  const ObserverResult tilted = observer.observe(
+      *obs, upd::mrptbridge::toIsometry(mrpt::poses::CPose3D(0, 0, 0, 0, pitch, 0)));
+  std::vector<float> sf, st;
+  for (std::size_t i = 0; i < flat.size(); ++i) {
+    if (std::isfinite(flat.classes.slope_rad[i])) sf.push_back(flat.classes.slope_rad[i]);
+  }
+  for (std::size_t i = 0; i < tilted.size(); ++i) {
+    if (std::isfinite(tilted.classes.slope_rad[i])) st.push_back(tilted.classes.slope_rad[i]);
+  }
+  ASSERT_FALSE(sf.empty());
+  ASSERT_FALSE(st.empty());
+  std::nth_element(sf.begin(), sf.begin() + sf.size() / 2, sf.end());
+  std::nth_element(st.begin(), st.begin() + st.size() / 2, st.end());
+  EXPECT_LT(sf[sf.size() / 2], 3.0 * M_PI / 180.0);
+  EXPECT_NEAR(st[st.size() / 2], pitch, 3.0 * M_PI / 180.0);
+}
+
+TEST(UpdObserver, UnsupportedObservationIsSkippedWithReason) {
+  const UpdObserver observer;
+  mrpt::obs::CObservation2DRangeScan scan;
+  const ObserverResult r = observer.observe(scan, Eigen::Isometry3d::Identity());
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.skipped_reason, "CObservation2DRangeScan has no 3D points (a planar laser scan)");
+  EXPECT_EQ(r.size(), 0u);
+  expectConsistentSizes(r);
+}
+
+TEST(UpdObserver, VelodyneScanIsScored) {
+  UPD_REQUIRE_SHARED_FILE(path, "mrpt/test_velodyne_VLP16.rawlog");
+  upd::mrptbridge::RawlogReader reader(path);
+  upd::mrptbridge::RawlogEntry e;
+  ASSERT_TRUE(reader.next(e));
+  ObserverParams params;
+  params.pipeline.preprocess.voxel_m = 0.1;
+  params.pipeline.normals.radius_m = 0.5;
+  params.pipeline.upd.radius_m = 1.0;
+  const ObserverResult r =
+      UpdObserver(params).observe(*e.observation, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(r.ok()) << r.skipped_reason;
+  EXPECT_FALSE(r.organized_input);
+  EXPECT_GT(r.size(), 1000u);
+  expectConsistentSizes(r);
+  EXPECT_GT(r.classes.traversable + r.classes.non_traversable, r.size() / 4);
+}
+
+struct TempIni {
+  std::filesystem::path path;
+  explicit TempIni(const std::string& text) {
+    path = std::filesystem::temp_directory_path() /
+           ("upd_observer_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".ini");
+    std::ofstream(path) << text;
+  }
+  ~TempIni() {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+  }
+};
+
+TEST(UpdObserver, ParamsFromIni) {
+  const TempIni ini(
+      "[PipelineParams]\nup = 0,0,1\n"
+      "[UpdParams]\nradius_m = 0.7\n"
+      "[SourceParams]\ncolor_enabled = false\nlidar_max_range_m = 40\n"
+      "[StereoMatchParams]\nnum_disparities_px = 64\nblock_size_px = 7\n");
+  ObserverParams p;
+  upd::mrptbridge::loadObserverParams(ini.path.string(), p);
+  EXPECT_DOUBLE_EQ(p.pipeline.upd.radius_m, 0.7);
+  EXPECT_FALSE(p.source.color_enabled);
+  EXPECT_DOUBLE_EQ(p.source.lidar_max_range_m, 40.0);
+  EXPECT_EQ(p.source.stereo.num_disparities_px, 64);
+  EXPECT_EQ(p.source.stereo.block_size_px, 7);
+
+  // Shared file with other components' sections: the caller checks unknown keys at the end.
+  const TempIni shared("[SourceParams]\nlidar_min_range_m = 2\n[SomebodyElse]\nkey = 1\n");
+  upd::mrptbridge::IniReader reader(shared.path.string());
+  ObserverParams q;
+  upd::mrptbridge::loadObserverParams(reader, q);
+  EXPECT_DOUBLE_EQ(q.source.lidar_min_range_m, 2.0);
+  EXPECT_THROW(reader.checkAllKeysKnown(), std::invalid_argument);
+
+  const TempIni tilted_up("[PipelineParams]\nup = 0,-1,0\n");
+  try {
+    ObserverParams r;
+    upd::mrptbridge::loadObserverParams(tilted_up.path.string(), r);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(tilted_up.path.string()), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("pipeline.up"), std::string::npos) << e.what();
+  }
+  const TempIni typo("[SourceParams]\nlidar_max_rang_m = 4\n");
+  ObserverParams s;
+  EXPECT_THROW(upd::mrptbridge::loadObserverParams(typo.path.string(), s), std::invalid_argument);
+  const TempIni bad_stereo("[StereoMatchParams]\nnum_disparities_px = 50\n");
+  EXPECT_THROW(upd::mrptbridge::loadObserverParams(bad_stereo.path.string(), s),
+               std::invalid_argument);
+}
+
+}  // namespace
