@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
-# Quick start, command 1: set up, build, and run the main job on data the project generates.
+# Quick start, command 1: set up, build, and run the main job on data the project generates:
+# a simulated Dune run through the mixed world (ramp, rocks, step, ditch) recorded as an MRPT
+# rawlog, played back into fused traversability maps and scored against the world's truth.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 
 OUT="${1:-$UPD_ROOT/out/demo}"
 mkdir -p "$OUT"
 UPD="$UPD_BUILD/apps/upd/upd"
-for scene in corner ramp step stairs ditch rocks; do
-  "$UPD" scene "$scene" --output "$OUT/$scene.ply" --noise-m 0.002
-  "$UPD" analyze "$OUT/$scene.ply" --no-preprocess --output "$OUT/$scene-upd.ply" \
-    --stats-json "$OUT/$scene-upd.json"
-done
-echo "demo: outputs in $OUT (open the *-upd.ply files in CloudCompare or MeshLab)"
+"$UPD" simulate --world mixed --output "$OUT/mixed.rawlog"
+"$UPD" playback "$OUT/mixed.rawlog" --config "$UPD_ROOT/config/dune-kinect.ini" \
+  --poses "$OUT/mixed.gt.tum" --output "$OUT/maps"
+echo "demo: maps in $OUT/maps (map.png, map.pgm/.yaml, map.ot/.bt, map.3Dscene, summary.json)"

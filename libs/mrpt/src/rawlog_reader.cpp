@@ -1,5 +1,8 @@
 #include "upd/mrpt/rawlog_reader.h"
 
+#include <mrpt/maps/registerAllClasses.h>
+#include <mrpt/obs/registerAllClasses.h>
+
 #include "mrpt_util.h"
 #include "upd/mrpt/pose_source.h"
 
@@ -234,6 +237,10 @@ struct RawlogReader::Impl {
 };
 
 RawlogReader::RawlogReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
+  // Observation classes register when their module loads; a program that links mrpt-maps but
+  // calls nothing in it would not know CObservationPointCloud (and friends) when reading.
+  mrpt::obs::registerAllClasses_mrpt_obs();
+  mrpt::maps::registerAllClasses_mrpt_maps();
   impl_->path = path;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec))
