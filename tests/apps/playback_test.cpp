@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <mrpt/opengl/COpenGLScene.h>
 #include <octomap/OcTree.h>
 
 #include <array>
@@ -62,6 +63,10 @@ void expectAllExports(const fs::path& out) {
   octomap::OcTree bt((out / "map.bt").string());
   EXPECT_GT(bt.getResolution(), 0.0);
   EXPECT_NO_THROW(maps::readTraversabilityOt((out / "map.ot").string()));
+  // The .3Dscene reloads in MRPT (what SceneViewer3D does): ground plane, cells, path.
+  mrpt::opengl::COpenGLScene scene;
+  ASSERT_TRUE(scene.loadFromFile((out / "map.3Dscene").string()));
+  EXPECT_EQ(scene.getViewport()->size(), 3u);
 }
 
 TEST(Playback, EveryRawlogInSharedDataPlaysBack) {
