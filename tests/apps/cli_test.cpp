@@ -1,6 +1,7 @@
 // The `upd` command as a user runs it: every cloud file in ../shared/data and every generated
 // scene is analysed; bad input stops with one line naming the file, option or value, a
 // non-zero exit, and no output file (not even half of one).
+#include "run_upd.h"
 #include "test_data.h"
 #include "upd/io/cloud_io.h"
 
@@ -19,22 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CmdResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-CmdResult runUpd(const std::string& args) {
-  const std::string cmd = std::string(UPD_BINARY) + " " + args + " 2>&1";
-  CmdResult r;
-  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe.get())) r.output += buf.data();
-  const int status = pclose(pipe.release());
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::CmdResult;
+using test::runUpd;
 
 class Cli : public ::testing::Test {
  protected:

@@ -1,6 +1,7 @@
 // `upd simulate` and `upd playback` as a user runs them: every rawlog in ../shared/data plays
 // back and writes every export; the simulated run's fused map agrees with the world's ground
 // truth; bad input stops cleanly with nothing written.
+#include "run_upd.h"
 #include "test_data.h"
 #include "upd/maps/traversability_octree.h"
 #include "upd/mrpt/rawlog_reader.h"
@@ -23,22 +24,8 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
-struct CmdResult {
-  int exit_code = -1;
-  std::string output;
-};
-
-CmdResult runUpd(const std::string& args) {
-  const std::string cmd = std::string(UPD_BINARY) + " " + args + " 2>&1";
-  CmdResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::CmdResult;
+using test::runUpd;
 
 const std::string kConfig = std::string(UPD_SOURCE_DIR) + "/config/dune-kinect.ini";
 
