@@ -26,7 +26,7 @@ struct NormalParams {
   int knn = 0;            ///< > 0: use the knn nearest points instead of the radius
   int weighting = static_cast<int>(NormalWeighting::Uniform);  ///< 0 uniform, 1 gaussian (eq. 4 xi)
   /// A normal closer than this to horizontal is oriented towards the sensor [rad].
-  double vertical_band_rad = 5.0 * kDegToRad;
+  double vertical_band_rad = 30.0 * kDegToRad;
 
   void validate() const;
   template <class V>
