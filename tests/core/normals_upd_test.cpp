@@ -201,6 +201,7 @@ PipelineParams noPreprocess(double radius_m) {
   PipelineParams p;
   p.preprocess.disableAll();
   p.upd.radius_m = radius_m;
+  p.upd.method = static_cast<int>(UpdMethod::Exact);  // the exact path's invariances
   return p;
 }
 

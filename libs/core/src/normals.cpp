@@ -15,6 +15,10 @@ void NormalParams::validate() const {
                "must be 0 (uniform) or 1 (gaussian)");
   requireParam(vertical_band_rad >= 0 && vertical_band_rad < 0.5 * M_PI, "NormalParams",
                "vertical_band_deg", vertical_band_rad * kRadToDeg, "must be in [0, 90)");
+  requireParam(fast_block_px >= 1 && fast_block_px <= 16, "NormalParams", "fast_block_px",
+               fast_block_px, "must be in [1, 16]");
+  requireParam(std::isfinite(max_depth_jump_ratio) && max_depth_jump_ratio > 0, "NormalParams",
+               "max_depth_jump_ratio", max_depth_jump_ratio, "must be > 0");
 }
 
 bool pcaNormal(const PointCloud& cloud, const std::vector<std::uint32_t>& neighbours,
@@ -54,12 +58,7 @@ bool pcaNormal(const PointCloud& cloud, const std::vector<std::uint32_t>& neighb
 Eigen::Vector3f orientNormal(const Eigen::Vector3f& n, const Eigen::Vector3f& point,
                              const Eigen::Vector3f& sensor_origin, const Eigen::Vector3f& up,
                              double vertical_band_rad) {
-  const float along_up = n.dot(up);
-  if (std::abs(along_up) > std::sin(static_cast<float>(vertical_band_rad))) {
-    return along_up > 0.f ? n : Eigen::Vector3f(-n);
-  }
-  // Near-vertical surface: towards the sensor so one wall's normals agree.
-  return n.dot(sensor_origin - point) >= 0.f ? n : Eigen::Vector3f(-n);
+  return NormalOrienter(sensor_origin, up, vertical_band_rad)(n, point);
 }
 
 Normals computeNormals(const PointCloud& cloud, const KdTree& tree, const NormalParams& params,

@@ -1,5 +1,7 @@
 #include "upd/core/pipeline.h"
 
+#include "upd/core/fast_normals.h"
+#include "upd/core/fast_upd.h"
 #include "upd/core/kdtree.h"
 
 #include <chrono>
@@ -14,6 +16,18 @@ void PipelineParams::validate() const {
   normals.validate();
   upd.validate();
   classify.validate();
+  requireParam(upd.method != static_cast<int>(UpdMethod::Fast) || normals.knn == 0, "UpdParams",
+               "method", upd.method,
+               "the fast path (2) needs radius neighbourhoods: NormalParams.knn must be 0");
+}
+
+UpdMethod resolveMethod(const PipelineParams& params) {
+  switch (static_cast<UpdMethod>(params.upd.method)) {
+    case UpdMethod::Exact: return UpdMethod::Exact;
+    case UpdMethod::Fast: return UpdMethod::Fast;
+    case UpdMethod::Auto: break;
+  }
+  return params.upd.knn == 0 && params.normals.knn == 0 ? UpdMethod::Fast : UpdMethod::Exact;
 }
 
 namespace {
@@ -38,12 +52,23 @@ PipelineResult runPipeline(const PointCloud& input, const PipelineParams& params
   Stopwatch total, lap;
   res.cloud = preprocess(input, params.preprocess, &res.preprocess_stats);
   res.timings.preprocess_ms = lap.lapMs();
-  const KdTree tree(res.cloud);
-  res.timings.index_ms = lap.lapMs();
-  res.normals = computeNormals(res.cloud, tree, params.normals, up);
-  res.timings.normals_ms = lap.lapMs();
-  res.upd = computeUpd(res.cloud, tree, res.normals, params.upd);
-  res.timings.upd_ms = lap.lapMs();
+  res.method = resolveMethod(params);
+  if (res.method == UpdMethod::Fast) {
+    // No index to build: the normals and the UPD bin the points themselves.
+    res.organized_normals = organizedNormalsApply(res.cloud, params.normals);
+    res.normals = res.organized_normals ? computeNormalsOrganized(res.cloud, params.normals, up)
+                                        : computeNormalsGrid(res.cloud, params.normals, up);
+    res.timings.normals_ms = lap.lapMs();
+    res.upd = computeUpdFast(res.cloud, res.normals, params.upd);
+    res.timings.upd_ms = lap.lapMs();
+  } else {
+    const KdTree tree(res.cloud);
+    res.timings.index_ms = lap.lapMs();
+    res.normals = computeNormals(res.cloud, tree, params.normals, up);
+    res.timings.normals_ms = lap.lapMs();
+    res.upd = computeUpd(res.cloud, tree, res.normals, params.upd);
+    res.timings.upd_ms = lap.lapMs();
+  }
   res.classes = classify(res.upd, up, params.classify);
   res.timings.classify_ms = lap.lapMs();
   res.timings.total_ms = total.lapMs();

@@ -11,6 +11,7 @@
 #include "upd/core/params.h"
 #include "upd/core/point_cloud.h"
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -27,6 +28,12 @@ struct NormalParams {
   int weighting = static_cast<int>(NormalWeighting::Uniform);  ///< 0 uniform, 1 gaussian (eq. 4 xi)
   /// A normal closer than this to horizontal is oriented towards the sensor [rad].
   double vertical_band_rad = 30.0 * kDegToRad;
+  /// Fast path on organized clouds (fast_normals.h): one normal is computed per block of
+  /// fast_block_px x fast_block_px pixels and shared by the block's pixels on its surface.
+  int fast_block_px = 4;
+  /// Fast path on organized clouds: a pixel shares its block's normal only when their ranges
+  /// differ by at most this fraction of the range [-] (PCL's depth-change factor is 0.02).
+  double max_depth_jump_ratio = 0.02;
 
   void validate() const;
   template <class V>
@@ -36,6 +43,12 @@ struct NormalParams {
     v("weighting", weighting, "covariance weights xi (eq. 4): 0 uniform, 1 gaussian");
     v.angleDeg("vertical_band_deg", vertical_band_rad,
                "normals this close to horizontal are oriented towards the sensor [deg]");
+    v("fast_block_px", fast_block_px,
+      "fast path, organized clouds: one normal per block of this many pixels squared, shared "
+      "by the block's pixels on the same surface (1 = a normal per pixel)");
+    v("max_depth_jump_ratio", max_depth_jump_ratio,
+      "fast path, organized clouds: a pixel shares its block's normal only if their ranges "
+      "differ by at most this fraction of the range");
   }
 };
 
@@ -60,6 +73,23 @@ bool pcaNormal(const PointCloud& cloud, const std::vector<std::uint32_t>& neighb
 Eigen::Vector3f orientNormal(const Eigen::Vector3f& n, const Eigen::Vector3f& point,
                              const Eigen::Vector3f& sensor_origin, const Eigen::Vector3f& up,
                              double vertical_band_rad);
+
+/// orientNormal's rule with the sine of the band computed once, for loops over many points.
+struct NormalOrienter {
+  Eigen::Vector3f sensor_origin, up;  ///< up must be unit length
+  float sin_band;                     ///< sin(vertical_band_rad)
+
+  NormalOrienter(const Eigen::Vector3f& origin, const Eigen::Vector3f& unit_up,
+                 double vertical_band_rad)
+      : sensor_origin(origin), up(unit_up),
+        sin_band(std::sin(static_cast<float>(vertical_band_rad))) {}
+  Eigen::Vector3f operator()(const Eigen::Vector3f& n, const Eigen::Vector3f& point) const {
+    const float along_up = n.dot(up);
+    if (std::abs(along_up) > sin_band) return along_up > 0.f ? n : Eigen::Vector3f(-n);
+    // Near-vertical surface: towards the sensor so one wall's normals agree.
+    return n.dot(sensor_origin - point) >= 0.f ? n : Eigen::Vector3f(-n);
+  }
+};
 
 /// Normals of every point of cloud (which tree indexes).
 Normals computeNormals(const PointCloud& cloud, const KdTree& tree, const NormalParams& params,

@@ -2,6 +2,20 @@
 //
 // This is what `upd analyze` runs and what the MRPT UPD observer calls per frame. Each stage is
 // timed (file I/O is not part of it).
+//
+// UpdParams::method picks how normals and the UPD are computed; pre-processing runs as
+// configured either way. The rule (resolveMethod):
+//  - exact (1): k-d tree neighbourhoods, computeNormals and computeUpd, brute-force equal;
+//  - fast (2): after pre-processing, an organized cloud (the input was organized and neither
+//    voxel down-sampling nor outlier removal ran, so the image layout survived) with uniform
+//    normal weights gets window-scan normals (computeNormalsOrganized), any other cloud gets
+//    the exact neighbourhoods from a hash grid (computeNormalsGrid); then the UPD by the
+//    voxel-moment lattice (computeUpdFast), whose cost per point does not grow with d_m.
+//    Needs radius neighbourhoods (NormalParams::knn = UpdParams::knn = 0);
+//  - auto (0, the default): fast when knn = 0 for both normals and UPD, else exact.
+// For a depth camera at sensor rate: keep the cloud organized (range cut-off only) and let the
+// fast path score every pixel. fast_upd.h and docs/PERFORMANCE.md state how far fast is from
+// exact.
 #pragma once
 
 #include "upd/core/classify.h"
@@ -28,6 +42,10 @@ struct StageTimings {
          total_ms = 0;
 };
 
+/// The method runPipeline uses with these parameters (Exact or Fast, never Auto): the rule in
+/// the header comment.
+UpdMethod resolveMethod(const PipelineParams& params);
+
 struct PipelineResult {
   PointCloud cloud;  ///< the pre-processed cloud that was scored
   Normals normals;
@@ -35,6 +53,8 @@ struct PipelineResult {
   Classification classes;
   PreprocessStats preprocess_stats;
   StageTimings timings;
+  UpdMethod method = UpdMethod::Exact;  ///< exact or fast, as resolveMethod chose
+  bool organized_normals = false;        ///< fast path: normals from image-window scans
 };
 
 /// Runs the chain; throws std::invalid_argument for bad parameters. An empty input (or one

@@ -1,0 +1,490 @@
+#include "upd/core/fast_normals.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "fast_cell_map.h"
+#include "fast_simd.h"
+
+namespace upd {
+
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Moments of a set of points relative to a reference: count, sum q, sum q q^T (upper).
+struct Moments {
+  double n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+};
+
+// The unoriented PCA normal of the covariance in m (eqs. 4-5; m.n is the sum of the weights)
+// and its curvature, or false for a neighbourhood without a plane (lambda_1 ~ 0, as
+// pcaNormal). The caller checks that there are at least 3 points.
+//
+// The eigenvector of the smallest eigenvalue of C is the dominant one of adj(C), whose
+// eigenvalues are l1 l2 >= l0 l2 >= l0 l1 for l0 <= l1 <= l2, and so of B = adj(C)^2. The
+// largest column of B is within (l0 / l1)^2 of it, and each product with B shrinks the error by
+// (l0 / l1)^2 again: after three, (l0 / l1)^8, below 0.3 degrees even where l0 = l1 / 2 (a
+// rounded edge) and at float precision on a surface; it goes on until it settles, and where
+// l0 is close to l1 (no clear plane) the general eigen solver takes over. C is scaled to unit
+// trace first, so the products neither overflow nor underflow.
+bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature) {
+  if (!(m.n > 0)) return false;
+  const double inv = 1.0 / m.n;
+  const double mx = m.x * inv, my = m.y * inv, mz = m.z * inv;
+  double a = m.xx * inv - mx * mx, b = m.xy * inv - mx * my, c = m.xz * inv - mx * mz;
+  double d = m.yy * inv - my * my, e = m.yz * inv - my * mz, f = m.zz * inv - mz * mz;
+  const double trace = a + d + f;
+  if (!(trace > 0)) return false;
+  const double s = 1.0 / trace;
+  a *= s, b *= s, c *= s, d *= s, e *= s, f *= s;
+  const double A00 = d * f - e * e, A01 = c * e - b * f, A02 = b * e - c * d;
+  const double A11 = a * f - c * c, A12 = b * c - a * e, A22 = a * d - b * b;
+  // |adj| ~ l1 l2 / trace^2: a neighbourhood without a plane has l1 ~ 0 (pcaNormal's test).
+  const double adj_norm2 =
+      A00 * A00 + A11 * A11 + A22 * A22 + 2 * (A01 * A01 + A02 * A02 + A12 * A12);
+  if (!(adj_norm2 > 1e-20)) return false;
+  const double B00 = A00 * A00 + A01 * A01 + A02 * A02;
+  const double B01 = A00 * A01 + A01 * A11 + A02 * A12;
+  const double B02 = A00 * A02 + A01 * A12 + A02 * A22;
+  const double B11 = A01 * A01 + A11 * A11 + A12 * A12;
+  const double B12 = A01 * A02 + A11 * A12 + A12 * A22;
+  const double B22 = A02 * A02 + A12 * A12 + A22 * A22;
+  double vx, vy, vz;
+  if (B00 >= B11 && B00 >= B22) {
+    vx = B00, vy = B01, vz = B02;
+  } else if (B11 >= B22) {
+    vx = B01, vy = B11, vz = B12;
+  } else {
+    vx = B02, vy = B12, vz = B22;
+  }
+  for (int it = 0; it < 3; ++it) {
+    const double wx = B00 * vx + B01 * vy + B02 * vz;
+    const double wy = B01 * vx + B11 * vy + B12 * vz;
+    const double wz = B02 * vx + B12 * vy + B22 * vz;
+    vx = wx, vy = wy, vz = wz;
+  }
+  double norm2 = vx * vx + vy * vy + vz * vz;
+  if (!(norm2 > 0) || !std::isfinite(norm2)) return false;
+  double k = 1.0 / std::sqrt(norm2);
+  vx *= k, vy *= k, vz *= k;
+  // How close are l0 and l1? l0 is v's Rayleigh quotient; l1 and l2 then follow from the trace
+  // (1 here) and the determinant. Where l1 < 2 l0 the iteration is slow to settle and the
+  // neighbourhood hardly has a plane: the general eigen solver decides, as in pcaNormal.
+  const double q0 = vx * (a * vx + b * vy + c * vz) + vy * (b * vx + d * vy + e * vz) +
+                    vz * (c * vx + e * vy + f * vz);
+  const double det = a * A00 + b * A01 + c * A02;
+  const double rest = 1.0 - q0;
+  const double l1 =
+      q0 > 1e-12 ? 0.5 * (rest - std::sqrt(std::max(0.0, rest * rest - 4.0 * det / q0))) : rest;
+  if (l1 < 2.0 * q0) {
+    Eigen::Matrix3d C;
+    C << a, b, c, b, d, e, c, e, f;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+    if (es.info() != Eigen::Success) return false;
+    const Eigen::Vector3d ev = es.eigenvalues();  // ascending, trace 1
+    if (ev[1] <= 1e-10) return false;
+    n = es.eigenvectors().col(0).cast<float>().normalized();
+    curvature = static_cast<float>(std::max(0.0, ev[0]));
+    return true;
+  }
+  // Otherwise each step shrinks the error by (l0 / l1)^2 < 1/4: go on until a step moves v by
+  // less than 1e-5 rad.
+  for (int it = 0; it < 20; ++it) {
+    const double wx = B00 * vx + B01 * vy + B02 * vz;
+    const double wy = B01 * vx + B11 * vy + B12 * vz;
+    const double wz = B02 * vx + B12 * vy + B22 * vz;
+    norm2 = wx * wx + wy * wy + wz * wz;
+    if (!(norm2 > 0)) break;
+    k = 1.0 / std::sqrt(norm2);
+    const double cos_step = (wx * vx + wy * vy + wz * vz) * k;
+    vx = wx * k, vy = wy * k, vz = wz * k;
+    if (cos_step > 1.0 - 5e-11) break;
+  }
+  const double l0 =
+      std::max(0.0, vx * (a * vx + b * vy + c * vz) + vy * (b * vx + d * vy + e * vz) +
+                        vz * (c * vx + e * vy + f * vz));
+  n = Eigen::Vector3f(static_cast<float>(vx), static_cast<float>(vy), static_cast<float>(vz));
+  curvature = static_cast<float>(l0);  // lambda_0 / trace: C has unit trace here
+  return true;
+}
+
+Normals emptyNormals(std::size_t n) {
+  Normals out;
+  out.nx.assign(n, kNaN);
+  out.ny.assign(n, kNaN);
+  out.nz.assign(n, kNaN);
+  out.curvature.assign(n, kNaN);
+  return out;
+}
+
+// The angular pitch of the sensor per column (along_u: the angle between the rays of columns
+// u and u + 1) or per row [rad]: the smallest over every 4th line, so that windows sized from
+// it hold the whole ball even where the pitch shrinks (off-axis, by cos^2 of the angle for a
+// pinhole camera). Columns without a sample take the median; a pitch below half the median
+// (duplicated pixels) is raised to it. Empty when too few pairs are valid.
+std::vector<float> pitchProfile(const PointCloud& cloud, const std::vector<float>& range,
+                                bool along_u) {
+  const std::size_t W = cloud.width, H = cloud.height;
+  const Eigen::Vector3f o = cloud.sensor_origin;
+  const std::size_t lines = along_u ? H : W, len = along_u ? W : H;
+  std::vector<float> lowest(len, std::numeric_limits<float>::infinity());
+  std::vector<float> all;
+  for (std::size_t l = 0; l < lines; l += 4) {
+    for (std::size_t t = 0; t + 1 < len; ++t) {
+      const std::size_t i = along_u ? l * W + t : t * W + l;
+      const std::size_t j = along_u ? i + 1 : i + W;
+      if (!(range[i] == range[i]) || !(range[j] == range[j])) continue;
+      // The chord between unit rays equals the angle to 1e-6 at these sizes.
+      const float a = ((cloud.point(i) - o) / range[i] - (cloud.point(j) - o) / range[j]).norm();
+      lowest[t] = std::min(lowest[t], a);
+      all.push_back(a);
+    }
+  }
+  if (all.size() < 16) return {};
+  auto mid = all.begin() + static_cast<std::ptrdiff_t>(all.size() / 2);
+  std::nth_element(all.begin(), mid, all.end());
+  const float median = *mid;
+  if (!(median > 0.f)) return {};
+  for (float& p : lowest) p = std::isfinite(p) ? std::max(p, 0.5f * median) : median;
+  return lowest;
+}
+
+// Coordinate of the invalid pixels in the scanned images: farther than any radius [m].
+constexpr float kFar = 1e18f;
+// Largest half-width of a scanned window [pixels]; wider windows than kScanSide + 1 pixels are
+// sampled every 2nd or 4th row and column (at most 24 x 24 points at full rate).
+constexpr std::ptrdiff_t kMaxHalf = 96;
+constexpr std::ptrdiff_t kScanSide = 23;
+
+// kScanLanes floats as one GCC vector: the compiler emits AVX-512, AVX2 or SSE code for it in the
+// respective UPD_VECTOR_CLONES version of a function (no intrinsics, no -march).
+constexpr int kScanLanes = 8;
+typedef float LaneF __attribute__((vector_size(kScanLanes * sizeof(float))));
+
+typedef int LaneI __attribute__((vector_size(kScanLanes * sizeof(int))));
+static_assert(kScanLanes == 8, "the shuffles below pick 8 lanes");
+
+inline void loadLanes(LaneF& v, const float* p) { std::memcpy(&v, p, sizeof v); }
+// Every 2nd (4th) of the 16 (32) floats from p, by shuffles of whole vectors: a gather
+// through memory would stall on store forwarding.
+inline void evenLanes(LaneF& v, const float* p) {
+  LaneF a, b;
+  loadLanes(a, p), loadLanes(b, p + kScanLanes);
+  v = __builtin_shuffle(a, b, LaneI{0, 2, 4, 6, 8, 10, 12, 14});
+}
+inline void fourthLanes(LaneF& v, const float* p) {
+  LaneF a, b, c, d;
+  loadLanes(a, p), loadLanes(b, p + kScanLanes), loadLanes(c, p + 2 * kScanLanes),
+      loadLanes(d, p + 3 * kScanLanes);
+  const LaneF lo = __builtin_shuffle(a, b, LaneI{0, 4, 8, 12, 0, 4, 8, 12});
+  const LaneF hi = __builtin_shuffle(c, d, LaneI{0, 4, 8, 12, 0, 4, 8, 12});
+  v = __builtin_shuffle(lo, hi, LaneI{0, 1, 2, 3, 8, 9, 10, 11});
+}
+
+// Moments, relative to p, of the points within sqrt(radius2) of p among rows [v0, v1] and
+// columns [a0, a1] of the coordinate images (row stride W), every stride-th row and column.
+// Non-finite pixels hold kFar, so they fail the distance test like any far point; the columns
+// read past a1 (a vector at a time) are real points of the cloud or kFar padding, and the ones
+// within the radius are neighbours of p like any other (the window only bounds the ball).
+UPD_VECTOR_CLONES
+Moments gatedMoments(const float* X, const float* Y, const float* Z, std::size_t W,
+                     std::ptrdiff_t v0, std::ptrdiff_t v1, std::ptrdiff_t a0, std::ptrdiff_t a1,
+                     std::ptrdiff_t stride, float px, float py, float pz, float radius2) {
+  const LaneF zero = {}, one = zero + 1.f;
+  LaneF n = zero, sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero,
+        syz = zero, szz = zero;
+  for (std::ptrdiff_t b = v0; b <= v1; b += stride) {
+    const std::size_t row = static_cast<std::size_t>(b) * W;
+    for (std::ptrdiff_t a = a0; a <= a1; a += kScanLanes * stride) {
+      const std::size_t at = row + static_cast<std::size_t>(a);
+      LaneF x, y, z;
+      if (stride == 1) {
+        loadLanes(x, X + at), loadLanes(y, Y + at), loadLanes(z, Z + at);
+      } else if (stride == 2) {
+        evenLanes(x, X + at), evenLanes(y, Y + at), evenLanes(z, Z + at);
+      } else {
+        fourthLanes(x, X + at), fourthLanes(y, Y + at), fourthLanes(z, Z + at);
+      }
+      const LaneF qx = x - px, qy = y - py, qz = z - pz;
+      const LaneF d2 = qx * qx + qy * qy + qz * qz;
+      const LaneF w = d2 <= radius2 ? one : zero;
+      const LaneF cx = w * qx, cy = w * qy, cz = w * qz;
+      n += w, sx += cx, sy += cy, sz += cz;
+      sxx += cx * qx, sxy += cx * qy, sxz += cx * qz, syy += cy * qy, syz += cy * qz,
+          szz += cz * qz;
+    }
+  }
+  const auto total = [](const LaneF& v) {
+    float s[4] = {0, 0, 0, 0};
+    for (int l = 0; l < kScanLanes; ++l) s[l % 4] += v[l];
+    return static_cast<double>((s[0] + s[1]) + (s[2] + s[3]));
+  };
+  Moments m;
+  m.n = total(n), m.x = total(sx), m.y = total(sy), m.z = total(sz);
+  m.xx = total(sxx), m.xy = total(sxy), m.xz = total(sxz);
+  m.yy = total(syy), m.yz = total(syz), m.zz = total(szz);
+  return m;
+}
+
+}  // namespace
+
+bool organizedNormalsApply(const PointCloud& cloud, const NormalParams& params) {
+  return cloud.isOrganized() && params.knn == 0 &&
+         params.weighting == static_cast<int>(NormalWeighting::Uniform);
+}
+
+Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params,
+                                const Eigen::Vector3f& up) {
+  params.validate();
+  if (!organizedNormalsApply(cloud, params)) {
+    throw std::invalid_argument(
+        "computeNormalsOrganized: needs an organized cloud (height > 1), NormalParams.knn = 0 "
+        "and NormalParams.weighting = 0 (uniform)");
+  }
+  const std::size_t W = cloud.width, H = cloud.height, N = cloud.size();
+  Normals out = emptyNormals(N);
+  std::size_t first = 0;
+  while (first < N && !cloud.isFinite(first)) ++first;
+  if (first == N) {
+    out.invalid = N;
+    return out;
+  }
+  const auto Wi = static_cast<std::ptrdiff_t>(W), Hi = static_cast<std::ptrdiff_t>(H);
+  // Points relative to the first finite one (float differences stay exact far from the
+  // origin), kFar where invalid and as padding (a vector of lanes may read past the last row),
+  // and the range of every pixel from the sensor.
+  const Eigen::Vector3f ref = cloud.point(first);
+  const Eigen::Vector3f origin = cloud.sensor_origin;
+  static thread_local std::vector<float> buffer;
+  buffer.assign(3 * (N + kMaxHalf + kScanLanes * kScanSide), kFar);
+  float* const X = buffer.data();  // the calling thread's buffer, shared by the team
+  float* const Y = X + N + kMaxHalf + kScanLanes * kScanSide;
+  float* const Z = Y + N + kMaxHalf + kScanLanes * kScanSide;
+  std::vector<float> range(N, kNaN);
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(N); ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    if (!cloud.isFinite(i)) continue;
+    const float rho = (cloud.point(i) - origin).norm();
+    if (!(rho > 0.f)) continue;
+    range[i] = rho;
+    X[i] = cloud.x[i] - ref.x(), Y[i] = cloud.y[i] - ref.y(), Z[i] = cloud.z[i] - ref.z();
+  }
+  const std::vector<float> pitch_u = pitchProfile(cloud, range, true);
+  const std::vector<float> pitch_v = pitchProfile(cloud, range, false);
+  if (pitch_u.empty() || pitch_v.empty()) {
+    // Not a central projection we can measure (too few neighbouring valid pixels, or all rays
+    // equal): the hash grid finds the same neighbours.
+    return computeNormalsGrid(cloud, params, up);
+  }
+
+  // The ball of radius r around a point at range rho subtends asin(r / rho) each way: its
+  // pixels lie within that angle over the pitch of their column and row, plus one. Those
+  // windows are scanned and the points within r in 3D kept: the neighbours of the exact path.
+  // A window wider than kScanSide + 1 pixels (a near point) is scanned every 2nd or 4th row
+  // and column: a regular sample of its ball, still hundreds of points.
+  const double radius = params.radius_m;
+  const auto radius2 = static_cast<float>(radius * radius);
+  const auto scanMoments = [&](std::ptrdiff_t u, std::ptrdiff_t v, std::size_t i) {
+    const double angle = std::asin(std::min(1.0, radius / range[i]));
+    const auto eu = std::min<std::ptrdiff_t>(
+        kMaxHalf, static_cast<std::ptrdiff_t>(angle / pitch_u[static_cast<std::size_t>(u)]) + 1);
+    const auto ev = std::min<std::ptrdiff_t>(
+        kMaxHalf, static_cast<std::ptrdiff_t>(angle / pitch_v[static_cast<std::size_t>(v)]) + 1);
+    // Every stride-th row and column (1, 2 or 4) so that at most kScanSide + 1 of each.
+    const std::ptrdiff_t side = 2 * std::max(eu, ev) + 1;
+    const std::ptrdiff_t stride = side <= kScanSide + 1 ? 1 : side <= 2 * (kScanSide + 1) ? 2 : 4;
+    return gatedMoments(
+        X, Y, Z, W, std::max<std::ptrdiff_t>(0, v - ev), std::min<std::ptrdiff_t>(Hi - 1, v + ev),
+        std::max<std::ptrdiff_t>(0, u - eu), std::min<std::ptrdiff_t>(Wi - 1, u + eu), stride, X[i],
+        Y[i], Z[i], radius2);
+  };
+  // A normal is computed at the centre of every block of D x D pixels, and a pixel of the block
+  // takes it when both lie on one surface (ranges within max_depth_jump_ratio of each other);
+  // any other pixel computes its own.
+  const std::ptrdiff_t D = params.fast_block_px;
+  const NormalOrienter orient(origin, up, params.vertical_band_rad);
+  const float jump = static_cast<float>(params.max_depth_jump_ratio);
+  std::size_t invalid = 0;
+#pragma omp parallel for schedule(dynamic, 2) reduction(+ : invalid)
+  for (std::ptrdiff_t bv = 0; bv < (Hi + D - 1) / D; ++bv) {
+    for (std::ptrdiff_t bu = 0; bu < (Wi + D - 1) / D; ++bu) {
+      // The block's own normal, at its centre pixel (or the first valid one).
+      std::ptrdiff_t cu = std::min(Wi - 1, bu * D + D / 2), cv = std::min(Hi - 1, bv * D + D / 2);
+      std::size_t ci = static_cast<std::size_t>(cv) * W + static_cast<std::size_t>(cu);
+      Eigen::Vector3f block_n = Eigen::Vector3f::Constant(kNaN);
+      float block_curv = kNaN;
+      bool block_ok = false;
+      if (range[ci] == range[ci]) {
+        const Moments m = scanMoments(cu, cv, ci);
+        block_ok = m.n >= 3 && normalFromMoments(m, block_n, block_curv);
+      }
+      for (std::ptrdiff_t v = bv * D; v < std::min(Hi, bv * D + D); ++v) {
+        for (std::ptrdiff_t u = bu * D; u < std::min(Wi, bu * D + D); ++u) {
+          const std::size_t i = static_cast<std::size_t>(v) * W + static_cast<std::size_t>(u);
+          const float rho = range[i];
+          if (!(rho == rho)) {
+            ++invalid;
+            continue;
+          }
+          Eigen::Vector3f n = block_n;
+          float curvature = block_curv;
+          bool ok = block_ok;
+          const bool same_surface =
+              i == ci || (range[ci] == range[ci] && std::abs(range[ci] - rho) <= jump * rho);
+          if (!same_surface || !block_ok) {
+            const Moments m = scanMoments(u, v, i);
+            ok = m.n >= 3 && normalFromMoments(m, n, curvature);
+          }
+          if (!ok) {
+            ++invalid;
+            continue;
+          }
+          n = orient(n, cloud.point(i));
+          out.nx[i] = n.x();
+          out.ny[i] = n.y();
+          out.nz[i] = n.z();
+          out.curvature[i] = curvature;
+        }
+      }
+    }
+  }
+  out.invalid = invalid;
+  return out;
+}
+
+Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
+                           const Eigen::Vector3f& up) {
+  params.validate();
+  requireParam(params.knn == 0, "NormalParams", "knn", params.knn,
+               "computeNormalsGrid finds radius neighbourhoods: it needs knn = 0");
+  const std::size_t N = cloud.size();
+  Normals out = emptyNormals(N);
+  std::size_t first = 0;
+  while (first < N && !cloud.isFinite(first)) ++first;
+  if (first == N) {
+    out.invalid = N;
+    return out;
+  }
+  // Cells of edge radius_m: the neighbours of a point lie in the 27 cells around its own.
+  // Points are sorted by cell (counting sort) and kept relative to the first finite point.
+  const Eigen::Vector3d ref = cloud.point(first).cast<double>();
+  const double inv = 1.0 / params.radius_m;
+  detail::CellMap map(N / 8 + 64);
+  std::vector<std::int32_t> cell_xyz;
+  std::vector<std::uint32_t> cell_of(N, detail::kNoIndex);
+  for (std::size_t i = first; i < N; ++i) {
+    if (!cloud.isFinite(i)) continue;
+    const Eigen::Vector3d g = (cloud.point(i).cast<double>() - ref) * inv;
+    const std::int64_t x = detail::floorToInt(g.x()), y = detail::floorToInt(g.y()),
+                       z = detail::floorToInt(g.z());
+    if (!detail::keyFits(x, y, z)) {
+      throw std::invalid_argument("NormalParams.radius_m = " + std::to_string(params.radius_m) +
+                                  ": the cloud spans more than 2^20 radii along an axis");
+    }
+    bool inserted = false;
+    cell_of[i] = map.findOrInsert(detail::packKey(x, y, z), inserted);
+    if (inserted) {
+      cell_xyz.insert(cell_xyz.end(), {static_cast<std::int32_t>(x), static_cast<std::int32_t>(y),
+                                       static_cast<std::int32_t>(z)});
+    }
+  }
+  const std::size_t n_cells = cell_xyz.size() / 3;
+  std::vector<std::uint32_t> start(n_cells + 1, 0);
+  for (std::size_t i = 0; i < N; ++i) {
+    if (cell_of[i] != detail::kNoIndex) ++start[cell_of[i] + 1];
+  }
+  for (std::size_t c = 0; c < n_cells; ++c) start[c + 1] += start[c];
+  std::vector<std::uint32_t> order(start.back());
+  std::vector<Eigen::Vector3f> local(start.back());
+  {
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < N; ++i) {
+      if (cell_of[i] == detail::kNoIndex) continue;
+      const std::uint32_t slot = fill[cell_of[i]]++;
+      order[slot] = static_cast<std::uint32_t>(i);
+      local[slot] = (cloud.point(i).cast<double>() - ref).cast<float>();
+    }
+  }
+
+  const float radius2 = static_cast<float>(params.radius_m * params.radius_m);
+  const bool gaussian = params.weighting == static_cast<int>(NormalWeighting::Gaussian);
+  const float sigma = 0.5f * static_cast<float>(params.radius_m);
+  const float inv_2s2 = 1.f / (2.f * sigma * sigma);
+  std::size_t invalid = N - start.back();
+  const NormalOrienter orient(cloud.sensor_origin, up, params.vertical_band_rad);
+#pragma omp parallel reduction(+ : invalid)
+  {
+    // The candidates of the points of a cell (the points of the 27 cells around it), as
+    // coordinate rows for gatedMoments, padded with kFar.
+    std::vector<float> cx, cy, cz;
+#pragma omp for schedule(dynamic, 16)
+    for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
+      const auto c = static_cast<std::size_t>(cc);
+      std::array<std::uint32_t, 27> around{};
+      int n_around = 0;
+      for (int d = 0; d < 27; ++d) {
+        const std::uint32_t id = map.find(detail::packKey(cell_xyz[3 * c] + d % 3 - 1,
+                                                          cell_xyz[3 * c + 1] + (d / 3) % 3 - 1,
+                                                          cell_xyz[3 * c + 2] + d / 9 - 1));
+        if (id != detail::kNoIndex) around[n_around++] = id;
+      }
+      cx.clear(), cy.clear(), cz.clear();
+      for (int a = 0; a < n_around; ++a) {
+        for (std::uint32_t t = start[around[a]]; t < start[around[a] + 1]; ++t) {
+          cx.push_back(local[t].x()), cy.push_back(local[t].y()), cz.push_back(local[t].z());
+        }
+      }
+      const auto n_candidates = static_cast<std::ptrdiff_t>(cx.size());
+      cx.resize(cx.size() + kScanLanes, kFar), cy.resize(cx.size(), kFar),
+          cz.resize(cx.size(), kFar);
+      for (std::uint32_t s = start[c]; s < start[c + 1]; ++s) {
+        const Eigen::Vector3f p = local[s];
+        // Moments of the neighbours relative to p (eq. 4), weighted when Gaussian.
+        Moments m;
+        std::size_t count = 0;
+        if (!gaussian) {
+          m = gatedMoments(cx.data(), cy.data(), cz.data(), cx.size(), 0, 0, 0, n_candidates - 1,
+                           1, p.x(), p.y(), p.z(), radius2);
+          count = static_cast<std::size_t>(m.n);
+        } else {
+          for (std::ptrdiff_t t = 0; t < n_candidates; ++t) {
+            const Eigen::Vector3f q = Eigen::Vector3f(cx[t], cy[t], cz[t]) - p;
+            const float d2 = q.squaredNorm();
+            if (d2 > radius2) continue;
+            const double w = std::exp(-d2 * inv_2s2);
+            const double x = q.x(), y = q.y(), z = q.z();
+            m.n += w, m.x += w * x, m.y += w * y, m.z += w * z;
+            m.xx += w * x * x, m.xy += w * x * y, m.xz += w * x * z;
+            m.yy += w * y * y, m.yz += w * y * z, m.zz += w * z * z;
+            ++count;
+          }
+        }
+        Eigen::Vector3f n;
+        float curvature;
+        const std::size_t i = order[s];
+        if (count < 3 || !normalFromMoments(m, n, curvature)) {
+          ++invalid;
+          continue;
+        }
+        n = orient(n, cloud.point(i));
+        out.nx[i] = n.x();
+        out.ny[i] = n.y();
+        out.nz[i] = n.z();
+        out.curvature[i] = curvature;
+      }
+    }
+  }
+  out.invalid = invalid;
+  return out;
+}
+
+}  // namespace upd

@@ -1,0 +1,591 @@
+#include "upd/core/fast_upd.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "fast_cell_map.h"
+#include "fast_simd.h"
+
+namespace upd {
+
+namespace {
+
+using detail::CellMap;
+using detail::kLanes;
+using detail::kNoIndex;
+
+// Per-cell sums over the points with a valid normal. Positions are relative to the cell's
+// lower corner in cell units (in [0, 1)), so float keeps them exact enough anywhere.
+struct CellSums {
+  float count = 0;
+  float nx = 0, ny = 0, nz = 0;
+  float px = 0, py = 0, pz = 0;
+  float pxx = 0, pxy = 0, pxz = 0, pyy = 0, pyz = 0, pzz = 0;
+
+  void add(const CellSums& o) {
+    count += o.count;
+    nx += o.nx, ny += o.ny, nz += o.nz;
+    px += o.px, py += o.py, pz += o.pz;
+    pxx += o.pxx, pxy += o.pxy, pxz += o.pxz, pyy += o.pyy, pyz += o.pyz, pzz += o.pzz;
+  }
+};
+
+// Four floats as one GCC vector (SSE everywhere): r_x, r_y, r_z, k.
+typedef float Quad __attribute__((vector_size(4 * sizeof(float))));
+
+// Ball sums at a node: (r_x, r_y, r_z, k), then their derivatives with respect to the node's
+// x, y and z (cell units), four values each: the layout the interpolation reads.
+struct NodeSums {
+  Quad q[4];
+};
+
+// The candidate cells of a block, structure of arrays padded with empty cells to a multiple
+// of kLanes, positions relative to the block origin in cell units.
+struct Candidates {
+  enum Field {
+    kLx,
+    kLy,
+    kLz,
+    kMx,
+    kMy,
+    kMz,
+    kCxx,
+    kCxy,
+    kCxz,
+    kCyy,
+    kCyz,
+    kCzz,
+    kCount,
+    kNx,
+    kNy,
+    kNz,
+    kFields
+  };
+  std::array<std::vector<float>, kFields> f;  // lower corner, centroid, covariance, sums
+
+  const float* operator[](Field k) const { return f[k].data(); }
+  void clear() {
+    for (auto& v : f) v.clear();
+  }
+  std::size_t size() const { return f[kLx].size(); }
+  void push(const std::array<float, kFields>& values) {
+    for (int k = 0; k < kFields; ++k) f[k].push_back(values[k]);
+  }
+  void pad() {
+    while (size() % kLanes != 0) push({});
+  }
+};
+
+// Eq. 6 and k at one node X (block-relative, cell units) for a ball of radius m cells, with
+// their gradients. A cell wholly inside adds its sums, one wholly outside nothing; a cell the
+// sphere cuts adds the fraction of its points on the inner side, from the spread of its points
+// along the direction u from X to its centroid (uniform with the cell's variance sigma^2 along
+// u: frac = 1/2 + t / (2 sqrt(3) sigma), t the centroid's depth inside the sphere). The
+// fraction moves with X at rate u / (2 sqrt(3) sigma): the gradient of the cut cells' share.
+constexpr float kMaxFracSlope = 1.f;
+
+UPD_VECTOR_CLONES
+void sumAtNode(const Candidates& c, float X, float Y, float Z, float m, NodeSums& out) {
+  float acc[16][kLanes] = {};
+  const float m2 = m * m;
+  const std::size_t n = c.size();
+  using C = Candidates;
+  const float* __restrict lx = c[C::kLx];
+  const float* __restrict ly = c[C::kLy];
+  const float* __restrict lz = c[C::kLz];
+  const float* __restrict mx = c[C::kMx];
+  const float* __restrict my = c[C::kMy];
+  const float* __restrict mz = c[C::kMz];
+  const float* __restrict cxx = c[C::kCxx];
+  const float* __restrict cxy = c[C::kCxy];
+  const float* __restrict cxz = c[C::kCxz];
+  const float* __restrict cyy = c[C::kCyy];
+  const float* __restrict cyz = c[C::kCyz];
+  const float* __restrict czz = c[C::kCzz];
+  const float* __restrict cnt = c[C::kCount];
+  const float* __restrict nx = c[C::kNx];
+  const float* __restrict ny = c[C::kNy];
+  const float* __restrict nz = c[C::kNz];
+  for (std::size_t j0 = 0; j0 < n; j0 += kLanes) {
+    for (int l = 0; l < kLanes; ++l) {
+      const std::size_t j = j0 + l;
+      // Nearest and farthest distance from X to the cell's box. (Written as selects and
+      // products of 0/1 floats: GCC keeps such a loop branch-free and vectorizes it.)
+      const float ax = lx[j] - X, ay = ly[j] - Y, az = lz[j] - Z;
+      const float bx = ax + 1.f, by = ay + 1.f, bz = az + 1.f;
+      const float qx = ax > 0.f ? ax : (bx < 0.f ? -bx : 0.f);
+      const float qy = ay > 0.f ? ay : (by < 0.f ? -by : 0.f);
+      const float qz = az > 0.f ? az : (bz < 0.f ? -bz : 0.f);
+      const float near2 = qx * qx + qy * qy + qz * qz;
+      const float far2 =
+          std::max(ax * ax, bx * bx) + std::max(ay * ay, by * by) + std::max(az * az, bz * bz);
+      // The cut fraction from the centroid.
+      const float vx = mx[j] - X, vy = my[j] - Y, vz = mz[j] - Z;
+      const float d2 = vx * vx + vy * vy + vz * vz + 1e-12f;
+      const float inv_d = detail::rsqrtNewton(d2);
+      const float dist = d2 * inv_d;
+      const float q = vx * vx * cxx[j] + vy * vy * cyy[j] + vz * vz * czz[j] +
+                      2.f * (vx * vy * cxy[j] + vx * vz * cxz[j] + vy * vz * cyz[j]);
+      const float var = q * inv_d * inv_d;
+      const float inv_w = 0.5f * detail::rsqrtNewton(3.f * var + 1e-12f);
+      const float soft = 0.5f + (m - dist) * inv_w;
+      const float clamped = std::min(1.f, std::max(0.f, soft));
+      const float wholly_in = far2 <= m2 ? 1.f : 0.f;
+      const float touched = near2 > m2 ? 0.f : 1.f;
+      const float frac = touched * std::max(wholly_in, clamped);
+      const float cut =
+          (soft > 0.f ? 1.f : 0.f) * (soft < 1.f ? 1.f : 0.f) * (1.f - wholly_in) * touched;
+      // A cell whose points are spread thinly along u has a near-step fraction and a spike
+      // for a gradient; the interpolation reads gradients over half a cell, so the slope is
+      // capped at kMaxFracSlope per cell (a ramp no steeper than one cell wide).
+      const float g = cut * std::min(inv_w, kMaxFracSlope) * inv_d;
+      const float gx = vx * g, gy = vy * g, gz = vz * g;
+      acc[0][l] += frac * nx[j];
+      acc[1][l] += frac * ny[j];
+      acc[2][l] += frac * nz[j];
+      acc[3][l] += frac * cnt[j];
+      acc[4][l] += gx * nx[j];
+      acc[5][l] += gx * ny[j];
+      acc[6][l] += gx * nz[j];
+      acc[7][l] += gx * cnt[j];
+      acc[8][l] += gy * nx[j];
+      acc[9][l] += gy * ny[j];
+      acc[10][l] += gy * nz[j];
+      acc[11][l] += gy * cnt[j];
+      acc[12][l] += gz * nx[j];
+      acc[13][l] += gz * ny[j];
+      acc[14][l] += gz * nz[j];
+      acc[15][l] += gz * cnt[j];
+    }
+  }
+  for (int a = 0; a < 16; ++a) {
+    float s = 0.f;
+    for (int l = 0; l < kLanes; ++l) s += acc[a][l];
+    out.q[a / 4][a % 4] = s;
+  }
+}
+
+struct Lattice {
+  Eigen::Vector3d ref = Eigen::Vector3d::Zero();  // world position of lattice point (0, 0, 0)
+  double inv_cell = 1.0;                          // 1 / s
+
+  // Lattice coordinates of a world point (double: exact relative to ref far from the origin).
+  Eigen::Vector3d coords(float x, float y, float z) const {
+    return {(static_cast<double>(x) - ref.x()) * inv_cell,
+            (static_cast<double>(y) - ref.y()) * inv_cell,
+            (static_cast<double>(z) - ref.z()) * inv_cell};
+  }
+};
+
+// The occupied cells of a run of points: what binning produces per chunk and after merging.
+struct Bins {
+  CellMap map;
+  std::vector<std::int32_t> xyz;  // 3 per cell
+  std::vector<CellSums> sums;
+
+  std::uint32_t cellOf(std::int32_t x, std::int32_t y, std::int32_t z) {
+    bool inserted = false;
+    const std::uint32_t id = map.findOrInsert(detail::packKey(x, y, z), inserted);
+    if (inserted) {
+      xyz.insert(xyz.end(), {x, y, z});
+      sums.emplace_back();
+    }
+    return id;
+  }
+};
+
+// Bins points [begin, end) into b, writing each point's cell (local to b) into cell_of.
+// Consecutive points (image rows, scan lines) mostly share a cell: the sums of such a run are
+// kept in registers and the hash map is consulted once per change of cell.
+UPD_VECTOR_CLONES
+void binRange(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+              std::size_t begin, std::size_t end, Bins& b, std::uint32_t* cell_of) {
+  std::int64_t lx = std::numeric_limits<std::int64_t>::min(), ly = 0, lz = 0;
+  std::uint32_t last = kNoIndex;
+  CellSums run;  // sums of the current run, added to b.sums[last] when the cell changes
+  const auto flush = [&] {
+    if (last != kNoIndex && run.count > 0.f) b.sums[last].add(run);
+    run = CellSums{};
+  };
+  for (std::size_t i = begin; i < end; ++i) {
+    const float x = cloud.x[i], y = cloud.y[i], z = cloud.z[i];
+    if (!(std::isfinite(x) && std::isfinite(y) && std::isfinite(z))) continue;
+    const Eigen::Vector3d g = lat.coords(x, y, z);
+    const std::int64_t ix = detail::floorToInt(g.x()), iy = detail::floorToInt(g.y()),
+                       iz = detail::floorToInt(g.z());
+    const auto fx = static_cast<double>(ix), fy = static_cast<double>(iy),
+               fz = static_cast<double>(iz);
+    if (ix != lx || iy != ly || iz != lz) {
+      flush();
+      last = b.cellOf(static_cast<std::int32_t>(ix), static_cast<std::int32_t>(iy),
+                      static_cast<std::int32_t>(iz));
+      lx = ix, ly = iy, lz = iz;
+    }
+    cell_of[i] = last;
+    if (!normals.isValid(i)) continue;
+    const float px = static_cast<float>(g.x() - fx), py = static_cast<float>(g.y() - fy),
+                pz = static_cast<float>(g.z() - fz);
+    run.count += 1.f;
+    run.nx += normals.nx[i];
+    run.ny += normals.ny[i];
+    run.nz += normals.nz[i];
+    run.px += px;
+    run.py += py;
+    run.pz += pz;
+    run.pxx += px * px;
+    run.pxy += px * py;
+    run.pxz += px * pz;
+    run.pyy += py * py;
+    run.pyz += py * pz;
+    run.pzz += pz * pz;
+  }
+  flush();
+}
+
+// r and k of points [begin, end) from the 8 nodes of their cell: trilinear weights w_o, and
+// each node's value carried towards the point by half its gradient step. For a quadratic
+// field the trilinear blend errs by +E and the blend of first-order Taylor steps by -E, so
+// their mean (this cubic Hermite blend) is exact. Returns the points left unscored.
+UPD_VECTOR_CLONES
+std::size_t interpolate(const PointCloud& cloud, const Lattice& lat, const std::uint32_t* cell_of,
+                        const std::int32_t* cell_xyz, const std::uint32_t* cell_nodes,
+                        const NodeSums* node_sums, const char* skip, float min_k, std::size_t begin,
+                        std::size_t end, UpdResult& out) {
+  std::size_t invalid = 0;
+  for (std::size_t i = begin; i < end; ++i) {
+    const std::uint32_t c = cell_of[i];
+    if (c == kNoIndex) {
+      ++invalid;
+      continue;
+    }
+    if (skip[c]) continue;
+    const Eigen::Vector3d g = lat.coords(cloud.x[i], cloud.y[i], cloud.z[i]);
+    const float fx = static_cast<float>(g.x() - cell_xyz[3 * c]);
+    const float fy = static_cast<float>(g.y() - cell_xyz[3 * c + 1]);
+    const float fz = static_cast<float>(g.z() - cell_xyz[3 * c + 2]);
+    const float wx[2] = {1.f - fx, fx}, wy[2] = {1.f - fy, fy}, wz[2] = {1.f - fz, fz};
+    Quad acc = {0.f, 0.f, 0.f, 0.f};
+    const std::uint32_t* corner = &cell_nodes[8 * c];
+    for (int o = 0; o < 8; ++o) {
+      const int ox = o & 1, oy = (o >> 1) & 1, oz = (o >> 2) & 1;
+      const NodeSums& s = node_sums[corner[o]];
+      const Quad value = s.q[0] + s.q[1] * (0.5f * (fx - static_cast<float>(ox))) +
+                         s.q[2] * (0.5f * (fy - static_cast<float>(oy))) +
+                         s.q[3] * (0.5f * (fz - static_cast<float>(oz)));
+      acc += value * (wx[ox] * wy[oy] * wz[oz]);
+    }
+    const float k = acc[3];
+    if (!(k + 0.5f >= min_k)) {  // k rounded to the nearest integer is below min_k
+      ++invalid;
+      continue;
+    }
+    // |r| <= k holds at every node; the gradient steps may break it by a rounding margin.
+    const float norm = std::sqrt(acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2]);
+    out.rx[i] = acc[0];
+    out.ry[i] = acc[1];
+    out.rz[i] = acc[2];
+    out.zeta[i] = std::min(1.f, norm / k);
+    out.k[i] = static_cast<std::uint32_t>(k + 0.5f);
+  }
+  return invalid;
+}
+
+}  // namespace
+
+UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdParams& params,
+                         FastUpdStats* stats) {
+  params.validate();
+  requireParam(params.knn == 0, "UpdParams", "knn", params.knn,
+               "the fast path sums over the radius d_m: it needs knn = 0");
+  const std::size_t n_pts = cloud.size();
+  if (normals.size() != n_pts) {
+    throw std::invalid_argument("computeUpdFast: " + std::to_string(normals.size()) +
+                                " normals for " + std::to_string(n_pts) + " points");
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  UpdResult out;
+  out.rx.assign(n_pts, nan);
+  out.ry.assign(n_pts, nan);
+  out.rz.assign(n_pts, nan);
+  out.zeta.assign(n_pts, nan);
+  out.k.assign(n_pts, 0);
+  if (stats) *stats = FastUpdStats{};
+
+  const int m = params.fast_cells_per_radius;
+  Lattice lat;
+  lat.inv_cell = m / params.radius_m;
+  std::size_t first = 0;
+  while (first < n_pts && !cloud.isFinite(first)) ++first;
+  if (first == n_pts) {
+    out.invalid = n_pts;
+    return out;
+  }
+  lat.ref = cloud.point(first).cast<double>();
+
+  // The lattice keys hold 21 bits per axis: check the extent once.
+  {
+    float lo[3] = {cloud.x[first], cloud.y[first], cloud.z[first]};
+    float hi[3] = {lo[0], lo[1], lo[2]};
+    for (std::size_t i = first; i < n_pts; ++i) {
+      if (!cloud.isFinite(i)) continue;
+      lo[0] = std::min(lo[0], cloud.x[i]), hi[0] = std::max(hi[0], cloud.x[i]);
+      lo[1] = std::min(lo[1], cloud.y[i]), hi[1] = std::max(hi[1], cloud.y[i]);
+      lo[2] = std::min(lo[2], cloud.z[i]), hi[2] = std::max(hi[2], cloud.z[i]);
+    }
+    const Eigen::Vector3d a = lat.coords(lo[0], lo[1], lo[2]);
+    const Eigen::Vector3d b = lat.coords(hi[0], hi[1], hi[2]);
+    const double limit = static_cast<double>(detail::kKeyBias) - 2.0;
+    if (a.minCoeff() < -limit || b.maxCoeff() > limit) {
+      throw std::invalid_argument(
+          "UpdParams.radius_m = " + std::to_string(params.radius_m) +
+          ": the cloud spans more than 2^20 fast-path lattice cells along an axis; use a "
+          "range cut-off, a larger radius or fewer fast_cells_per_radius");
+    }
+  }
+
+  // 1. Bin the points, in fixed chunks (so the result does not depend on the thread count),
+  // then merge the chunks' cells in chunk order.
+  std::vector<std::uint32_t> cell_of(n_pts, kNoIndex);
+  constexpr std::size_t kChunk = std::size_t(1) << 15;
+  const std::size_t n_chunks = (n_pts - first + kChunk - 1) / kChunk;
+  std::vector<Bins> chunk_bins(n_chunks);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
+    const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
+    binRange(cloud, normals, lat, begin, std::min(n_pts, begin + kChunk), chunk_bins[c],
+             cell_of.data());
+  }
+  Bins bins = std::move(chunk_bins[0]);
+  std::vector<std::vector<std::uint32_t>> remap(n_chunks);
+  for (std::size_t c = 1; c < n_chunks; ++c) {
+    const Bins& cb = chunk_bins[c];
+    remap[c].resize(cb.sums.size());
+    for (std::size_t j = 0; j < cb.sums.size(); ++j) {
+      const std::uint32_t id = bins.cellOf(cb.xyz[3 * j], cb.xyz[3 * j + 1], cb.xyz[3 * j + 2]);
+      bins.sums[id].add(cb.sums[j]);
+      remap[c][j] = id;
+    }
+  }
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t c = 1; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
+    const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
+    const std::size_t end = std::min(n_pts, begin + kChunk);
+    for (std::size_t i = begin; i < end; ++i) {
+      if (cell_of[i] != kNoIndex) cell_of[i] = remap[c][cell_of[i]];
+    }
+  }
+  chunk_bins.clear();
+  const std::vector<std::int32_t>& cell_xyz = bins.xyz;
+  const std::vector<CellSums>& sums = bins.sums;
+  const std::size_t n_cells = sums.size();
+
+  // 2. Lattice nodes: the 8 corners of every occupied cell.
+  std::vector<std::uint32_t> cell_nodes(8 * n_cells);
+  std::vector<std::int32_t> node_xyz;
+  {
+    CellMap node_map(4 * n_cells);
+    node_xyz.reserve(3 * 4 * n_cells);
+    for (std::size_t c = 0; c < n_cells; ++c) {
+      for (int o = 0; o < 8; ++o) {
+        const std::int32_t x = cell_xyz[3 * c] + (o & 1), y = cell_xyz[3 * c + 1] + ((o >> 1) & 1),
+                           z = cell_xyz[3 * c + 2] + ((o >> 2) & 1);
+        bool inserted = false;
+        const std::uint32_t id = node_map.findOrInsert(detail::packKey(x, y, z), inserted);
+        if (inserted) node_xyz.insert(node_xyz.end(), {x, y, z});
+        cell_nodes[8 * c + o] = id;
+      }
+    }
+  }
+  const std::size_t n_nodes = node_xyz.size() / 3;
+
+  // 3. Blocks of B^3 cells with B = m + 1: every cell within d_m of a node lies in the 27
+  // blocks around the node's block. Cells and nodes are grouped by block (counting sort).
+  const std::int32_t B = m + 1;
+  CellMap block_map(n_cells / 8 + 64);
+  std::vector<std::int32_t> block_xyz;
+  const auto blockOf = [&](std::int32_t x, std::int32_t y, std::int32_t z) {
+    const std::int32_t bx = detail::floorDiv(x, B), by = detail::floorDiv(y, B),
+                       bz = detail::floorDiv(z, B);
+    bool inserted = false;
+    const std::uint32_t id = block_map.findOrInsert(detail::packKey(bx, by, bz), inserted);
+    if (inserted) block_xyz.insert(block_xyz.end(), {bx, by, bz});
+    return id;
+  };
+  std::vector<std::uint32_t> cell_block(n_cells), node_block(n_nodes);
+  for (std::size_t c = 0; c < n_cells; ++c) {
+    cell_block[c] = blockOf(cell_xyz[3 * c], cell_xyz[3 * c + 1], cell_xyz[3 * c + 2]);
+  }
+  for (std::size_t v = 0; v < n_nodes; ++v) {
+    node_block[v] = blockOf(node_xyz[3 * v], node_xyz[3 * v + 1], node_xyz[3 * v + 2]);
+  }
+  const std::size_t n_blocks = block_xyz.size() / 3;
+  const auto groupBy = [n_blocks](const std::vector<std::uint32_t>& owner,
+                                  std::vector<std::uint32_t>& start,
+                                  std::vector<std::uint32_t>& order) {
+    start.assign(n_blocks + 1, 0);
+    for (const std::uint32_t b : owner) ++start[b + 1];
+    for (std::size_t b = 0; b < n_blocks; ++b) start[b + 1] += start[b];
+    order.resize(owner.size());
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < owner.size(); ++i) {
+      order[fill[owner[i]]++] = static_cast<std::uint32_t>(i);
+    }
+  };
+  std::vector<std::uint32_t> cell_start, cell_order, node_start, node_order;
+  groupBy(cell_block, cell_start, cell_order);
+  groupBy(node_block, node_start, node_order);
+
+  // The candidate cells of block b: the occupied cells of the 27 blocks around it, relative
+  // to its origin (in cell units) so that floats stay small.
+  const auto gather = [&](std::size_t b, Candidates& cand) {
+    const std::int32_t ox = block_xyz[3 * b] * B, oy = block_xyz[3 * b + 1] * B,
+                       oz = block_xyz[3 * b + 2] * B;
+    cand.clear();
+    for (int d = 0; d < 27; ++d) {
+      const std::uint32_t nb = block_map.find(
+          detail::packKey(block_xyz[3 * b] + d % 3 - 1, block_xyz[3 * b + 1] + (d / 3) % 3 - 1,
+                          block_xyz[3 * b + 2] + d / 9 - 1));
+      if (nb == kNoIndex) continue;
+      for (std::uint32_t q = cell_start[nb]; q < cell_start[nb + 1]; ++q) {
+        const std::uint32_t c = cell_order[q];
+        const CellSums& s = sums[c];
+        if (s.count <= 0.f) continue;
+        const float lx = static_cast<float>(cell_xyz[3 * c] - ox),
+                    ly = static_cast<float>(cell_xyz[3 * c + 1] - oy),
+                    lz = static_cast<float>(cell_xyz[3 * c + 2] - oz);
+        const float inv = 1.f / s.count;
+        const float mx = s.px * inv, my = s.py * inv, mz = s.pz * inv;
+        cand.push({lx, ly, lz, lx + mx, ly + my, lz + mz, std::max(0.f, s.pxx * inv - mx * mx),
+                   s.pxy * inv - mx * my, s.pxz * inv - mx * mz,
+                   std::max(0.f, s.pyy * inv - my * my), s.pyz * inv - my * mz,
+                   std::max(0.f, s.pzz * inv - mz * mz), s.count, s.nx, s.ny, s.nz});
+      }
+    }
+    cand.pad();
+  };
+
+  // 4. Ball sums at every node, block by block (the candidates gathered once per block).
+  std::vector<NodeSums> node_sums(n_nodes);
+  const float mf = static_cast<float>(m);
+#pragma omp parallel
+  {
+    Candidates cand;
+#pragma omp for schedule(dynamic, 2)
+    for (std::ptrdiff_t bb = 0; bb < static_cast<std::ptrdiff_t>(n_blocks); ++bb) {
+      const auto b = static_cast<std::size_t>(bb);
+      if (node_start[b] == node_start[b + 1]) continue;
+      gather(b, cand);
+      const std::int32_t ox = block_xyz[3 * b] * B, oy = block_xyz[3 * b + 1] * B,
+                         oz = block_xyz[3 * b + 2] * B;
+      for (std::uint32_t q = node_start[b]; q < node_start[b + 1]; ++q) {
+        const std::uint32_t v = node_order[q];
+        sumAtNode(cand, static_cast<float>(node_xyz[3 * v] - ox),
+                  static_cast<float>(node_xyz[3 * v + 1] - oy),
+                  static_cast<float>(node_xyz[3 * v + 2] - oz), mf, node_sums[v]);
+      }
+    }
+  }
+
+  // Cells where interpolation is not to be trusted: the zeta of their 8 nodes spreads by more
+  // than fast_refine_spread, i.e. the ball's edge meets a step, riser or wall within the cell
+  // and zeta bends sharply there. Their points get the lattice sums at their own position
+  // instead (the same cell sums, no interpolation): exact where the cut cells are thin, as a
+  // riser seen edge-on is.
+  std::vector<char> refine(n_cells, 0);
+  std::size_t refined_points = 0;
+  if (params.fast_refine_spread > 0) {
+    const auto spread = static_cast<float>(params.fast_refine_spread);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
+      const auto c = static_cast<std::size_t>(cc);
+      // Nodes with a small share of the cell's data (beyond the edge of the data, off the
+      // surface) have an erratic zeta of their own: only the nodes with at least half the
+      // largest k of the cell count.
+      float k_max = 0.f;
+      for (int o = 0; o < 8; ++o) k_max = std::max(k_max, node_sums[cell_nodes[8 * c + o]].q[0][3]);
+      float lo = 2.f, hi = -1.f;
+      for (int o = 0; o < 8; ++o) {
+        const Quad& v = node_sums[cell_nodes[8 * c + o]].q[0];
+        if (!(v[3] >= 0.5f * k_max) || !(v[3] >= 1.f)) continue;
+        const float zeta = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / v[3];
+        lo = std::min(lo, zeta), hi = std::max(hi, zeta);
+      }
+      refine[c] = hi - lo > spread ? 1 : 0;
+    }
+  }
+
+  // 5. Every point from the 8 nodes of its cell (interpolate, above), in chunks.
+  std::size_t invalid = 0;
+  const std::size_t n_blocks_pts = (n_pts + kChunk - 1) / kChunk;
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : invalid)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_blocks_pts); ++c) {
+    const std::size_t begin = static_cast<std::size_t>(c) * kChunk;
+    invalid +=
+        interpolate(cloud, lat, cell_of.data(), cell_xyz.data(), cell_nodes.data(),
+                    node_sums.data(), refine.data(), static_cast<float>(params.min_neighbors),
+                    begin, std::min(n_pts, begin + kChunk), out);
+  }
+  // 6. The points of the refined cells, cell by cell, from the sums at their own position.
+  if (params.fast_refine_spread > 0) {
+    std::vector<std::uint32_t> start(n_cells + 1, 0);
+    for (std::size_t i = 0; i < n_pts; ++i) {
+      if (cell_of[i] != kNoIndex && refine[cell_of[i]]) ++start[cell_of[i] + 1];
+    }
+    for (std::size_t c = 0; c < n_cells; ++c) start[c + 1] += start[c];
+    std::vector<std::uint32_t> members(start[n_cells]);
+    {
+      std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+      for (std::size_t i = 0; i < n_pts; ++i) {
+        if (cell_of[i] != kNoIndex && refine[cell_of[i]]) {
+          members[fill[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+        }
+      }
+    }
+    refined_points = members.size();
+    const auto min_k = static_cast<float>(params.min_neighbors);
+#pragma omp parallel reduction(+ : invalid)
+    {
+      Candidates cand;
+      NodeSums sum;
+#pragma omp for schedule(dynamic, 4)
+      for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
+        const auto c = static_cast<std::size_t>(cc);
+        if (start[c] == start[c + 1]) continue;
+        const std::size_t b = cell_block[c];
+        gather(b, cand);
+        const double ox = block_xyz[3 * b] * B, oy = block_xyz[3 * b + 1] * B,
+                     oz = block_xyz[3 * b + 2] * B;
+        for (std::uint32_t q = start[c]; q < start[c + 1]; ++q) {
+          const std::uint32_t i = members[q];
+          const Eigen::Vector3d g = lat.coords(cloud.x[i], cloud.y[i], cloud.z[i]);
+          sumAtNode(cand, static_cast<float>(g.x() - ox), static_cast<float>(g.y() - oy),
+                    static_cast<float>(g.z() - oz), mf, sum);
+          const Quad& v = sum.q[0];
+          if (!(v[3] + 0.5f >= min_k)) {
+            ++invalid;
+            continue;
+          }
+          out.rx[i] = v[0];
+          out.ry[i] = v[1];
+          out.rz[i] = v[2];
+          out.zeta[i] = std::min(1.f, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / v[3]);
+          out.k[i] = static_cast<std::uint32_t>(v[3] + 0.5f);
+        }
+      }
+    }
+  }
+  out.invalid = invalid;
+  if (stats) {
+    stats->cells = n_cells;
+    stats->nodes = n_nodes;
+    stats->blocks = n_blocks;
+    stats->refined_points = refined_points;
+  }
+  return out;
+}
+
+}  // namespace upd

@@ -1,0 +1,315 @@
+// The fast paths (fast_normals.h, fast_upd.h) against the exact path: the same neighbourhoods
+// for normals, and the UPD within the agreement promised by docs/PERFORMANCE.md (mean
+// |delta zeta| <= 0.005, the same label on >= 99.5 % of the points) on generated scenes and a
+// simulated Kinect frame; the properties the fast path keeps exactly (planes, translation far
+// from the origin); degenerate inputs. The benchmark (bench/upd_bench) repeats the agreement on
+// the real frames and times everything; no timing is asserted here.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "synthetic.h"
+#include "upd/core/classify.h"
+#include "upd/core/fast_normals.h"
+#include "upd/core/fast_upd.h"
+#include "upd/core/kdtree.h"
+#include "upd/core/pipeline.h"
+#include "upd/core/render.h"
+#include "upd/core/scenes.h"
+#include "upd/core/terrain.h"
+
+namespace upd {
+namespace {
+
+// Angle between two unit normals [rad] (their orientation is compared separately).
+double angleBetween(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
+  return std::acos(std::clamp(static_cast<double>(a.dot(b)), -1.0, 1.0));
+}
+
+struct Agreement {
+  std::size_t compared = 0, both_valid = 0, validity_differs = 0, same_label = 0;
+  double mean_abs_dzeta = 0, max_abs_dzeta = 0;
+  double sameLabelFraction() const {
+    return compared ? static_cast<double>(same_label) / static_cast<double>(compared) : 0.0;
+  }
+};
+
+// The exact UPD (computeUpd's sums) at every stride-th finite point, from exact normals, against
+// the fast UPD at the same points; labels by classify with default parameters.
+Agreement agreeWithExact(const PointCloud& cloud, const Normals& exact_normals,
+                         const UpdResult& fast, const UpdParams& p, const Eigen::Vector3f& up,
+                         std::size_t stride) {
+  const KdTree tree(cloud);
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (cloud.isFinite(i) && (i % stride) == 0) idx.push_back(i);
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  UpdResult e, f;
+  for (UpdResult* r : {&e, &f}) {
+    r->rx.assign(idx.size(), nan);
+    r->ry = r->rz = r->zeta = r->rx;
+    r->k.assign(idx.size(), 0);
+  }
+  std::vector<std::uint32_t> nb;
+  for (std::size_t q = 0; q < idx.size(); ++q) {
+    tree.radiusSearch(cloud.point(idx[q]), static_cast<float>(p.radius_m), nb);
+    double x = 0, y = 0, z = 0;
+    std::uint32_t k = 0;
+    for (const auto j : nb) {
+      if (!exact_normals.isValid(j)) continue;
+      x += exact_normals.nx[j], y += exact_normals.ny[j], z += exact_normals.nz[j];
+      ++k;
+    }
+    if (k >= static_cast<std::uint32_t>(p.min_neighbors)) {
+      e.rx[q] = static_cast<float>(x), e.ry[q] = static_cast<float>(y);
+      e.rz[q] = static_cast<float>(z), e.k[q] = k;
+      e.zeta[q] = static_cast<float>(std::sqrt(x * x + y * y + z * z) / k);
+    }
+    const std::size_t i = idx[q];
+    f.rx[q] = fast.rx[i], f.ry[q] = fast.ry[i], f.rz[q] = fast.rz[i];
+    f.zeta[q] = fast.zeta[i], f.k[q] = fast.k[i];
+  }
+  const Classification ce = classify(e, up, ClassifyParams{});
+  const Classification cf = classify(f, up, ClassifyParams{});
+  Agreement a;
+  a.compared = idx.size();
+  for (std::size_t q = 0; q < idx.size(); ++q) {
+    a.same_label += ce.label[q] == cf.label[q] ? 1 : 0;
+    if (e.isValid(q) != f.isValid(q)) ++a.validity_differs;
+    if (!e.isValid(q) || !f.isValid(q)) continue;
+    const double d = std::abs(static_cast<double>(e.zeta[q]) - f.zeta[q]);
+    a.mean_abs_dzeta += d;
+    a.max_abs_dzeta = std::max(a.max_abs_dzeta, d);
+    ++a.both_valid;
+  }
+  if (a.both_valid) a.mean_abs_dzeta /= static_cast<double>(a.both_valid);
+  return a;
+}
+
+// A simulated Kinect frame of the "mixed" world (a ramp, rocks, a step, a ditch), at a quarter
+// of the Kinect's resolution so the exact reference stays quick.
+RenderedScene kinectFrame() {
+  CameraIntrinsics K;
+  K.width = 320, K.height = 240, K.fx = K.fy = 262.5, K.cx = 159.5, K.cy = 119.5;
+  DepthNoise noise;
+  noise.max_range_m = 5.0;
+  return renderScene(makeWorld("mixed").terrain,
+                     cameraPoseLookingAt({1.0, 0.3, 0.6}, {4.5, -0.4, 0.0}), K, noise, 7);
+}
+
+TEST(FastNormals, GridEqualsTheExactPath) {
+  for (const int weighting : {0, 1}) {
+    PointCloud c = test::makeRandomCloud(3000, 5, 1.f);
+    c.sensor_origin = Eigen::Vector3f(0, 0, 3);
+    NormalParams p;
+    p.radius_m = 0.12;
+    p.weighting = weighting;
+    const KdTree tree(c);
+    const Normals exact = computeNormals(c, tree, p, Eigen::Vector3f::UnitZ());
+    const Normals grid = computeNormalsGrid(c, p, Eigen::Vector3f::UnitZ());
+    EXPECT_EQ(grid.invalid, exact.invalid);
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      ASSERT_EQ(grid.isValid(i), exact.isValid(i)) << "point " << i;
+      if (!exact.isValid(i)) continue;
+      EXPECT_NEAR((grid.normal(i) - exact.normal(i)).norm(), 0.f, 1e-4f) << "point " << i;
+      EXPECT_NEAR(grid.curvature[i], exact.curvature[i], 1e-4f) << "point " << i;
+    }
+  }
+}
+
+TEST(FastNormals, OrganizedScansFindTheExactNeighbourhoods) {
+  const RenderedScene rs = kinectFrame();
+  const PointCloud& c = rs.scene.cloud;
+  NormalParams p;
+  p.radius_m = 0.05;
+  p.fast_block_px = 1;  // a normal per pixel: the scans alone
+  const KdTree tree(c);
+  const Normals exact = computeNormals(c, tree, p, rs.scene.up);
+  const Normals fast = computeNormalsOrganized(c, p, rs.scene.up);
+  // Beyond 2 m the ball spans fewer than 24 pixels and its window is scanned whole: the same
+  // points as the k-d tree (in float instead of double). Nearer, every 2nd row and column.
+  std::vector<double> far_angles, near_angles;
+  std::size_t flipped = 0, validity_differs = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (exact.isValid(i) != fast.isValid(i)) ++validity_differs;
+    if (!exact.isValid(i) || !fast.isValid(i)) continue;
+    const double angle = angleBetween(exact.normal(i), fast.normal(i));
+    (c.point(i).norm() > 2.f ? far_angles : near_angles).push_back(angle);
+    flipped += exact.normal(i).dot(fast.normal(i)) < 0.f ? 1 : 0;
+  }
+  ASSERT_GT(far_angles.size(), c.size() / 10);
+  ASSERT_GT(near_angles.size(), c.size() / 10);
+  std::sort(far_angles.begin(), far_angles.end());
+  std::sort(near_angles.begin(), near_angles.end());
+  // The last few per cent are neighbourhoods of a few points without a clear plane (curvature
+  // > 0.1, l0 ~ l1), whose smallest eigenvector is ill-defined in either path.
+  EXPECT_LT(far_angles[far_angles.size() * 97 / 100], 1e-3);
+  EXPECT_LT(near_angles[near_angles.size() / 2], 2e-2);
+  EXPECT_LE(flipped, (far_angles.size() + near_angles.size()) / 1000);
+  EXPECT_LE(validity_differs, c.size() / 1000);
+}
+
+TEST(FastUpd, AgreesWithTheExactPathOnGeneratedScenes) {
+  for (const std::string name : {"corner", "ramp", "step", "stairs", "ditch", "rocks"}) {
+    SCOPED_TRACE(name);
+    SceneParams sp;
+    sp.spacing_m = 0.02;
+    sp.noise_m = 0.002;
+    const Scene s = makeScene(name, sp);
+    NormalParams np;
+    np.radius_m = 0.05;
+    const KdTree tree(s.cloud);
+    const Normals normals = computeNormals(s.cloud, tree, np, s.up);
+    UpdParams defaults;
+    defaults.radius_m = 0.5;
+    const Agreement d = agreeWithExact(s.cloud, normals, computeUpdFast(s.cloud, normals, defaults),
+                                       defaults, s.up, 3);
+    EXPECT_LE(d.mean_abs_dzeta, 0.007);
+    EXPECT_GE(d.sameLabelFraction(), 0.98);
+    EXPECT_LE(d.validity_differs, d.compared / 200);
+    UpdParams accurate = defaults;
+    accurate.fast_cells_per_radius = 8;
+    accurate.fast_refine_spread = 0.02;
+    const Agreement a = agreeWithExact(s.cloud, normals, computeUpdFast(s.cloud, normals, accurate),
+                                       accurate, s.up, 3);
+    EXPECT_LE(a.mean_abs_dzeta, 0.005);
+    EXPECT_GE(a.sameLabelFraction(), 0.995);
+    EXPECT_LE(a.validity_differs, a.compared / 200);
+  }
+}
+
+TEST(FastPipeline, KinectFrameAgreesWithTheExactPath) {
+  const RenderedScene rs = kinectFrame();
+  PipelineParams p;
+  p.up = rs.scene.up;
+  p.preprocess.disableAll();  // keep the image: every pixel is scored
+  p.normals.radius_m = 0.05;
+  p.upd.radius_m = 0.5;
+  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  const PipelineResult fast = runPipeline(rs.scene.cloud, p);
+  ASSERT_EQ(fast.method, UpdMethod::Fast);
+  ASSERT_TRUE(fast.organized_normals);
+  ASSERT_EQ(fast.cloud.size(), rs.scene.cloud.size());
+  const KdTree tree(fast.cloud);
+  const Normals exact_normals = computeNormals(fast.cloud, tree, p.normals, p.unitUp());
+  const Agreement a = agreeWithExact(fast.cloud, exact_normals, fast.upd, p.upd, p.unitUp(), 7);
+  ASSERT_GT(a.compared, 5000u);
+  EXPECT_LE(a.mean_abs_dzeta, 0.005);
+  EXPECT_GE(a.sameLabelFraction(), 0.995);
+}
+
+TEST(FastUpd, PlaneOfAnyTiltHasZetaOneAndTheTiltAsSlope) {
+  for (const double tilt_deg : {0.0, 20.0, 60.0}) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = (Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(tilt_deg * kDegToRad, Eigen::Vector3d::UnitX()))
+                        .toRotationMatrix();
+    PipelineParams p;
+    p.preprocess.disableAll();
+    p.upd.method = static_cast<int>(UpdMethod::Fast);
+    const PipelineResult r = runPipeline(test::makePlane(1.6, 0.02, pose), p);
+    for (std::size_t i = 0; i < r.cloud.size(); ++i) {
+      ASSERT_TRUE(r.upd.isValid(i));
+      EXPECT_NEAR(r.upd.zeta[i], 1.0, 1e-5);
+      EXPECT_NEAR(r.classes.slope_rad[i], tilt_deg * kDegToRad, 2e-3);
+    }
+  }
+}
+
+// On a 2^-10 m grid the cloud moved by 10 km is the same cloud in float: the lattice is anchored
+// at the first point, so the fast path gives the same numbers.
+TEST(FastUpd, TranslationFarFromOriginChangesNothing) {
+  PointCloud c = test::makeRandomCloud(4000, 99, 1.5f);
+  for (auto* v : {&c.x, &c.y, &c.z}) {
+    for (float& f : *v) f = std::round(f * 1024.f) / 1024.f;
+  }
+  c.sensor_origin = Eigen::Vector3f(0, 0, 3);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(10240.0, -10240.0, 10240.0);
+  PipelineParams p;
+  p.preprocess.disableAll();
+  p.upd.radius_m = 0.4;
+  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  const PipelineResult a = runPipeline(c, p);
+  const PipelineResult b = runPipeline(test::transformed(c, T), p);
+  ASSERT_EQ(a.upd.size(), b.upd.size());
+  for (std::size_t i = 0; i < a.upd.size(); ++i) {
+    ASSERT_EQ(a.upd.isValid(i), b.upd.isValid(i));
+    if (!a.upd.isValid(i)) continue;
+    EXPECT_NEAR(a.upd.zeta[i], b.upd.zeta[i], 1e-5f);
+    EXPECT_EQ(a.upd.k[i], b.upd.k[i]);
+  }
+}
+
+TEST(FastUpd, CostDoesNotDependOnTheRadiusButTheLatticeSizeDoes) {
+  // Not a timing: the lattice shrinks as d_m grows, so the work per point cannot grow.
+  const Scene s = makeScene("rocks");
+  NormalParams np;
+  np.radius_m = 0.05;
+  const Normals n = computeNormalsGrid(s.cloud, np, s.up);
+  std::size_t previous_nodes = std::numeric_limits<std::size_t>::max();
+  for (const double d_m : {0.25, 0.5, 1.0, 2.0}) {
+    UpdParams p;
+    p.radius_m = d_m;
+    FastUpdStats st;
+    const UpdResult r = computeUpdFast(s.cloud, n, p, &st);
+    EXPECT_EQ(r.size(), s.cloud.size());
+    EXPECT_LT(st.nodes, previous_nodes) << "d_m " << d_m;
+    previous_nodes = st.nodes;
+  }
+}
+
+TEST(FastPaths, DegenerateInputsGiveNaNAndCounts) {
+  NormalParams np;
+  UpdParams up;
+  // Empty.
+  const PointCloud empty;
+  EXPECT_EQ(computeNormalsGrid(empty, np, Eigen::Vector3f::UnitZ()).size(), 0u);
+  EXPECT_EQ(computeUpdFast(empty, Normals{}, up).size(), 0u);
+  // All NaN, organized.
+  PointCloud nan_image;
+  nan_image.resizeOrganized(16, 12);
+  const Normals nn = computeNormalsOrganized(nan_image, np, Eigen::Vector3f::UnitZ());
+  EXPECT_EQ(nn.invalid, 192u);
+  const UpdResult nu = computeUpdFast(nan_image, nn, up);
+  EXPECT_EQ(nu.invalid, 192u);
+  // Two points: no normal, no UPD.
+  PointCloud two;
+  two.push_back(0, 0, 0);
+  two.push_back(0.01f, 0, 0);
+  const Normals tn = computeNormalsGrid(two, np, Eigen::Vector3f::UnitZ());
+  EXPECT_EQ(tn.invalid, 2u);
+  EXPECT_EQ(computeUpdFast(two, tn, up).invalid, 2u);
+  // Sizes must match; knn is not a radius.
+  EXPECT_THROW(computeUpdFast(two, Normals{}, up), std::invalid_argument);
+  UpdParams knn = up;
+  knn.knn = 8;
+  EXPECT_THROW(computeUpdFast(two, tn, knn), std::invalid_argument);
+  np.knn = 8;
+  EXPECT_THROW(computeNormalsGrid(two, np, Eigen::Vector3f::UnitZ()), std::invalid_argument);
+  EXPECT_THROW(computeNormalsOrganized(nan_image, np, Eigen::Vector3f::UnitZ()),
+               std::invalid_argument);
+}
+
+TEST(FastPipeline, MethodRuleIsExplicit) {
+  PipelineParams p;
+  EXPECT_EQ(resolveMethod(p), UpdMethod::Fast);  // auto, radius neighbourhoods
+  p.upd.knn = 16;
+  EXPECT_EQ(resolveMethod(p), UpdMethod::Exact);  // auto falls back for knn
+  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = PipelineParams{};
+  p.normals.knn = 16;
+  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p.upd.method = static_cast<int>(UpdMethod::Exact);
+  EXPECT_EQ(resolveMethod(p), UpdMethod::Exact);
+  p.upd.method = 3;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace upd
