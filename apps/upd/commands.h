@@ -19,11 +19,15 @@ int runScene(const std::vector<std::string>& args);
 int runParams(const std::vector<std::string>& args);
 int runSimulate(const std::vector<std::string>& args);
 int runPlayback(const std::vector<std::string>& args);
+int runNavigate(const std::vector<std::string>& args);
+int runLive(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
 extern const char* const kSceneUsage;
 extern const char* const kParamsUsage;
 extern const char* const kSimulateUsage;
 extern const char* const kPlaybackUsage;
+extern const char* const kNavigateUsage;
+extern const char* const kLiveUsage;
 
 }  // namespace upd::app

@@ -19,6 +19,10 @@ const Command kCommands[] = {
      upd::app::kSimulateUsage, upd::app::runSimulate},
     {"playback", "replay a rawlog: UPD per frame, fused traversability maps, exports",
      upd::app::kPlaybackUsage, upd::app::runPlayback},
+    {"navigate", "drive a simulated robot to a goal on UPD traversability (closed loop)",
+     upd::app::kNavigateUsage, upd::app::runNavigate},
+    {"live", "UPD, map and navigation on a live OpenNI2 depth camera (or an .oni file)",
+     upd::app::kLiveUsage, upd::app::runLive},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };

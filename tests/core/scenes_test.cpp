@@ -638,7 +638,7 @@ TEST(Worlds, DitchAndCorridorHaveOneWayThrough) {
     const upd::WorldSpec w = upd::makeWorld("corridor");
     Reach reach(w.terrain, 0.0);
     ASSERT_TRUE(reach.reachable(w.start_xy_yaw.head<2>(), w.goal_xy));
-    reach.block({5.9, -1.3}, {6.1, 1.3});  // across the corridor
+    reach.block({5.9, -1.6}, {6.1, 1.6});  // across the corridor
     EXPECT_FALSE(reach.reachable(w.start_xy_yaw.head<2>(), w.goal_xy));
   }
 }

@@ -783,23 +783,26 @@ WorldSpec ditchWorld() {
 
 WorldSpec corridorWorld() {
   Terrain t({0.0, -3.0}, {12.0, 3.0});
-  // Corridor walls along y = +-1.275 (inner faces at +-1.2) for x in [2, 10], closed to the
-  // borders by cross walls at x = 2 and x = 10, so the corridor is the only way through.
-  t.add(wallBox(6.0, 1.275, 8.0, 0.15))
-      .add(wallBox(6.0, -1.275, 8.0, 0.15))
-      .add(wallBox(2.075, 2.4, 0.15, 2.3))
-      .add(wallBox(2.075, -2.4, 0.15, 2.3))
-      .add(wallBox(9.925, 2.4, 0.15, 2.3))
-      .add(wallBox(9.925, -2.4, 0.15, 2.3))
-      // A chicane of two 0.15 m steps, each blocking half of the corridor (they reach under
-      // the walls so no gap is left there).
-      .add(block(5.0, -0.7, 0.8, 1.1, 0.15))
-      .add(block(7.5, 0.7, 0.8, 1.1, 0.15));
+  // Corridor walls along y = +-1.575 (inner faces at +-1.5) for x in [2, 10], closed to the
+  // borders by cross walls at x = 2 and x = 10, so the corridor is the only way through. The
+  // width leaves 1.65 m passages beside the steps: the UPD's band (about 0.35 m at d_m = 0.5)
+  // on both sides plus the Dune's 0.45 m width.
+  t.add(wallBox(6.0, 1.575, 8.0, 0.15))
+      .add(wallBox(6.0, -1.575, 8.0, 0.15))
+      .add(wallBox(2.075, 2.55, 0.15, 2.0))
+      .add(wallBox(2.075, -2.55, 0.15, 2.0))
+      .add(wallBox(9.925, 2.55, 0.15, 2.0))
+      .add(wallBox(9.925, -2.55, 0.15, 2.0))
+      // A chicane of two 0.15 m steps, overlapping across the middle of the corridor (they
+      // reach under the walls so no gap is left there).
+      .add(block(5.0, -0.85, 0.8, 1.4, 0.15))
+      .add(block(7.5, 0.85, 0.8, 1.4, 0.15));
   return {t,
           {1.0, 0.0, 0.0},
           {11.0, 0.0},
-          "a 2.4 m wide walled corridor (x 2..10) closed to the borders by cross walls; two "
-          "0.15 m steps (x 4.6..5.4 south half, x 7.1..7.9 north half) form a chicane"};
+          "a 3 m wide walled corridor (x 2..10) closed to the borders by cross walls; two "
+          "0.15 m steps (x 4.6..5.4 south, x 7.1..7.9 north) overlap across the middle: a chicane "
+          "with 1.65 m passages"};
 }
 
 WorldSpec trappedWorld() {

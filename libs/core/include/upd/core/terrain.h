@@ -271,10 +271,11 @@ std::vector<std::string> worldNames();
 ///  ditch     x 0..10, y -4..4. A ditch 0.6 m wide, 0.3 m deep along x = 5 (x 4.7..5.3) from
 ///            beyond the south border to y = 2.2; the way round is the 1.8 m gap north of it.
 ///            Start (1, -1, 0), goal (9, -1).
-///  corridor  x 0..12, y -3..3. Walls 0.8 m high along y = +-1.275 for x 2..10 (inner faces
-///            at +-1.2), joined to the borders by cross walls at x = 2 and x = 10, so the
-///            corridor is the only way through; inside, two 0.15 m steps form a chicane (x
-///            4.6..5.4 for y < -0.15 and x 7.1..7.9 for y > 0.15). Start (1, 0, 0), goal (11, 0).
+///  corridor  x 0..12, y -3..3. Walls 0.8 m high along y = +-1.575 for x 2..10 (inner faces
+///            at +-1.5), joined to the borders by cross walls at x = 2 and x = 10, so the
+///            corridor is the only way through; inside, two 0.15 m steps overlap across the
+///            middle (x 4.6..5.4 for y < 0.15 and x 7.1..7.9 for y > -0.15), a chicane with
+///            1.65 m passages. Start (1, 0, 0), goal (11, 0).
 ///  trapped   x 0..10, y -4..4. The goal (7, 0) is inside a closed square of 0.8 m walls
 ///            (outside 2.4 m, 0.15 m thick): unreachable. Start (1, 0, 0).
 /// Throws std::invalid_argument listing the valid names for an unknown name.

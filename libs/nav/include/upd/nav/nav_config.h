@@ -1,0 +1,123 @@
+// Every parameter of the navigation loop (`upd navigate`, `upd live`), from two ini files:
+//  1. the robot config (`--config`, default config/dune-kinect.ini), shared by every `upd`
+//     command: the loop reads its UPD pipeline, [BaselineParams], [GridParams] and
+//     [FusionParams] and leaves its other sections to the commands that own them (the `upd`
+//     commands check the whole file strictly);
+//  2. the navigation config (`--nav-config`, default config/dune-nav.ini), read strictly (an
+//     unknown section or key is an error naming the file): robot body, camera mount, depth
+//     noise, simulated base, obstacles, missing ground, route planner, navigator and loop.
+// [NavigatorParams] also holds two paths, read as strings: ptg_ini (the MRPT navigator's own ini
+// file, relative to the file that names it) and ptg_cache_dir (where the PTG collision grids
+// are cached; empty = the user's cache directory, never the working directory).
+#pragma once
+
+#include "upd/core/baselines.h"
+#include "upd/core/pipeline.h"
+#include "upd/core/render.h"
+#include "upd/maps/fusion.h"
+#include "upd/maps/traversability_grid.h"
+#include "upd/nav/navigator.h"
+#include "upd/nav/negative_obstacles.h"
+#include "upd/nav/obstacles.h"
+#include "upd/nav/robot_base.h"
+#include "upd/nav/route_planner.h"
+#include "upd/nav/simulation.h"
+
+#include <string>
+#include <vector>
+
+namespace upd::nav {
+
+/// The closed loop in simulation. Loaded from [LoopParams].
+struct LoopParams {
+  double control_period_s = 0.2;    ///< one frame, one navigator step, one motion step [s]
+  double max_time_s = 300.0;        ///< simulated time limit; the run ends as "time limit" [s]
+  int seed = 1;                     ///< depth-noise seed (frame k uses seed + k)
+  bool fence_world = true;          ///< the world's border is an obstacle (the mission area)
+  double truth_cell_m = 0.025;      ///< raster of the ground-truth checks [m]
+  double clearance_search_m = 2.0;  ///< clearance is reported up to this distance [m]
+
+  void validate() const;
+  template <class V>
+  void visit(V& v) {
+    v("control_period_s", control_period_s, "frame + navigator step + motion per period [s]");
+    v("max_time_s", max_time_s, "simulated time limit of a run [s]");
+    v("seed", seed, "depth-noise seed (frame k uses seed + k)");
+    v("fence_world", fence_world, "treat the border of the world as an obstacle");
+    v("truth_cell_m", truth_cell_m, "cell of the ground-truth raster for collisions [m]");
+    v("clearance_search_m", clearance_search_m, "clearance is measured up to this distance [m]");
+  }
+};
+
+struct NavConfig {
+  PipelineParams pipeline;
+  BaselineParams baseline;
+  maps::GridParams grid;
+  maps::FusionParams fusion;
+  DepthNoise depth_noise;
+  RobotBodyParams body;
+  CameraMountParams camera;
+  SimulatedBaseParams base;
+  ObstacleParams obstacles;
+  NegativeObstacleParams negative;
+  RoutePlannerParams route;
+  NavigatorParams navigator;
+  LoopParams loop;
+  std::string ptg_ini;        ///< absolute path of the MRPT navigator ini
+  std::string ptg_cache_dir;  ///< absolute path; defaultPtgCacheDir() when not configured
+
+  /// Validates every part (std::invalid_argument naming the field).
+  void validate() const;
+};
+
+/// The `up` key of [PipelineParams] as a visitable section.
+struct UpKey {
+  Eigen::Vector3f& up;
+  void validate() const {}
+  template <class V>
+  void visit(V& v) {
+    v("up", up, "gravity-up direction in the cloud frame (the navigation loop scores z-up)");
+  }
+};
+
+/// Calls f(section, params) for every section the loop reads from the robot config.
+template <class F>
+void forEachRobotSection(NavConfig& c, F&& f) {
+  UpKey up{c.pipeline.up};
+  f("PipelineParams", up);
+  f("PreprocessParams", c.pipeline.preprocess);
+  f("NormalParams", c.pipeline.normals);
+  f("UpdParams", c.pipeline.upd);
+  f("ClassifyParams", c.pipeline.classify);
+  f("BaselineParams", c.baseline);
+  f("GridParams", c.grid);
+  f("FusionParams", c.fusion);
+}
+
+/// Calls f(section, params) for every section of the navigation config ([NavigatorParams]'s
+/// two path keys aside).
+template <class F>
+void forEachNavSection(NavConfig& c, F&& f) {
+  f("RobotBodyParams", c.body);
+  f("CameraMountParams", c.camera);
+  f("DepthNoise", c.depth_noise);
+  f("SimulatedBaseParams", c.base);
+  f("ObstacleParams", c.obstacles);
+  f("NegativeObstacleParams", c.negative);
+  f("RoutePlannerParams", c.route);
+  f("NavigatorParams", c.navigator);
+  f("LoopParams", c.loop);
+}
+
+/// Reads the robot config's sections (absent ones keep their defaults), then the navigation
+/// config strictly, and validates (see the header comment). Throws std::runtime_error /
+/// std::invalid_argument naming the file, section, key and value.
+NavConfig loadNavConfig(const std::string& robot_ini, const std::string& nav_ini);
+
+/// Where the shipped config/ directory is: $UPD_CONFIG_DIR when set, else the source tree's
+/// config/ (compiled in), else config/ beside the executable's parent directory.
+std::string defaultConfigDir();
+/// $XDG_CACHE_HOME/upd-nav/ptg, else $HOME/.cache/upd-nav/ptg, else <temp>/upd-nav-ptg.
+std::string defaultPtgCacheDir();
+
+}  // namespace upd::nav

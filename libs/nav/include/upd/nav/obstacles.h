@@ -1,0 +1,83 @@
+// What the reactive navigator sees as obstacles: the non-traversable evidence around the robot,
+// in the robot frame.
+//
+// Three sources are merged, each in the world frame until the robot pose maps it to the robot
+// frame (p_robot = R(-yaw) (p_world - t)):
+//  - the fused traversability grid: the centre of every cell that labelOf() reads as
+//    NonTraversable, within range_m of the robot. The map remembers what left the camera's
+//    field of view (the camera cannot see the ground right in front of the bumper);
+//  - the current frame: every NonTraversable point of the latest scored frame within range_m,
+//    so an obstacle acts at once even before the map has fused it (or when the map disagrees);
+//  - fixed obstacles: points the caller knows a priori, such as the fence around the mission
+//    area (the simulated worlds are bounded; the robot must not leave them).
+// Points are thinned to one per decimation_m x decimation_m cell (in the world frame, so the
+// result does not flicker as the robot turns) and carry z = point_height_m, which must fall in the
+// navigator's [min_obstacles_height, max_obstacles_height] band.
+#pragma once
+
+#include "upd/nav/robot_base.h"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace upd::maps {
+class TraversabilityGrid;
+}
+
+namespace upd::nav {
+
+/// Loaded from [ObstacleParams].
+struct ObstacleParams {
+  double range_m = 4.0;           ///< evidence farther than this from the robot is left out [m]
+  bool use_map = true;            ///< take NonTraversable cells of the fused grid
+  bool use_current_frame = true;  ///< take NonTraversable points of the latest frame
+  double decimation_m = 0.05;     ///< at most one point per square of this side [m]
+  double point_height_m = 0.2;    ///< z of every obstacle point in the robot frame [m]
+
+  void validate() const;
+  template <class V>
+  void visit(V& v) {
+    v("range_m", range_m, "obstacle evidence within this distance of the robot is used [m]");
+    v("use_map", use_map, "use the non-traversable cells of the fused map");
+    v("use_current_frame", use_current_frame, "use the non-traversable points of the latest frame");
+    v("decimation_m", decimation_m, "keep at most one obstacle point per square of this side [m]");
+    v("point_height_m", point_height_m,
+      "z of the obstacle points (inside the navigator's obstacle height band) [m]");
+  }
+};
+
+/// p_world expressed in the robot frame of pose_world_robot.
+Eigen::Vector2d worldToRobot(const Pose2D& pose_world_robot, const Eigen::Vector2d& p_world);
+/// p_robot expressed in the world frame.
+Eigen::Vector2d robotToWorld(const Pose2D& pose_world_robot, const Eigen::Vector2d& p_robot);
+
+/// Points every spacing_m (> 0) along the border of the rectangle [min_xy, max_xy].
+std::vector<Eigen::Vector2d> rectangleFence(const Eigen::Vector2d& min_xy,
+                                            const Eigen::Vector2d& max_xy, double spacing_m);
+
+/// The merged obstacle evidence (see the header comment). Holds a pointer to the grid: the grid
+/// must outlive the source or be replaced by setMap.
+class ObstacleSource {
+ public:
+  explicit ObstacleSource(const ObstacleParams& params = {});
+
+  const ObstacleParams& params() const { return params_; }
+  /// The fused map to read (nullptr: none).
+  void setMap(const maps::TraversabilityGrid* grid) { grid_ = grid; }
+  /// Replaces the current frame's NonTraversable points (world frame, xy).
+  void setFrameObstacles(std::vector<Eigen::Vector2d> points_world);
+  /// Replaces the fixed obstacles (world frame, xy).
+  void setFixedObstacles(std::vector<Eigen::Vector2d> points_world);
+
+  /// Every source within range_m of the robot, thinned, in the robot frame (x forward, y left).
+  std::vector<Eigen::Vector2d> pointsInRobot(const Pose2D& pose_world_robot) const;
+
+ private:
+  ObstacleParams params_;
+  const maps::TraversabilityGrid* grid_ = nullptr;
+  std::vector<Eigen::Vector2d> frame_world_;
+  std::vector<Eigen::Vector2d> fixed_world_;
+};
+
+}  // namespace upd::nav

@@ -1,0 +1,115 @@
+#include "upd/nav/nav_config.h"
+
+#include "upd/mrpt/ini_params.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+#include <system_error>
+
+namespace fs = std::filesystem;
+
+namespace upd::nav {
+
+void LoopParams::validate() const {
+  requireParam(std::isfinite(control_period_s) && control_period_s > 0 && control_period_s <= 2,
+               "LoopParams", "control_period_s", control_period_s, "must be in (0, 2]");
+  requireParam(std::isfinite(max_time_s) && max_time_s > 0, "LoopParams", "max_time_s", max_time_s,
+               "must be > 0");
+  requireParam(seed >= 0, "LoopParams", "seed", seed, "must be >= 0");
+  requireParam(std::isfinite(truth_cell_m) && truth_cell_m > 0 && truth_cell_m <= 0.2, "LoopParams",
+               "truth_cell_m", truth_cell_m, "must be in (0, 0.2]");
+  requireParam(std::isfinite(clearance_search_m) && clearance_search_m > 0, "LoopParams",
+               "clearance_search_m", clearance_search_m, "must be > 0");
+}
+
+void NavConfig::validate() const {
+  pipeline.validate();
+  baseline.validate();
+  grid.validate();
+  fusion.validate();
+  depth_noise.validate();
+  body.validate();
+  camera.validate();
+  base.validate();
+  obstacles.validate();
+  negative.validate();
+  route.validate();
+  navigator.validate();
+  loop.validate();
+  if (ptg_ini.empty()) {
+    throw std::invalid_argument("NavigatorParams.ptg_ini is not set (the MRPT navigator's ini)");
+  }
+}
+
+namespace {
+
+// [NavigatorParams] string keys: paths relative to the file that holds them.
+void readPath(mrptbridge::IniReader& ini, const char* key, std::string& out) {
+  ini.markKnown("NavigatorParams", key);
+  if (!ini.hasKey("NavigatorParams", key)) return;
+  const std::string v = ini.rawValue("NavigatorParams", key);
+  if (v.empty()) {
+    out.clear();
+    return;
+  }
+  fs::path p(v);
+  if (p.is_relative()) p = fs::path(ini.path()).parent_path() / p;
+  out = p.lexically_normal().string();
+}
+
+}  // namespace
+
+NavConfig loadNavConfig(const std::string& robot_ini, const std::string& nav_ini) {
+  NavConfig c;
+  {
+    mrptbridge::IniReader ini(robot_ini);
+    forEachRobotSection(c, [&](const char* name, auto& params) { ini.read(name, params); });
+  }
+  {
+    mrptbridge::IniReader ini(nav_ini);
+    forEachNavSection(c, [&](const char* name, auto& params) { ini.read(name, params); });
+    readPath(ini, "ptg_ini", c.ptg_ini);
+    readPath(ini, "ptg_cache_dir", c.ptg_cache_dir);
+    ini.checkAllKeysKnown();
+  }
+  if (c.ptg_cache_dir.empty()) c.ptg_cache_dir = defaultPtgCacheDir();
+  try {
+    c.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("config " + robot_ini + " + " + nav_ini + ": " + e.what());
+  }
+  return c;
+}
+
+std::string defaultConfigDir() {
+  if (const char* env = std::getenv("UPD_CONFIG_DIR"); env != nullptr && *env != '\0') {
+    return env;
+  }
+  std::error_code ec;
+#ifdef UPD_NAV_SOURCE_CONFIG_DIR
+  if (fs::is_directory(UPD_NAV_SOURCE_CONFIG_DIR, ec)) return UPD_NAV_SOURCE_CONFIG_DIR;
+#endif
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (const fs::path& candidate : {exe.parent_path().parent_path() / "config",
+                                      exe.parent_path().parent_path() / "share/upd-nav/config"}) {
+      if (fs::is_directory(candidate, ec)) return candidate.string();
+    }
+  }
+  throw std::runtime_error(
+      "cannot find the config/ directory: set UPD_CONFIG_DIR or pass the config files");
+}
+
+std::string defaultPtgCacheDir() {
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0') {
+    return (fs::path(xdg) / "upd-nav" / "ptg").string();
+  }
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') {
+    return (fs::path(home) / ".cache" / "upd-nav" / "ptg").string();
+  }
+  return (fs::temp_directory_path() / "upd-nav-ptg").string();
+}
+
+}  // namespace upd::nav

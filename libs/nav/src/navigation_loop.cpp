@@ -1,0 +1,206 @@
+#include "upd/nav/navigation_loop.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace upd::nav {
+
+namespace {
+
+constexpr double kRouteLookahead_m = 4.0;  // the PTGs' reach
+constexpr double kRouteTolerance_m = 0.4;
+constexpr double kProgress_m = 0.2;  // a route this much shorter than the best so far is progress
+
+// Distance from p to the polyline.
+double distanceToPolyline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& line) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+    const Eigen::Vector2d ab = line[i + 1] - line[i];
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 0 ? std::clamp((p - line[i]).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, (p - (line[i] + t * ab)).norm());
+  }
+  if (line.size() == 1) best = (p - line[0]).norm();
+  return best;
+}
+
+// A new route replaces the one being driven only when it leaves it (by more than
+// tolerance_m within the next lookahead_m): re-issuing waypoints restarts MRPT's navigator, so
+// a route that merely shifts by a cell must not.
+bool routeDiffers(const Route& next, const Route& current, double lookahead_m, double tolerance_m) {
+  if (!current.found) return true;
+  double along = 0.0;
+  for (std::size_t i = 0; i < next.path_world.size(); ++i) {
+    if (i > 0) along += (next.path_world[i] - next.path_world[i - 1]).norm();
+    if (along > lookahead_m) break;
+    if (distanceToPolyline(next.path_world[i], current.path_world) > tolerance_m) return true;
+  }
+  return false;
+}
+
+// Collision grids depend on the PTG file (PTGs, shape): cache them per file content so editing
+// the file never reuses stale grids.
+std::string cacheDirFor(const std::string& cache_root, const std::string& ptg_ini) {
+  std::ifstream in(ptg_ini, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a
+  for (const unsigned char c : os.str()) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return (fs::path(cache_root) / hex).string();
+}
+
+}  // namespace
+
+NavigationLoop::NavigationLoop(RobotBase& base, const NavConfig& config, ObstacleDetector detector,
+                               const std::string& navlog_path)
+    : base_(base),
+      config_(config),
+      detector_(detector),
+      navlog_path_(navlog_path),
+      grid_(config.grid),
+      obstacles_(config.obstacles) {
+  config_.validate();
+  obstacles_.setMap(&grid_);
+}
+
+NavigationLoop::~NavigationLoop() = default;
+
+const FrameEvidence& NavigationLoop::addFrame(const PointCloud& cloud_world, double time_s,
+                                              double ground_z_m) {
+  last_frame_ = scoreFrame(cloud_world, detector_, config_.pipeline, config_.baseline);
+  BaseState s;
+  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  const auto view = maps::viewPoints(last_frame_.cloud_world, last_frame_.classes,
+                                     last_frame_.upd.zeta.empty() ? nullptr : &last_frame_.upd);
+  const Eigen::Vector2d robot_xy(s.pose_world_robot.x_m, s.pose_world_robot.y_m);
+  last_fusion_ = maps::integrateScan(grid_, view, robot_xy, time_s, config_.fusion);
+
+  // Missing ground: gaps whose near side the map (this frame included) reads as traversable
+  // ground are fused as NonTraversable evidence and act as obstacles at once.
+  last_missing_ground_.clear();
+  std::vector<float> gx, gy, gz;
+  for (const GroundGap& gap : findGroundGaps(cloud_world, ground_z_m, config_.negative)) {
+    if (maps::cellLabel(grid_, gap.near_world.x(), gap.near_world.y()) != Label::Traversable) {
+      continue;
+    }
+    const auto pts = sampleGap(gap, 0.5 * grid_.cellSize());
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const double t = pts.size() > 1 ? static_cast<double>(k) / (pts.size() - 1) : 0.0;
+      gx.push_back(static_cast<float>(pts[k].x()));
+      gy.push_back(static_cast<float>(pts[k].y()));
+      gz.push_back(static_cast<float>((1 - t) * gap.near_world.z() + t * gap.far_world.z()));
+      last_missing_ground_.push_back(pts[k]);
+    }
+  }
+  if (!gx.empty()) {
+    const std::vector<Label> labels(gx.size(), Label::NonTraversable);
+    maps::PointsWorld missing;
+    missing.x = gx.data();
+    missing.y = gy.data();
+    missing.z = gz.data();
+    missing.label = labels.data();
+    missing.size = gx.size();
+    maps::integrateScan(grid_, missing, robot_xy, time_s, config_.fusion);
+  }
+  std::vector<Eigen::Vector2d> frame_obstacles = last_frame_.obstacles_world;
+  frame_obstacles.insert(frame_obstacles.end(), last_missing_ground_.begin(),
+                         last_missing_ground_.end());
+  obstacles_.setFrameObstacles(std::move(frame_obstacles));
+  return last_frame_;
+}
+
+void NavigationLoop::setFixedObstacles(std::vector<Eigen::Vector2d> points_world) {
+  fixed_world_ = points_world;
+  obstacles_.setFixedObstacles(std::move(points_world));
+}
+
+void NavigationLoop::navigateTo(const Eigen::Vector2d& goal_world) {
+  if (!navigator_) {
+    NavigatorSetup setup;
+    setup.ptg_ini_path = config_.ptg_ini;
+    setup.ptg_cache_dir = cacheDirFor(config_.ptg_cache_dir, config_.ptg_ini);
+    setup.navlog_path = navlog_path_;
+    setup.params = config_.navigator;
+    navigator_ = std::make_unique<Navigator>(base_, obstacles_, setup);
+  }
+  goal_world_ = goal_world;
+  route_ = Route{};
+  failed_plans_ = 0;
+  replanning_stopped_ = false;
+  best_route_m_ = std::numeric_limits<double>::infinity();
+  last_progress_s_ = base_.timeS();
+  replan();
+  if (!route_.found) navigator_->navigateTo(goal_world);
+}
+
+void NavigationLoop::replan() {
+  BaseState s;
+  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  last_plan_s_ = base_.timeS();
+  Route r = planRoute(grid_, fixed_world_, {s.pose_world_robot.x_m, s.pose_world_robot.y_m},
+                      goal_world_, config_.route);
+  if (r.found && r.length_m < best_route_m_ - kProgress_m) {
+    best_route_m_ = r.length_m;
+    last_progress_s_ = last_plan_s_;
+  }
+  if (last_plan_s_ - last_progress_s_ > config_.navigator.no_progress_timeout_s) {
+    // The way to the goal has not got shorter for a while (circling a walled-in goal, each
+    // route through a stretch of wall not seen yet): stop replanning and leave the navigator on
+    // its last route, so it ends with its own error if it cannot get on.
+    replanning_stopped_ = true;
+  }
+  if (!r.found) {
+    // Keep driving the last route: the navigator reports its own error when it cannot get on.
+    ++failed_plans_;
+    return;
+  }
+  if (replanning_stopped_) return;
+  // The route is kept while the new one follows it. One that became blocked within the
+  // lookahead is replaced: the new route cannot pass there, so it leaves the old one.
+  if (!routeDiffers(r, route_, kRouteLookahead_m, kRouteTolerance_m) &&
+      navigator_->state() == NavState::Navigating) {
+    return;
+  }
+  route_ = std::move(r);
+  navigator_->followWaypoints(route_.waypoints);
+}
+
+bool NavigationLoop::navigating() const {
+  return navigator_ && navigator_->state() == NavState::Navigating;
+}
+
+NavState NavigationLoop::step() {
+  if (!navigator_) throw std::logic_error("NavigationLoop::step before navigateTo");
+  if (navigator_->state() == NavState::Navigating && !replanning_stopped_ &&
+      base_.timeS() - last_plan_s_ >= config_.route.replan_period_s) {
+    replan();
+  }
+  return navigator_->step();
+}
+
+NavOutcome NavigationLoop::outcome() const {
+  return navigator_ ? navigator_->outcome() : NavOutcome{};
+}
+
+void NavigationLoop::finish() {
+  if (!navigator_) return;
+  if (navigator_->state() == NavState::Navigating) navigator_->cancel();
+  base_.stop(false);
+  navigator_->closeLog();
+}
+
+}  // namespace upd::nav

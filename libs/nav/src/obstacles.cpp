@@ -1,0 +1,109 @@
+#include "upd/nav/obstacles.h"
+
+#include "upd/core/params.h"
+#include "upd/maps/traversability_grid.h"
+
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <unordered_set>
+
+namespace upd::nav {
+
+void ObstacleParams::validate() const {
+  requireParam(std::isfinite(range_m) && range_m > 0, "ObstacleParams", "range_m", range_m,
+               "must be > 0");
+  requireParam(std::isfinite(decimation_m) && decimation_m > 0, "ObstacleParams", "decimation_m",
+               decimation_m, "must be > 0");
+  requireParam(std::isfinite(point_height_m), "ObstacleParams", "point_height_m", point_height_m,
+               "must be finite");
+}
+
+Eigen::Vector2d worldToRobot(const Pose2D& pose_world_robot, const Eigen::Vector2d& p_world) {
+  const double c = std::cos(pose_world_robot.yaw_rad), s = std::sin(pose_world_robot.yaw_rad);
+  const double dx = p_world.x() - pose_world_robot.x_m, dy = p_world.y() - pose_world_robot.y_m;
+  return {c * dx + s * dy, -s * dx + c * dy};
+}
+
+Eigen::Vector2d robotToWorld(const Pose2D& pose_world_robot, const Eigen::Vector2d& p_robot) {
+  const double c = std::cos(pose_world_robot.yaw_rad), s = std::sin(pose_world_robot.yaw_rad);
+  return {pose_world_robot.x_m + c * p_robot.x() - s * p_robot.y(),
+          pose_world_robot.y_m + s * p_robot.x() + c * p_robot.y()};
+}
+
+std::vector<Eigen::Vector2d> rectangleFence(const Eigen::Vector2d& min_xy,
+                                            const Eigen::Vector2d& max_xy, double spacing_m) {
+  if (!(spacing_m > 0) || !std::isfinite(spacing_m)) {
+    throw std::invalid_argument("rectangleFence: spacing_m = " + std::to_string(spacing_m) +
+                                ": must be > 0");
+  }
+  if (!(max_xy.x() > min_xy.x()) || !(max_xy.y() > min_xy.y())) {
+    throw std::invalid_argument("rectangleFence: empty rectangle");
+  }
+  std::vector<Eigen::Vector2d> pts;
+  const Eigen::Vector2d corners[4] = {
+      min_xy, {max_xy.x(), min_xy.y()}, max_xy, {min_xy.x(), max_xy.y()}};
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d a = corners[k], b = corners[(k + 1) % 4];
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing_m)));
+    for (int i = 0; i < n; ++i) pts.push_back(a + (b - a) * (static_cast<double>(i) / n));
+  }
+  return pts;
+}
+
+ObstacleSource::ObstacleSource(const ObstacleParams& params) : params_(params) {
+  params_.validate();
+}
+
+void ObstacleSource::setFrameObstacles(std::vector<Eigen::Vector2d> points_world) {
+  frame_world_ = std::move(points_world);
+}
+
+void ObstacleSource::setFixedObstacles(std::vector<Eigen::Vector2d> points_world) {
+  fixed_world_ = std::move(points_world);
+}
+
+std::vector<Eigen::Vector2d> ObstacleSource::pointsInRobot(const Pose2D& pose_world_robot) const {
+  const double r2 = params_.range_m * params_.range_m;
+  const double inv = 1.0 / params_.decimation_m;
+  const Eigen::Vector2d centre(pose_world_robot.x_m, pose_world_robot.y_m);
+  std::unordered_set<std::uint64_t> taken;
+  std::vector<Eigen::Vector2d> out;
+  // One point per decimation square of the world frame: the first source that claims the
+  // square gives its point (map cells first, so the set is stable from step to step).
+  const auto add = [&](const Eigen::Vector2d& p_world) {
+    if (!p_world.allFinite() || (p_world - centre).squaredNorm() > r2) return;
+    const auto ix = static_cast<std::int64_t>(std::floor(p_world.x() * inv));
+    const auto iy = static_cast<std::int64_t>(std::floor(p_world.y() * inv));
+    const std::uint64_t key =
+        (static_cast<std::uint64_t>(ix) << 32) ^ (static_cast<std::uint64_t>(iy) & 0xffffffffull);
+    if (!taken.insert(key).second) return;
+    out.push_back(worldToRobot(pose_world_robot, p_world));
+  };
+  if (params_.use_map && grid_ != nullptr) {
+    int cx0, cy0, cx1, cy1;
+    const auto& g = *grid_;
+    const double r = params_.range_m;
+    // Clamp the search square to the window; cellIndex fails outside it.
+    const double x0 = std::max(centre.x() - r, g.xMin() + 0.5 * g.cellSize());
+    const double y0 = std::max(centre.y() - r, g.yMin() + 0.5 * g.cellSize());
+    const double x1 = std::min(centre.x() + r, g.xMax() - 0.5 * g.cellSize());
+    const double y1 = std::min(centre.y() + r, g.yMax() - 0.5 * g.cellSize());
+    if (x0 <= x1 && y0 <= y1 && g.cellIndex(x0, y0, cx0, cy0) && g.cellIndex(x1, y1, cx1, cy1)) {
+      for (int cy = cy0; cy <= cy1; ++cy) {
+        for (int cx = cx0; cx <= cx1; ++cx) {
+          if (maps::labelOf(g.at(cx, cy), g.params()) == Label::NonTraversable) {
+            add(g.cellCenter(cx, cy));
+          }
+        }
+      }
+    }
+  }
+  if (params_.use_current_frame) {
+    for (const auto& p : frame_world_) add(p);
+  }
+  for (const auto& p : fixed_world_) add(p);
+  return out;
+}
+
+}  // namespace upd::nav

@@ -1,0 +1,88 @@
+// The closed loop on every scenario with the shipped configs: the goal is reached without
+// touching non-traversable ground truth; the walled-in goal ends with the navigator's error in
+// bounded time; with the roughness index instead of the UPD the ramp blocks the way (the
+// paper's failure case). One test per scenario so they run in parallel.
+#include "upd/maps/traversability_grid.h"
+#include "upd/nav/nav_config.h"
+#include "upd/nav/scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace upd::nav {
+namespace {
+
+namespace fs = std::filesystem;
+
+class NavScenario : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    cache_ = fs::temp_directory_path() /
+             ("upd_nav_scn_" + std::to_string(::getpid()) + "_" +
+              ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    const std::string cfg = std::string(UPD_SOURCE_DIR) + "/config";
+    config_ = loadNavConfig(cfg + "/dune-kinect.ini", cfg + "/dune-nav.ini");
+    config_.ptg_cache_dir = cache_.string();  // tests run in parallel: no shared cache
+  }
+  void TearDown() override { fs::remove_all(cache_); }
+
+  ScenarioResult run(const std::string& name, ObstacleDetector d = ObstacleDetector::Upd) {
+    const ScenarioResult r = runScenario(makeWorld(name), name, config_, d);
+    RecordProperty("sim_time_s", std::to_string(r.sim_time_s));
+    RecordProperty("min_clearance_m", std::to_string(r.min_clearance_m));
+    return r;
+  }
+  static void expectReachedSafely(const ScenarioResult& r) {
+    EXPECT_TRUE(r.reached) << toString(r.end) << ", " << r.final_distance_to_goal_m
+                           << " m from the goal; navigator " << toString(r.navigator.state) << " "
+                           << r.navigator.error_message;
+    EXPECT_EQ(r.end, RunEnd::GoalReached);
+    EXPECT_EQ(r.collision_steps, 0);
+    EXPECT_GT(r.min_clearance_m, 0.0);
+    EXPECT_LT(r.final_distance_to_goal_m, 0.45);
+  }
+  fs::path cache_;
+  NavConfig config_;
+};
+
+TEST_F(NavScenario, Rocks) { expectReachedSafely(run("rocks")); }
+
+TEST_F(NavScenario, RampIsClimbed) {
+  const ScenarioResult r = run("ramp");
+  expectReachedSafely(r);
+  // The goal is on the platform: the robot ends up there, and the UPD mapped the ramp's body
+  // as traversable.
+  EXPECT_GT(r.trajectory.back().z_m, 0.25);
+  EXPECT_EQ(maps::cellLabel(r.grid, 8.0, -1.4), Label::Traversable);
+}
+
+TEST_F(NavScenario, Ditch) { expectReachedSafely(run("ditch")); }
+
+TEST_F(NavScenario, Corridor) { expectReachedSafely(run("corridor")); }
+
+TEST_F(NavScenario, TrappedEndsWithTheNavigatorsError) {
+  const ScenarioResult r = run("trapped");
+  EXPECT_FALSE(r.reached);
+  EXPECT_EQ(r.end, RunEnd::NavigatorError);
+  EXPECT_EQ(r.navigator.state, NavState::Error);
+  EXPECT_EQ(r.navigator.error_code, "ERR_CANNOT_REACH_TARGET");
+  EXPECT_FALSE(r.navigator.error_message.empty());
+  EXPECT_LT(r.sim_time_s, config_.loop.max_time_s);  // the navigator ended it, not the limit
+  EXPECT_EQ(r.collision_steps, 0);
+}
+
+TEST_F(NavScenario, RoughnessIndexBlocksTheRamp) {
+  // The paper's failure: the roughness index reads the smooth 20 deg ramp as an obstacle, and
+  // the ramp is the only way onto the platform. 100 s is three times what the UPD needs.
+  config_.loop.max_time_s = 100.0;
+  const ScenarioResult r = run("ramp", ObstacleDetector::Roughness);
+  EXPECT_FALSE(r.reached);
+  EXPECT_NE(r.end, RunEnd::GoalReached);
+  EXPECT_LT(r.trajectory.back().z_m, 0.1);  // never got onto the platform
+  EXPECT_EQ(maps::cellLabel(r.grid, 8.0, -1.4), Label::NonTraversable);
+  EXPECT_EQ(r.collision_steps, 0);
+}
+
+}  // namespace
+}  // namespace upd::nav
