@@ -1,4 +1,5 @@
 // Atomic output: the target is replaced whole or not at all, and no temporary file is left.
+#include "io_test_util.h"
 #include "upd/io/atomic_file.h"
 #include "upd/io/cloud_io.h"
 
@@ -16,25 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("upd_io_" + std::string(info->test_suite_name()) + "_" +
-                                         info->name() + "_" + std::to_string(::getpid()));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using upd::test::TempDir;
 
 std::string readText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

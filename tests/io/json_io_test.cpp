@@ -1,5 +1,6 @@
 // The JSON summary: required keys, counts that add up, a histogram over [0.70, 1] with
 // clamped ends, parameters in ini units, and never a NaN in the text.
+#include "io_test_util.h"
 #include "upd/io/json_io.h"
 
 #include <gtest/gtest.h>
@@ -23,24 +24,7 @@ using upd::Label;
 
 const float kNan = std::numeric_limits<float>::quiet_NaN();
 
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("upd_io_" + std::string(info->test_suite_name()) + "_" +
-                                         info->name() + "_" + std::to_string(::getpid()));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
+using upd::test::TempDir;
 
 void expectNoNonFinite(const std::string& text) {
   for (const char* bad : {"nan", "NaN", "inf", "Infinity"}) {

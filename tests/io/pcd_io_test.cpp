@@ -1,6 +1,7 @@
 // PCD through PCL: every shared .pcd with x/y/z loads with the documented size, layout and
 // colour; a file without x/y/z and truncated or corrupt copies fail cleanly; writePcd round
 // trips (organized, NaN, colour, viewpoint).
+#include "io_test_util.h"
 #include "upd/io/cloud_io.h"
 
 #include "test_data.h"
@@ -21,31 +22,9 @@ namespace {
 namespace fs = std::filesystem;
 using upd::PointCloud;
 
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("upd_io_" + std::string(info->test_suite_name()) + "_" +
-                                         info->name() + "_" + std::to_string(::getpid()));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
+using upd::test::TempDir;
 
- private:
-  fs::path path_;
-};
-
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using upd::test::readBytes;
 
 void writeBytes(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);

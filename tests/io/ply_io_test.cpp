@@ -1,5 +1,6 @@
 // PLY reader and writers: binary round trips, hand-made ascii and big-endian files with elements
 // and list properties to skip, the scored PLY's exact header and body, and clean failures.
+#include "io_test_util.h"
 #include "upd/io/cloud_io.h"
 
 #include <gtest/gtest.h>
@@ -23,36 +24,14 @@ using upd::Label;
 using upd::PointCloud;
 
 /// A fresh directory per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("upd_io_" + std::string(info->test_suite_name()) + "_" +
-                                         info->name() + "_" + std::to_string(::getpid()));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
+using upd::test::TempDir;
 
 void writeBytes(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using upd::test::readBytes;
 
 template <class T>
 void appendBigEndian(std::string& out, T v) {

@@ -1,5 +1,6 @@
 // XYZ text: comments, commas, blank lines, a column header, colour columns, exact round trips,
 // and errors that name the file and line.
+#include "io_test_util.h"
 #include "upd/io/cloud_io.h"
 
 #include <gtest/gtest.h>
@@ -18,24 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 using upd::PointCloud;
 
-class TempDir {
- public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() / ("upd_io_" + std::string(info->test_suite_name()) + "_" +
-                                         info->name() + "_" + std::to_string(::getpid()));
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
+using upd::test::TempDir;
 
 void writeText(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
