@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -126,7 +129,7 @@ Normals emptyNormals(std::size_t n) {
 }
 
 // The angular pitch of the sensor per column (along_u: the angle between the rays of columns
-// u and u + 1) or per row [rad]: the smallest over every 4th line, so that windows sized from
+// u and u + 1) or per row [rad]: the smallest over every 16th line, so that windows sized from
 // it hold the whole ball even where the pitch shrinks (off-axis, by cos^2 of the angle for a
 // pinhole camera). Columns without a sample take the median; a pitch below half the median
 // (duplicated pixels) is raised to it. Empty when too few pairs are valid.
@@ -137,7 +140,7 @@ std::vector<float> pitchProfile(const PointCloud& cloud, const std::vector<float
   const std::size_t lines = along_u ? H : W, len = along_u ? W : H;
   std::vector<float> lowest(len, std::numeric_limits<float>::infinity());
   std::vector<float> all;
-  for (std::size_t l = 0; l < lines; l += 4) {
+  for (std::size_t l = 0; l < lines; l += 16) {
     for (std::size_t t = 0; t + 1 < len; ++t) {
       const std::size_t i = along_u ? l * W + t : t * W + l;
       const std::size_t j = along_u ? i + 1 : i + W;
@@ -160,7 +163,7 @@ std::vector<float> pitchProfile(const PointCloud& cloud, const std::vector<float
 // Coordinate of the invalid pixels in the scanned images: farther than any radius [m].
 constexpr float kFar = 1e18f;
 // Largest half-width of a scanned window [pixels]; wider windows than kScanSide + 1 pixels are
-// sampled every 2nd or 4th row and column (at most 24 x 24 points at full rate).
+// sampled every 2nd or 4th row and column (at most 16 x 16 points at full rate).
 constexpr std::ptrdiff_t kMaxHalf = 96;
 constexpr std::ptrdiff_t kScanSide = 23;
 
@@ -261,6 +264,8 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
   // Points relative to the first finite one (float differences stay exact far from the
   // origin), kFar where invalid and as padding (a vector of lanes may read past the last row),
   // and the range of every pixel from the sensor.
+  auto T0 = std::chrono::steady_clock::now();
+  auto lapT = [&](const char* what) { auto t = std::chrono::steady_clock::now(); if (getenv("NTIME")) fprintf(stderr, "%s %.2f\n", what, std::chrono::duration<double, std::milli>(t - T0).count()); T0 = t; };
   const Eigen::Vector3f ref = cloud.point(first);
   const Eigen::Vector3f origin = cloud.sensor_origin;
   static thread_local std::vector<float> buffer;
@@ -278,6 +283,7 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
     range[i] = rho;
     X[i] = cloud.x[i] - ref.x(), Y[i] = cloud.y[i] - ref.y(), Z[i] = cloud.z[i] - ref.z();
   }
+  lapT("ranges");
   const std::vector<float> pitch_u = pitchProfile(cloud, range, true);
   const std::vector<float> pitch_v = pitchProfile(cloud, range, false);
   if (pitch_u.empty() || pitch_v.empty()) {
@@ -286,6 +292,7 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
     return computeNormalsGrid(cloud, params, up);
   }
 
+  lapT("pitch");
   // The ball of radius r around a point at range rho subtends asin(r / rho) each way: its
   // pixels lie within that angle over the pitch of their column and row, plus one. Those
   // windows are scanned and the points within r in 3D kept: the neighbours of the exact path.
@@ -307,56 +314,86 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
         std::max<std::ptrdiff_t>(0, u - eu), std::min<std::ptrdiff_t>(Wi - 1, u + eu), stride, X[i],
         Y[i], Z[i], radius2);
   };
-  // A normal is computed at the centre of every block of D x D pixels, and a pixel of the block
-  // takes it when both lie on one surface (ranges within max_depth_jump_ratio of each other);
-  // any other pixel computes its own.
+  // A normal is computed at the centre of every block of D x D pixels (pass 1). A pixel takes
+  // the normal of the nearest block centre on its surface (ranges within max_depth_jump_ratio
+  // of each other): its own block's, else the closest in range of the 8 blocks around it; a
+  // pixel with no such centre (a thin object, a depth edge) computes its own (pass 2).
   const std::ptrdiff_t D = params.fast_block_px;
+  const std::ptrdiff_t BW = (Wi + D - 1) / D, BH = (Hi + D - 1) / D;
+  const auto n_blocks = static_cast<std::size_t>(BW * BH);
   const NormalOrienter orient(origin, up, params.vertical_band_rad);
   const float jump = static_cast<float>(params.max_depth_jump_ratio);
-  std::size_t invalid = 0;
-#pragma omp parallel for schedule(dynamic, 2) reduction(+ : invalid)
-  for (std::ptrdiff_t bv = 0; bv < (Hi + D - 1) / D; ++bv) {
-    for (std::ptrdiff_t bu = 0; bu < (Wi + D - 1) / D; ++bu) {
-      // The block's own normal, at its centre pixel (or the first valid one).
-      std::ptrdiff_t cu = std::min(Wi - 1, bu * D + D / 2), cv = std::min(Hi - 1, bv * D + D / 2);
-      std::size_t ci = static_cast<std::size_t>(cv) * W + static_cast<std::size_t>(cu);
-      Eigen::Vector3f block_n = Eigen::Vector3f::Constant(kNaN);
-      float block_curv = kNaN;
-      bool block_ok = false;
-      if (range[ci] == range[ci]) {
-        const Moments m = scanMoments(cu, cv, ci);
-        block_ok = m.n >= 3 && normalFromMoments(m, block_n, block_curv);
-      }
-      for (std::ptrdiff_t v = bv * D; v < std::min(Hi, bv * D + D); ++v) {
-        for (std::ptrdiff_t u = bu * D; u < std::min(Wi, bu * D + D); ++u) {
-          const std::size_t i = static_cast<std::size_t>(v) * W + static_cast<std::size_t>(u);
-          const float rho = range[i];
-          if (!(rho == rho)) {
-            ++invalid;
-            continue;
-          }
-          Eigen::Vector3f n = block_n;
-          float curvature = block_curv;
-          bool ok = block_ok;
-          const bool same_surface =
-              i == ci || (range[ci] == range[ci] && std::abs(range[ci] - rho) <= jump * rho);
-          if (!same_surface || !block_ok) {
-            const Moments m = scanMoments(u, v, i);
-            ok = m.n >= 3 && normalFromMoments(m, n, curvature);
-          }
-          if (!ok) {
-            ++invalid;
-            continue;
-          }
-          n = orient(n, cloud.point(i));
-          out.nx[i] = n.x();
-          out.ny[i] = n.y();
-          out.nz[i] = n.z();
-          out.curvature[i] = curvature;
-        }
-      }
+  static thread_local std::vector<float> block_buffer;
+  block_buffer.assign(5 * n_blocks, kNaN);
+  float* const bn = block_buffer.data();  // per block: nx, ny, nz, curvature, centre range
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::ptrdiff_t b = 0; b < static_cast<std::ptrdiff_t>(n_blocks); ++b) {
+    const std::ptrdiff_t bu = b % BW, bv = b / BW;
+    const std::ptrdiff_t cu = std::min(Wi - 1, bu * D + D / 2), cv = std::min(Hi - 1, bv * D + D / 2);
+    const std::size_t ci = static_cast<std::size_t>(cv) * W + static_cast<std::size_t>(cu);
+    if (!(range[ci] == range[ci])) continue;
+    const Moments m = scanMoments(cu, cv, ci);
+    Eigen::Vector3f n;
+    float curvature;
+    if (m.n >= 3 && normalFromMoments(m, n, curvature)) {
+      float* const o = bn + 5 * b;
+      o[0] = n.x(), o[1] = n.y(), o[2] = n.z(), o[3] = curvature, o[4] = range[ci];
     }
   }
+  lapT("pass1");
+  std::size_t invalid = 0;
+#pragma omp parallel for schedule(dynamic, 2) reduction(+ : invalid)
+  for (std::ptrdiff_t v = 0; v < Hi; ++v) {
+    const std::ptrdiff_t bv = v / D;
+    for (std::ptrdiff_t u = 0; u < Wi; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * W + static_cast<std::size_t>(u);
+      const float rho = range[i];
+      if (!(rho == rho)) {
+        ++invalid;
+        continue;
+      }
+      const std::ptrdiff_t bu = u / D;
+      const float tolerance = jump * rho;
+      const float* pick = bn + 5 * (bv * BW + bu);
+      const bool is_centre = u == std::min(Wi - 1, bu * D + D / 2) &&
+                             v == std::min(Hi - 1, bv * D + D / 2);
+      if (is_centre && !(pick[4] == pick[4])) {  // its own scan found no plane
+        ++invalid;
+        continue;
+      }
+      if (!(std::abs(pick[4] - rho) <= tolerance)) {  // NaN (no normal there) fails too
+        pick = nullptr;
+        float best = tolerance;
+        for (std::ptrdiff_t dv = std::max<std::ptrdiff_t>(0, bv - 1);
+             dv <= std::min(BH - 1, bv + 1); ++dv) {
+          for (std::ptrdiff_t du = std::max<std::ptrdiff_t>(0, bu - 1);
+               du <= std::min(BW - 1, bu + 1); ++du) {
+            const float* c = bn + 5 * (dv * BW + du);
+            const float d = std::abs(c[4] - rho);
+            if (d <= best) best = d, pick = c;
+          }
+        }
+      }
+      Eigen::Vector3f n;
+      float curvature;
+      if (pick != nullptr) {
+        n = Eigen::Vector3f(pick[0], pick[1], pick[2]);
+        curvature = pick[3];
+      } else {
+        const Moments m = scanMoments(u, v, i);
+        if (!(m.n >= 3 && normalFromMoments(m, n, curvature))) {
+          ++invalid;
+          continue;
+        }
+      }
+      n = orient(n, cloud.point(i));
+      out.nx[i] = n.x();
+      out.ny[i] = n.y();
+      out.nz[i] = n.z();
+      out.curvature[i] = curvature;
+    }
+  }
+  lapT("pass2");
   out.invalid = invalid;
   return out;
 }

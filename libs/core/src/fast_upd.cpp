@@ -170,16 +170,25 @@ void sumAtNode(const Candidates& c, float X, float Y, float Z, float m, NodeSums
 }
 
 struct Lattice {
-  Eigen::Vector3d ref = Eigen::Vector3d::Zero();  // world position of lattice point (0, 0, 0)
-  double inv_cell = 1.0;                          // 1 / s
+  float rx = 0, ry = 0, rz = 0;  // world position of lattice point (0, 0, 0): the first point
+  float inv_cell = 1.f;          // 1 / s
 
-  // Lattice coordinates of a world point (double: exact relative to ref far from the origin).
-  Eigen::Vector3d coords(float x, float y, float z) const {
-    return {(static_cast<double>(x) - ref.x()) * inv_cell,
-            (static_cast<double>(y) - ref.y()) * inv_cell,
-            (static_cast<double>(z) - ref.z()) * inv_cell};
-  }
+  // Lattice coordinates of a world point. The cloud's coordinates are floats: their difference
+  // from the first point is exact wherever both lie on a common binary grid (a cloud moved by
+  // 10 km gives the same numbers), so float keeps everything the input holds.
+  float gx(float x) const { return (x - rx) * inv_cell; }
+  float gy(float y) const { return (y - ry) * inv_cell; }
+  float gz(float z) const { return (z - rz) * inv_cell; }
 };
+
+// floor(v) for |v| < 2^31, without the library call of baseline x86-64.
+inline std::int32_t floorToInt32(float v) {
+  const auto t = static_cast<std::int32_t>(v);  // truncates towards zero
+  return t - (v < static_cast<float>(t) ? 1 : 0);
+}
+
+// Largest |lattice coordinate| the keys hold (21 bits per axis), with a margin for the nodes.
+constexpr float kMaxCoord = static_cast<float>(detail::kKeyBias - 4);
 
 // The occupied cells of a run of points: what binning produces per chunk and after merging.
 struct Bins {
@@ -201,34 +210,37 @@ struct Bins {
 // Bins points [begin, end) into b, writing each point's cell (local to b) into cell_of.
 // Consecutive points (image rows, scan lines) mostly share a cell: the sums of such a run are
 // kept in registers and the hash map is consulted once per change of cell.
+// Returns false when a point lies beyond the lattice's key range (it is left out).
 UPD_VECTOR_CLONES
-void binRange(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+bool binRange(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
               std::size_t begin, std::size_t end, Bins& b, std::uint32_t* cell_of) {
-  std::int64_t lx = std::numeric_limits<std::int64_t>::min(), ly = 0, lz = 0;
+  std::int32_t lx = std::numeric_limits<std::int32_t>::min(), ly = 0, lz = 0;
   std::uint32_t last = kNoIndex;
+  bool fits = true;
   CellSums run;  // sums of the current run, added to b.sums[last] when the cell changes
   const auto flush = [&] {
     if (last != kNoIndex && run.count > 0.f) b.sums[last].add(run);
     run = CellSums{};
   };
   for (std::size_t i = begin; i < end; ++i) {
-    const float x = cloud.x[i], y = cloud.y[i], z = cloud.z[i];
-    if (!(std::isfinite(x) && std::isfinite(y) && std::isfinite(z))) continue;
-    const Eigen::Vector3d g = lat.coords(x, y, z);
-    const std::int64_t ix = detail::floorToInt(g.x()), iy = detail::floorToInt(g.y()),
-                       iz = detail::floorToInt(g.z());
-    const auto fx = static_cast<double>(ix), fy = static_cast<double>(iy),
-               fz = static_cast<double>(iz);
+    const float gx = lat.gx(cloud.x[i]), gy = lat.gy(cloud.y[i]), gz = lat.gz(cloud.z[i]);
+    // NaN and infinity fail this test too.
+    if (!(std::abs(gx) < kMaxCoord && std::abs(gy) < kMaxCoord && std::abs(gz) < kMaxCoord)) {
+      if (std::isfinite(cloud.x[i]) && std::isfinite(cloud.y[i]) && std::isfinite(cloud.z[i])) {
+        fits = false;
+      }
+      continue;
+    }
+    const std::int32_t ix = floorToInt32(gx), iy = floorToInt32(gy), iz = floorToInt32(gz);
     if (ix != lx || iy != ly || iz != lz) {
       flush();
-      last = b.cellOf(static_cast<std::int32_t>(ix), static_cast<std::int32_t>(iy),
-                      static_cast<std::int32_t>(iz));
+      last = b.cellOf(ix, iy, iz);
       lx = ix, ly = iy, lz = iz;
     }
     cell_of[i] = last;
     if (!normals.isValid(i)) continue;
-    const float px = static_cast<float>(g.x() - fx), py = static_cast<float>(g.y() - fy),
-                pz = static_cast<float>(g.z() - fz);
+    const float px = gx - static_cast<float>(ix), py = gy - static_cast<float>(iy),
+                pz = gz - static_cast<float>(iz);
     run.count += 1.f;
     run.nx += normals.nx[i];
     run.ny += normals.ny[i];
@@ -244,6 +256,7 @@ void binRange(const PointCloud& cloud, const Normals& normals, const Lattice& la
     run.pzz += pz * pz;
   }
   flush();
+  return fits;
 }
 
 // r and k of points [begin, end) from the 8 nodes of their cell: trilinear weights w_o, and
@@ -263,10 +276,9 @@ std::size_t interpolate(const PointCloud& cloud, const Lattice& lat, const std::
       continue;
     }
     if (skip[c]) continue;
-    const Eigen::Vector3d g = lat.coords(cloud.x[i], cloud.y[i], cloud.z[i]);
-    const float fx = static_cast<float>(g.x() - cell_xyz[3 * c]);
-    const float fy = static_cast<float>(g.y() - cell_xyz[3 * c + 1]);
-    const float fz = static_cast<float>(g.z() - cell_xyz[3 * c + 2]);
+    const float fx = lat.gx(cloud.x[i]) - static_cast<float>(cell_xyz[3 * c]);
+    const float fy = lat.gy(cloud.y[i]) - static_cast<float>(cell_xyz[3 * c + 1]);
+    const float fz = lat.gz(cloud.z[i]) - static_cast<float>(cell_xyz[3 * c + 2]);
     const float wx[2] = {1.f - fx, fx}, wy[2] = {1.f - fy, fy}, wz[2] = {1.f - fz, fz};
     Quad acc = {0.f, 0.f, 0.f, 0.f};
     const std::uint32_t* corner = &cell_nodes[8 * c];
@@ -317,35 +329,14 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
 
   const int m = params.fast_cells_per_radius;
   Lattice lat;
-  lat.inv_cell = m / params.radius_m;
+  lat.inv_cell = static_cast<float>(m / params.radius_m);
   std::size_t first = 0;
   while (first < n_pts && !cloud.isFinite(first)) ++first;
   if (first == n_pts) {
     out.invalid = n_pts;
     return out;
   }
-  lat.ref = cloud.point(first).cast<double>();
-
-  // The lattice keys hold 21 bits per axis: check the extent once.
-  {
-    float lo[3] = {cloud.x[first], cloud.y[first], cloud.z[first]};
-    float hi[3] = {lo[0], lo[1], lo[2]};
-    for (std::size_t i = first; i < n_pts; ++i) {
-      if (!cloud.isFinite(i)) continue;
-      lo[0] = std::min(lo[0], cloud.x[i]), hi[0] = std::max(hi[0], cloud.x[i]);
-      lo[1] = std::min(lo[1], cloud.y[i]), hi[1] = std::max(hi[1], cloud.y[i]);
-      lo[2] = std::min(lo[2], cloud.z[i]), hi[2] = std::max(hi[2], cloud.z[i]);
-    }
-    const Eigen::Vector3d a = lat.coords(lo[0], lo[1], lo[2]);
-    const Eigen::Vector3d b = lat.coords(hi[0], hi[1], hi[2]);
-    const double limit = static_cast<double>(detail::kKeyBias) - 2.0;
-    if (a.minCoeff() < -limit || b.maxCoeff() > limit) {
-      throw std::invalid_argument(
-          "UpdParams.radius_m = " + std::to_string(params.radius_m) +
-          ": the cloud spans more than 2^20 fast-path lattice cells along an axis; use a "
-          "range cut-off, a larger radius or fewer fast_cells_per_radius");
-    }
-  }
+  lat.rx = cloud.x[first], lat.ry = cloud.y[first], lat.rz = cloud.z[first];
 
   // 1. Bin the points, in fixed chunks (so the result does not depend on the thread count),
   // then merge the chunks' cells in chunk order.
@@ -353,11 +344,20 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
   constexpr std::size_t kChunk = std::size_t(1) << 15;
   const std::size_t n_chunks = (n_pts - first + kChunk - 1) / kChunk;
   std::vector<Bins> chunk_bins(n_chunks);
-#pragma omp parallel for schedule(dynamic, 1)
+  int all_fit = 1;
+#pragma omp parallel for schedule(dynamic, 1) reduction(& : all_fit)
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
     const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
-    binRange(cloud, normals, lat, begin, std::min(n_pts, begin + kChunk), chunk_bins[c],
-             cell_of.data());
+    all_fit &= binRange(cloud, normals, lat, begin, std::min(n_pts, begin + kChunk),
+                        chunk_bins[c], cell_of.data())
+                   ? 1
+                   : 0;
+  }
+  if (!all_fit) {
+    throw std::invalid_argument(
+        "UpdParams.radius_m = " + std::to_string(params.radius_m) +
+        ": the cloud spans more than 2^20 fast-path lattice cells along an axis; use a "
+        "range cut-off, a larger radius or fewer fast_cells_per_radius");
   }
   Bins bins = std::move(chunk_bins[0]);
   std::vector<std::vector<std::uint32_t>> remap(n_chunks);
@@ -561,9 +561,9 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
                      oz = block_xyz[3 * b + 2] * B;
         for (std::uint32_t q = start[c]; q < start[c + 1]; ++q) {
           const std::uint32_t i = members[q];
-          const Eigen::Vector3d g = lat.coords(cloud.x[i], cloud.y[i], cloud.z[i]);
-          sumAtNode(cand, static_cast<float>(g.x() - ox), static_cast<float>(g.y() - oy),
-                    static_cast<float>(g.z() - oz), mf, sum);
+          sumAtNode(cand, lat.gx(cloud.x[i]) - static_cast<float>(ox),
+                    lat.gy(cloud.y[i]) - static_cast<float>(oy),
+                    lat.gz(cloud.z[i]) - static_cast<float>(oz), mf, sum);
           const Quad& v = sum.q[0];
           if (!(v[3] + 0.5f >= min_k)) {
             ++invalid;

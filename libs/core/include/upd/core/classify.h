@@ -44,5 +44,8 @@ struct Classification {
 /// up must be unit length.
 Classification classify(const UpdResult& upd, const Eigen::Vector3f& up,
                         const ClassifyParams& params);
+/// The same into out, reusing its buffers (a frame loop allocates nothing after the first).
+void classify(const UpdResult& upd, const Eigen::Vector3f& up, const ClassifyParams& params,
+              Classification& out);
 
 }  // namespace upd
