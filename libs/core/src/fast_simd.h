@@ -29,8 +29,10 @@ inline std::int64_t floorToInt(double v) {
   return t - (v < static_cast<double>(t) ? 1 : 0);
 }
 
-/// 1 / sqrt(x) for x > 0 to float precision (relative error < 2e-7): the bit-level first guess
-/// and three Newton steps, plain arithmetic that vectorizes.
+/// 1 / sqrt(x) for x > 0: the bit-level first guess and Steps Newton steps, plain arithmetic
+/// that vectorizes. Three steps reach float precision (relative error < 2e-7); two give 1e-5,
+/// enough for the lattice sums, whose inputs (cell moments) carry far larger errors.
+template <int Steps = 3>
 inline float rsqrtNewton(float x) {
   std::int32_t i;
   std::memcpy(&i, &x, sizeof i);
@@ -38,9 +40,7 @@ inline float rsqrtNewton(float x) {
   float y;
   std::memcpy(&y, &i, sizeof y);
   const float h = 0.5f * x;
-  y = y * (1.5f - h * y * y);
-  y = y * (1.5f - h * y * y);
-  y = y * (1.5f - h * y * y);
+  for (int s = 0; s < Steps; ++s) y = y * (1.5f - h * y * y);
   return y;
 }
 

@@ -126,12 +126,12 @@ void sumAtNode(const Candidates& c, float X, float Y, float Z, float m, NodeSums
       // The cut fraction from the centroid.
       const float vx = mx[j] - X, vy = my[j] - Y, vz = mz[j] - Z;
       const float d2 = vx * vx + vy * vy + vz * vz + 1e-12f;
-      const float inv_d = detail::rsqrtNewton(d2);
+      const float inv_d = detail::rsqrtNewton<2>(d2);
       const float dist = d2 * inv_d;
       const float q = vx * vx * cxx[j] + vy * vy * cyy[j] + vz * vz * czz[j] +
                       2.f * (vx * vy * cxy[j] + vx * vz * cxz[j] + vy * vz * cyz[j]);
       const float var = q * inv_d * inv_d;
-      const float inv_w = 0.5f * detail::rsqrtNewton(3.f * var + 1e-12f);
+      const float inv_w = 0.5f * detail::rsqrtNewton<2>(3.f * var + 1e-12f);
       const float soft = 0.5f + (m - dist) * inv_w;
       const float clamped = std::min(1.f, std::max(0.f, soft));
       const float wholly_in = far2 <= m2 ? 1.f : 0.f;

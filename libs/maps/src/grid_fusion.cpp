@@ -6,6 +6,10 @@
 #include <limits>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace upd::maps {
 
 namespace {
@@ -91,89 +95,113 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
     }
     cell_of[i] = code;
   }
-  // 2. Per-frame sums per touched cell: a dense slot table over the grid (reset after use)
-  // points each touched cell to its FrameCell; consecutive points mostly share a cell.
-  static thread_local std::vector<std::uint32_t> slot_of_cell;
-  if (slot_of_cell.size() < n_cells) slot_of_cell.assign(n_cells, kInvalid);
-  std::vector<FrameCell> frame;
-  std::vector<std::uint32_t> frame_index;
-  std::uint32_t last_cell = kInvalid;
-  FrameCell* cur = nullptr;
-  for (std::size_t i = 0; i < points.size; ++i) {
-    const std::uint32_t cell = cell_of[i];
-    if (cell >= kOutside) {
-      if (cell == kInvalid) {
-        ++stats.points_invalid;
-      } else if (cell == kUnknown) {
-        ++stats.points_unknown;
+  // 2. Per-frame sums per touched cell, then one update per cell. The grid's rows are dealt to
+  // the threads in bands: every thread reads all the points and takes those of its bands,
+  // in point order, so the result does not depend on the number of threads. A dense slot table
+  // over the grid (per thread, reset after use) points each touched cell to its FrameCell;
+  // consecutive points mostly share a cell.
+  std::size_t invalid = 0, unknown = 0, outside = 0, used = 0, updated = 0, hit = 0, sparse = 0;
+#pragma omp parallel reduction(+ : invalid, unknown, outside, used, updated, hit, sparse)
+  {
+#ifdef _OPENMP
+    const int team = omp_get_num_threads(), me = omp_get_thread_num();
+#else
+    const int team = 1, me = 0;
+#endif
+    static thread_local std::vector<std::uint32_t> slot_of_cell;
+    if (slot_of_cell.size() < n_cells) slot_of_cell.assign(n_cells, kInvalid);
+    std::uint32_t* const slots = slot_of_cell.data();
+    std::vector<FrameCell> frame;
+    std::vector<std::uint32_t> frame_index;
+    std::uint32_t last_cell = kInvalid;
+    bool mine = false;
+    FrameCell* cur = nullptr;
+    for (std::size_t i = 0; i < points.size; ++i) {
+      const std::uint32_t cell = cell_of[i];
+      if (cell >= kOutside) {
+        if (me == 0) {  // counted once
+          invalid += cell == kInvalid ? 1 : 0;
+          unknown += cell == kUnknown ? 1 : 0;
+          outside += cell == kOutside ? 1 : 0;
+        }
+        continue;
+      }
+      if (cell != last_cell) {
+        // Bands of 8 rows, dealt round-robin: a view covers a few bands, not half the grid.
+        last_cell = cell;
+        mine = static_cast<int>((cell / static_cast<std::uint32_t>(size_x)) / 8) % team == me;
+        if (mine) {
+          std::uint32_t& slot = slots[cell];
+          if (slot == kInvalid) {
+            slot = static_cast<std::uint32_t>(frame.size());
+            frame.emplace_back();
+            frame_index.push_back(cell);
+          }
+          cur = &frame[slot];
+        }
+      }
+      if (!mine) continue;
+      ++used;
+      if (points.label[i] == Label::NonTraversable) {
+        ++cur->n_nontrav;
       } else {
-        ++stats.points_outside;
+        ++cur->n_trav;
       }
-      continue;
-    }
-    ++stats.points_used;
-    if (cell != last_cell) {
-      std::uint32_t& slot = slot_of_cell[cell];
-      if (slot == kInvalid) {
-        slot = static_cast<std::uint32_t>(frame.size());
-        frame.emplace_back();
-        frame_index.push_back(cell);
+      const float z = points.z[i];
+      cur->z_sum += z;
+      cur->z_max = std::max(cur->z_max, z);
+      float v;
+      if (finiteValue(points.zeta, i, v)) {
+        cur->zeta_min = cur->zeta_min <= v ? cur->zeta_min : v;  // NaN (none yet) takes v
+        cur->zeta_sum += v;
+        ++cur->n_zeta;
       }
-      cur = &frame[slot];
-      last_cell = cell;
+      if (finiteValue(points.slope_rad, i, v)) {
+        cur->slope_sum += v;
+        ++cur->n_slope;
+      }
+      if (finiteValue(points.cost, i, v)) {
+        cur->cost_sum += v;
+        ++cur->n_cost;
+      }
     }
-    if (points.label[i] == Label::NonTraversable) {
-      ++cur->n_nontrav;
-    } else {
-      ++cur->n_trav;
-    }
-    const float z = points.z[i];
-    cur->z_sum += z;
-    cur->z_max = std::max(cur->z_max, z);
-    float v;
-    if (finiteValue(points.zeta, i, v)) {
-      cur->zeta_min = std::fmin(cur->zeta_min, v);
-      cur->zeta_sum += v;
-      ++cur->n_zeta;
-    }
-    if (finiteValue(points.slope_rad, i, v)) {
-      cur->slope_sum += v;
-      ++cur->n_slope;
-    }
-    if (finiteValue(points.cost, i, v)) {
-      cur->cost_sum += v;
-      ++cur->n_cost;
+    for (const std::uint32_t cell : frame_index) slots[cell] = kInvalid;
+
+    for (std::size_t s = 0; s < frame.size(); ++s) {
+      const std::uint32_t index = frame_index[s];
+      const FrameCell& f = frame[s];
+      const double update = frameLogOddsUpdate(f.n_nontrav, f.n_trav, params);
+      if (update == 0.0) {
+        ++sparse;
+        continue;
+      }
+      GridCell& c = grid.at(static_cast<int>(index % static_cast<std::uint32_t>(size_x)),
+                            static_cast<int>(index / static_cast<std::uint32_t>(size_x)));
+      c.logodds_nontrav = fuseLogOdds(c.logodds_nontrav, update, params);
+      ++updated;
+      if (update > 0) ++hit;
+
+      const std::uint32_t n = f.n_nontrav + f.n_trav;
+      c.elevation_m = mergeMean(c.elevation_m, c.hits, f.z_sum, n);
+      c.elevation_max_m = std::fmax(c.elevation_max_m, f.z_max);
+      c.zeta_min = std::fmin(c.zeta_min, f.zeta_min);
+      c.zeta_mean = mergeMean(c.zeta_mean, c.zeta_count, f.zeta_sum, f.n_zeta);
+      c.slope_rad = mergeMean(c.slope_rad, c.slope_count, f.slope_sum, f.n_slope);
+      c.cost_mean = mergeMean(c.cost_mean, c.cost_count, f.cost_sum, f.n_cost);
+      c.hits = addSaturating(c.hits, n);
+      c.zeta_count = addSaturating(c.zeta_count, f.n_zeta);
+      c.slope_count = addSaturating(c.slope_count, f.n_slope);
+      c.cost_count = addSaturating(c.cost_count, f.n_cost);
+      c.last_seen_s = time_s;
     }
   }
-  for (const std::uint32_t cell : frame_index) slot_of_cell[cell] = kInvalid;
-
-  for (std::size_t s = 0; s < frame.size(); ++s) {
-    const std::uint32_t index = frame_index[s];
-    const FrameCell& f = frame[s];
-    const double update = frameLogOddsUpdate(f.n_nontrav, f.n_trav, params);
-    if (update == 0.0) {
-      ++stats.cells_too_sparse;
-      continue;
-    }
-    GridCell& c = grid.at(static_cast<int>(index % static_cast<std::uint32_t>(size_x)),
-                          static_cast<int>(index / static_cast<std::uint32_t>(size_x)));
-    c.logodds_nontrav = fuseLogOdds(c.logodds_nontrav, update, params);
-    ++stats.cells_updated;
-    if (update > 0) ++stats.cells_hit;
-
-    const std::uint32_t n = f.n_nontrav + f.n_trav;
-    c.elevation_m = mergeMean(c.elevation_m, c.hits, f.z_sum, n);
-    c.elevation_max_m = std::fmax(c.elevation_max_m, f.z_max);
-    c.zeta_min = std::fmin(c.zeta_min, f.zeta_min);
-    c.zeta_mean = mergeMean(c.zeta_mean, c.zeta_count, f.zeta_sum, f.n_zeta);
-    c.slope_rad = mergeMean(c.slope_rad, c.slope_count, f.slope_sum, f.n_slope);
-    c.cost_mean = mergeMean(c.cost_mean, c.cost_count, f.cost_sum, f.n_cost);
-    c.hits = addSaturating(c.hits, n);
-    c.zeta_count = addSaturating(c.zeta_count, f.n_zeta);
-    c.slope_count = addSaturating(c.slope_count, f.n_slope);
-    c.cost_count = addSaturating(c.cost_count, f.n_cost);
-    c.last_seen_s = time_s;
-  }
+  stats.points_invalid = invalid;
+  stats.points_unknown = unknown;
+  stats.points_outside = outside;
+  stats.points_used = used;
+  stats.cells_updated = updated;
+  stats.cells_hit = hit;
+  stats.cells_too_sparse = sparse;
   return stats;
 }
 
