@@ -10,9 +10,11 @@
 // radius search, without building or walking a tree. Near the sensor, where a ball spans more
 // than 24 pixels, every 2nd or 4th row and column is scanned (a regular sample of hundreds of
 // its points). One normal is computed per block of fast_block_px x fast_block_px pixels, at
-// its centre, and shared by the block's pixels whose range is within max_depth_jump_ratio of
-// the centre's (the others compute their own): the UPD sums thousands of normals per point, so
-// sharing changes zeta by about 1e-3 while cutting the work by fast_block_px^2. The normal is
+// its centre. A pixel takes the normal of the nearest block centre on its surface (range
+// within max_depth_jump_ratio of the pixel's): its own block's, else the closest in range of
+// the 8 blocks around it. A pixel with none (a depth edge, a thin object) computes its own.
+// The UPD sums thousands of normals per point, so sharing changes zeta by about 1e-3 while
+// cutting the work by about fast_block_px^2. The normal is
 // the eigenvector of the smallest eigenvalue (eq. 5), found without a general eigen solver (see
 // normalFromMoments in fast_normals.cpp), and oriented by the rule of normals.h.
 //

@@ -19,8 +19,9 @@
 // Cost: binning and interpolation are O(1) per point; a node costs O(fast_cells_per_radius^2)
 // cells (those near a surface), and a surface of area A has about 2.5 A / s^2 nodes, so for a
 // fixed fast_cells_per_radius the node work falls as d_m grows. Memory is O(points + cells).
-// The lattice is anchored at the first finite point and built in double, so a cloud 10 km from
-// the origin (UTM) gives the same numbers as at the origin.
+// The lattice is anchored at the first finite point: coordinates relative to it are exact in
+// float wherever the input floats are, so a cloud 10 km from the origin (UTM) gives the same
+// numbers as at the origin.
 //
 // How far from exact (measured by tests/core/fast_agreement_test.cpp and bench/upd_bench,
 // docs/PERFORMANCE.md), with the defaults (4 cells per d_m, no refinement): mean |delta zeta|

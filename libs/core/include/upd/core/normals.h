@@ -29,10 +29,11 @@ struct NormalParams {
   /// A normal closer than this to horizontal is oriented towards the sensor [rad].
   double vertical_band_rad = 30.0 * kDegToRad;
   /// Fast path on organized clouds (fast_normals.h): one normal is computed per block of
-  /// fast_block_px x fast_block_px pixels and shared by the block's pixels on its surface.
+  /// fast_block_px x fast_block_px pixels (at its centre) and shared by the pixels on its
+  /// surface in the block and the 8 blocks around it (each takes the nearest in range).
   int fast_block_px = 4;
-  /// Fast path on organized clouds: a pixel shares its block's normal only when their ranges
-  /// differ by at most this fraction of the range [-] (PCL's depth-change factor is 0.02).
+  /// Fast path on organized clouds: a pixel shares a block centre's normal only when their
+  /// ranges differ by at most this fraction of the range [-] (PCL's depth-change factor is 0.02).
   double max_depth_jump_ratio = 0.02;
 
   void validate() const;
@@ -45,10 +46,10 @@ struct NormalParams {
                "normals this close to horizontal are oriented towards the sensor [deg]");
     v("fast_block_px", fast_block_px,
       "fast path, organized clouds: one normal per block of this many pixels squared, shared "
-      "by the block's pixels on the same surface (1 = a normal per pixel)");
+      "by the pixels on the same surface nearby (1 = a normal per pixel)");
     v("max_depth_jump_ratio", max_depth_jump_ratio,
-      "fast path, organized clouds: a pixel shares its block's normal only if their ranges "
-      "differ by at most this fraction of the range");
+      "fast path, organized clouds: a pixel shares a block centre's normal only if their "
+      "ranges differ by at most this fraction of the range");
   }
 };
 
