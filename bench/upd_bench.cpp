@@ -138,12 +138,7 @@ ExactReference exactReference(const PointCloud& cloud, const PipelineParams& par
       std::max<std::size_t>(1, (finite.size() + max_samples - 1) / max_samples);
   for (std::size_t j = 0; j < finite.size(); j += stride) ref.index.push_back(finite[j]);
   const std::size_t n = ref.index.size();
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  ref.upd.rx.assign(n, nan);
-  ref.upd.ry.assign(n, nan);
-  ref.upd.rz.assign(n, nan);
-  ref.upd.zeta.assign(n, nan);
-  ref.upd.k.assign(n, 0);
+  ref.upd = UpdResult::unscored(n);
   t0 = Clock::now();
   if (stride == 1) {
     const UpdResult all = computeUpd(cloud, tree, normals, params.upd);

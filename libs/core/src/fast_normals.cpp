@@ -4,9 +4,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -117,15 +114,6 @@ bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature) {
   n = Eigen::Vector3f(static_cast<float>(vx), static_cast<float>(vy), static_cast<float>(vz));
   curvature = static_cast<float>(l0);  // lambda_0 / trace: C has unit trace here
   return true;
-}
-
-Normals emptyNormals(std::size_t n) {
-  Normals out;
-  out.nx.assign(n, kNaN);
-  out.ny.assign(n, kNaN);
-  out.nz.assign(n, kNaN);
-  out.curvature.assign(n, kNaN);
-  return out;
 }
 
 // The angular pitch of the sensor per column (along_u: the angle between the rays of columns
@@ -253,7 +241,7 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
         "and NormalParams.weighting = 0 (uniform)");
   }
   const std::size_t W = cloud.width, H = cloud.height, N = cloud.size();
-  Normals out = emptyNormals(N);
+  Normals out = Normals::unset(N);
   std::size_t first = 0;
   while (first < N && !cloud.isFinite(first)) ++first;
   if (first == N) {
@@ -264,8 +252,6 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
   // Points relative to the first finite one (float differences stay exact far from the
   // origin), kFar where invalid and as padding (a vector of lanes may read past the last row),
   // and the range of every pixel from the sensor.
-  auto T0 = std::chrono::steady_clock::now();
-  auto lapT = [&](const char* what) { auto t = std::chrono::steady_clock::now(); if (getenv("NTIME")) fprintf(stderr, "%s %.2f\n", what, std::chrono::duration<double, std::milli>(t - T0).count()); T0 = t; };
   const Eigen::Vector3f ref = cloud.point(first);
   const Eigen::Vector3f origin = cloud.sensor_origin;
   static thread_local std::vector<float> buffer;
@@ -283,7 +269,6 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
     range[i] = rho;
     X[i] = cloud.x[i] - ref.x(), Y[i] = cloud.y[i] - ref.y(), Z[i] = cloud.z[i] - ref.z();
   }
-  lapT("ranges");
   const std::vector<float> pitch_u = pitchProfile(cloud, range, true);
   const std::vector<float> pitch_v = pitchProfile(cloud, range, false);
   if (pitch_u.empty() || pitch_v.empty()) {
@@ -292,7 +277,6 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
     return computeNormalsGrid(cloud, params, up);
   }
 
-  lapT("pitch");
   // The ball of radius r around a point at range rho subtends asin(r / rho) each way: its
   // pixels lie within that angle over the pitch of their column and row, plus one. Those
   // windows are scanned and the points within r in 3D kept: the neighbours of the exact path.
@@ -326,10 +310,13 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
   static thread_local std::vector<float> block_buffer;
   block_buffer.assign(5 * n_blocks, kNaN);
   float* const bn = block_buffer.data();  // per block: nx, ny, nz, curvature, centre range
+  // The centre pixel of block (bu, bv) along u or v (clamped to the image).
+  const auto centreU = [&](std::ptrdiff_t bu) { return std::min(Wi - 1, bu * D + D / 2); };
+  const auto centreV = [&](std::ptrdiff_t bv) { return std::min(Hi - 1, bv * D + D / 2); };
 #pragma omp parallel for schedule(dynamic, 16)
   for (std::ptrdiff_t b = 0; b < static_cast<std::ptrdiff_t>(n_blocks); ++b) {
     const std::ptrdiff_t bu = b % BW, bv = b / BW;
-    const std::ptrdiff_t cu = std::min(Wi - 1, bu * D + D / 2), cv = std::min(Hi - 1, bv * D + D / 2);
+    const std::ptrdiff_t cu = centreU(bu), cv = centreV(bv);
     const std::size_t ci = static_cast<std::size_t>(cv) * W + static_cast<std::size_t>(cu);
     if (!(range[ci] == range[ci])) continue;
     const Moments m = scanMoments(cu, cv, ci);
@@ -340,7 +327,6 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
       o[0] = n.x(), o[1] = n.y(), o[2] = n.z(), o[3] = curvature, o[4] = range[ci];
     }
   }
-  lapT("pass1");
   std::size_t invalid = 0;
 #pragma omp parallel for schedule(dynamic, 2) reduction(+ : invalid)
   for (std::ptrdiff_t v = 0; v < Hi; ++v) {
@@ -355,8 +341,7 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
       const std::ptrdiff_t bu = u / D;
       const float tolerance = jump * rho;
       const float* pick = bn + 5 * (bv * BW + bu);
-      const bool is_centre = u == std::min(Wi - 1, bu * D + D / 2) &&
-                             v == std::min(Hi - 1, bv * D + D / 2);
+      const bool is_centre = u == centreU(bu) && v == centreV(bv);
       if (is_centre && !(pick[4] == pick[4])) {  // its own scan found no plane
         ++invalid;
         continue;
@@ -393,7 +378,6 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
       out.curvature[i] = curvature;
     }
   }
-  lapT("pass2");
   out.invalid = invalid;
   return out;
 }
@@ -404,7 +388,7 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
   requireParam(params.knn == 0, "NormalParams", "knn", params.knn,
                "computeNormalsGrid finds radius neighbourhoods: it needs knn = 0");
   const std::size_t N = cloud.size();
-  Normals out = emptyNormals(N);
+  Normals out = Normals::unset(N);
   std::size_t first = 0;
   while (first < N && !cloud.isFinite(first)) ++first;
   if (first == N) {

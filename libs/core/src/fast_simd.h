@@ -29,6 +29,12 @@ inline std::int64_t floorToInt(double v) {
   return t - (v < static_cast<double>(t) ? 1 : 0);
 }
 
+/// The same for a float with |v| < 2^31.
+inline std::int32_t floorToInt32(float v) {
+  const auto t = static_cast<std::int32_t>(v);  // truncates towards zero
+  return t - (v < static_cast<float>(t) ? 1 : 0);
+}
+
 /// 1 / sqrt(x) for x > 0: the bit-level first guess and Steps Newton steps, plain arithmetic
 /// that vectorizes. Three steps reach float precision (relative error < 2e-7); two give 1e-5,
 /// enough for the lattice sums, whose inputs (cell moments) carry far larger errors.

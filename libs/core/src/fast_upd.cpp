@@ -181,12 +181,6 @@ struct Lattice {
   float gz(float z) const { return (z - rz) * inv_cell; }
 };
 
-// floor(v) for |v| < 2^31, without the library call of baseline x86-64.
-inline std::int32_t floorToInt32(float v) {
-  const auto t = static_cast<std::int32_t>(v);  // truncates towards zero
-  return t - (v < static_cast<float>(t) ? 1 : 0);
-}
-
 // Largest |lattice coordinate| the keys hold (21 bits per axis), with a margin for the nodes.
 constexpr float kMaxCoord = static_cast<float>(detail::kKeyBias - 4);
 
@@ -231,7 +225,8 @@ bool binRange(const PointCloud& cloud, const Normals& normals, const Lattice& la
       }
       continue;
     }
-    const std::int32_t ix = floorToInt32(gx), iy = floorToInt32(gy), iz = floorToInt32(gz);
+    const std::int32_t ix = detail::floorToInt32(gx), iy = detail::floorToInt32(gy),
+                       iz = detail::floorToInt32(gz);
     if (ix != lx || iy != ly || iz != lz) {
       flush();
       last = b.cellOf(ix, iy, iz);
@@ -318,13 +313,7 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
     throw std::invalid_argument("computeUpdFast: " + std::to_string(normals.size()) +
                                 " normals for " + std::to_string(n_pts) + " points");
   }
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  UpdResult out;
-  out.rx.assign(n_pts, nan);
-  out.ry.assign(n_pts, nan);
-  out.rz.assign(n_pts, nan);
-  out.zeta.assign(n_pts, nan);
-  out.k.assign(n_pts, 0);
+  UpdResult out = UpdResult::unscored(n_pts);
   if (stats) *stats = FastUpdStats{};
 
   const int m = params.fast_cells_per_radius;

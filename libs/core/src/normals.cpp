@@ -65,12 +65,7 @@ Normals computeNormals(const PointCloud& cloud, const KdTree& tree, const Normal
                        const Eigen::Vector3f& up) {
   params.validate();
   const std::size_t n_pts = cloud.size();
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  Normals out;
-  out.nx.assign(n_pts, nan);
-  out.ny.assign(n_pts, nan);
-  out.nz.assign(n_pts, nan);
-  out.curvature.assign(n_pts, nan);
+  Normals out = Normals::unset(n_pts);
   const float radius = static_cast<float>(params.radius_m);
   const bool gaussian = params.weighting == static_cast<int>(NormalWeighting::Gaussian);
   const float sigma = params.knn > 0 ? 0.f : 0.5f * radius;

@@ -29,13 +29,7 @@ UpdResult computeUpd(const PointCloud& cloud, const KdTree& tree, const Normals&
     throw std::invalid_argument("computeUpd: " + std::to_string(normals.size()) +
                                 " normals for " + std::to_string(n_pts) + " points");
   }
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  UpdResult out;
-  out.rx.assign(n_pts, nan);
-  out.ry.assign(n_pts, nan);
-  out.rz.assign(n_pts, nan);
-  out.zeta.assign(n_pts, nan);
-  out.k.assign(n_pts, 0);
+  UpdResult out = UpdResult::unscored(n_pts);
   const float radius = static_cast<float>(params.radius_m);
   std::size_t invalid = 0;
 

@@ -220,6 +220,19 @@ struct VertexLayout {
   bool hasColor() const { return r >= 0 && g >= 0 && b >= 0; }
 };
 
+// Appends one vertex whose property values (in the element's order) are v.
+void appendVertex(const std::vector<double>& v, const PlyElement& e, const VertexLayout& lay,
+                  bool color, PointCloud& cloud) {
+  cloud.x.push_back(static_cast<float>(v[lay.x]));
+  cloud.y.push_back(static_cast<float>(v[lay.y]));
+  cloud.z.push_back(static_cast<float>(v[lay.z]));
+  if (color) {
+    cloud.r.push_back(toColor(v[lay.r], e.properties[lay.r].type));
+    cloud.g.push_back(toColor(v[lay.g], e.properties[lay.g].type));
+    cloud.b.push_back(toColor(v[lay.b], e.properties[lay.b].type));
+  }
+}
+
 void prepareCloud(PointCloud& cloud, std::size_t n, bool color) {
   cloud.x.resize(n);
   cloud.y.resize(n);
@@ -356,14 +369,7 @@ void readBinaryVertices(const std::string& path, std::ifstream& in, BinaryReader
         v[k] = rd.value(p.type, instanceName(e, i));
       }
     }
-    cloud.x.push_back(static_cast<float>(v[lay.x]));
-    cloud.y.push_back(static_cast<float>(v[lay.y]));
-    cloud.z.push_back(static_cast<float>(v[lay.z]));
-    if (color) {
-      cloud.r.push_back(toColor(v[lay.r], e.properties[lay.r].type));
-      cloud.g.push_back(toColor(v[lay.g], e.properties[lay.g].type));
-      cloud.b.push_back(toColor(v[lay.b], e.properties[lay.b].type));
-    }
+    appendVertex(v, e, lay, color, cloud);
   }
   cloud.width = cloud.x.size();
   cloud.height = 1;
@@ -442,14 +448,7 @@ void readAsciiVertices(const std::string& path, AsciiReader& rd, const PlyElemen
       throw fileError(path, rd.where() + "more values than the " + std::to_string(np) +
                                 " properties of element '" + e.name + "'");
     }
-    cloud.x.push_back(static_cast<float>(v[lay.x]));
-    cloud.y.push_back(static_cast<float>(v[lay.y]));
-    cloud.z.push_back(static_cast<float>(v[lay.z]));
-    if (color) {
-      cloud.r.push_back(toColor(v[lay.r], e.properties[lay.r].type));
-      cloud.g.push_back(toColor(v[lay.g], e.properties[lay.g].type));
-      cloud.b.push_back(toColor(v[lay.b], e.properties[lay.b].type));
-    }
+    appendVertex(v, e, lay, color, cloud);
   }
   cloud.width = cloud.x.size();
   cloud.height = 1;

@@ -29,13 +29,6 @@ bool finiteValue(const float* values, std::size_t i, float& v) {
   return std::isfinite(v);
 }
 
-// std::floor for |v| < 2^52 without the library call baseline x86-64 makes of it.
-inline double floorExact(double v) {
-  if (!(std::abs(v) < 4.5e15)) return std::floor(v);
-  const auto t = static_cast<double>(static_cast<std::int64_t>(v));  // towards zero
-  return v < t ? t - 1.0 : t;
-}
-
 // Running mean over old_count earlier samples and n new ones summing to sum.
 float mergeMean(float mean, std::uint32_t old_count, double sum, std::uint32_t n) {
   if (n == 0) return mean;
@@ -66,14 +59,7 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
   constexpr std::uint32_t kInvalid = 0xFFFFFFFFu, kUnknown = 0xFFFFFFFEu, kOutside = 0xFFFFFFFDu;
   const int size_x = grid.sizeX();
   const std::size_t n_cells = static_cast<std::size_t>(size_x) * grid.sizeY();
-  // The cell of (x, y) as TraversabilityGrid::cellIndex computes it (floor(x * (1 / cell)) -
-  // i0), inlined: a call per point with std::floor (a library call on baseline x86-64) was a
-  // third of the stage.
-  const double inv_cell = 1.0 / grid.cellSize();
-  const Eigen::Vector2d corner = grid.cellCenter(0, 0);
-  const double i0 = std::round(corner.x() * inv_cell - 0.5);
-  const double j0 = std::round(corner.y() * inv_cell - 0.5);
-  const double n_side_x = size_x, n_side_y = grid.sizeY();
+  const GridCellIndexer cell_index = grid.indexer();  // inline: no call per point
   static thread_local std::vector<std::uint32_t> point_cell;
   point_cell.resize(points.size);
   std::uint32_t* const cell_of = point_cell.data();  // the calling thread's, shared by the team
@@ -86,12 +72,11 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
       code = kInvalid;
     } else if (points.label[i] != Label::Traversable && points.label[i] != Label::NonTraversable) {
       code = kUnknown;
+    } else if (int cx, cy; cell_index(x, y, cx, cy)) {
+      code = static_cast<std::uint32_t>(cy) * static_cast<std::uint32_t>(size_x) +
+             static_cast<std::uint32_t>(cx);
     } else {
-      const double gi = floorExact(x * inv_cell) - i0, gj = floorExact(y * inv_cell) - j0;
-      code = gi >= 0 && gi < n_side_x && gj >= 0 && gj < n_side_y
-                 ? static_cast<std::uint32_t>(gj) * static_cast<std::uint32_t>(size_x) +
-                       static_cast<std::uint32_t>(gi)
-                 : kOutside;
+      code = kOutside;
     }
     cell_of[i] = code;
   }

@@ -129,14 +129,17 @@ double TraversabilityGrid::yMax() const {
 bool TraversabilityGrid::cellIndex(double x_m, double y_m, int& cx, int& cy) const {
   // floor, not CDynamicGrid::x2idx (which truncates towards zero and so folds the strip just
   // outside the lower edge into the first cell).
-  // x * (1 / cell) as integrateScan computes it, so that both agree on every point.
-  const double inv = 1.0 / cellSize();
-  const double gi = std::floor(x_m * inv) - static_cast<double>(impl_->i0);
-  const double gj = std::floor(y_m * inv) - static_cast<double>(impl_->j0);
-  if (!(gi >= 0 && gi < impl_->n && gj >= 0 && gj < impl_->n)) return false;  // NaN: false
-  cx = static_cast<int>(gi);
-  cy = static_cast<int>(gj);
-  return true;
+  return indexer()(x_m, y_m, cx, cy);
+}
+
+GridCellIndexer TraversabilityGrid::indexer() const {
+  GridCellIndexer ix;
+  ix.inv_cell = 1.0 / cellSize();
+  ix.i0 = static_cast<double>(impl_->i0);
+  ix.j0 = static_cast<double>(impl_->j0);
+  ix.size_x = impl_->n;
+  ix.size_y = impl_->n;
+  return ix;
 }
 
 Eigen::Vector2d TraversabilityGrid::cellCenter(int cx, int cy) const {

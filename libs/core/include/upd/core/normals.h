@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace upd {
@@ -62,6 +63,17 @@ struct Normals {
   std::size_t size() const { return nx.size(); }
   bool isValid(std::size_t i) const { return nx[i] == nx[i]; }
   Eigen::Vector3f normal(std::size_t i) const { return {nx[i], ny[i], nz[i]}; }
+
+  /// n points, no normal yet (NaN): where the exact and fast paths start.
+  static Normals unset(std::size_t n) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    Normals out;
+    out.nx.assign(n, nan);
+    out.ny.assign(n, nan);
+    out.nz.assign(n, nan);
+    out.curvature.assign(n, nan);
+    return out;
+  }
 };
 
 /// PCA normal of a neighbourhood (eqs. 4-5), plain function: returns false and leaves n as NaN

@@ -11,6 +11,7 @@
 #include "upd/core/params.h"
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace upd {
@@ -62,6 +63,18 @@ struct UpdResult {
   std::size_t size() const { return zeta.size(); }
   bool isValid(std::size_t i) const { return zeta[i] == zeta[i]; }
   Eigen::Vector3f r(std::size_t i) const { return {rx[i], ry[i], rz[i]}; }
+
+  /// n points, none scored yet (NaN, k = 0): where the exact and fast paths start.
+  static UpdResult unscored(std::size_t n) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    UpdResult out;
+    out.rx.assign(n, nan);
+    out.ry.assign(n, nan);
+    out.rz.assign(n, nan);
+    out.zeta.assign(n, nan);
+    out.k.assign(n, 0);
+    return out;
+  }
 };
 
 /// UPD of every point of cloud from its normals (exact: sums over the true neighbourhood).

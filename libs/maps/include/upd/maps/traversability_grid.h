@@ -27,6 +27,7 @@
 #include "upd/core/params.h"
 #include "upd/core/point_cloud.h"
 
+#include <cmath>
 #include <Eigen/Core>
 
 #include <cstddef>
@@ -106,6 +107,30 @@ const char* layerName(GridLayer layer);
 /// The layer's value in the cell (hits as a float; NaN for a never-observed cell).
 float layerValue(const GridCell& cell, GridLayer layer);
 
+/// The window cell of a world point, for per-point loops: the arithmetic of
+/// TraversabilityGrid::cellIndex, inline. Valid until the window moves.
+struct GridCellIndexer {
+  double inv_cell = 1.0;  ///< 1 / cell size [1/m]
+  double i0 = 0, j0 = 0;  ///< world index of window cell (0, 0)
+  double size_x = 0, size_y = 0;
+
+  /// floor(x / cell) - i0 as floor(x * (1 / cell)) - i0; false outside the window or for NaN.
+  bool operator()(double x_m, double y_m, int& cx, int& cy) const {
+    const double gi = floorNoCall(x_m * inv_cell) - i0, gj = floorNoCall(y_m * inv_cell) - j0;
+    if (!(gi >= 0 && gi < size_x && gj >= 0 && gj < size_y)) return false;
+    cx = static_cast<int>(gi);
+    cy = static_cast<int>(gj);
+    return true;
+  }
+  /// std::floor without the library call baseline x86-64 makes of it (|v| < 2^52; others and
+  /// NaN go to std::floor).
+  static double floorNoCall(double v) {
+    if (!(std::abs(v) < 4.5e15)) return std::floor(v);
+    const auto t = static_cast<double>(static_cast<std::int64_t>(v));  // towards zero
+    return v < t ? t - 1.0 : t;
+  }
+};
+
 class TraversabilityGrid {
  public:
   /// Validates params (std::invalid_argument); every cell starts unknown.
@@ -130,6 +155,8 @@ class TraversabilityGrid {
 
   /// Window indices of the cell holding (x_m, y_m); false when outside the window or not finite.
   bool cellIndex(double x_m, double y_m, int& cx, int& cy) const;
+  /// The same computation, inline, for loops over many points.
+  GridCellIndexer indexer() const;
   /// Centre of window cell (cx, cy) [m, world].
   Eigen::Vector2d cellCenter(int cx, int cy) const;
 
