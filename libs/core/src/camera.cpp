@@ -3,6 +3,7 @@
 #include "upd/core/params.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -18,6 +19,12 @@ void CameraIntrinsics::validate() const {
 }
 
 PointCloud depthToCloud(const DepthImage& depth, const CameraIntrinsics& K) {
+  PointCloud cloud;
+  depthToCloud(depth, K, cloud);
+  return cloud;
+}
+
+void depthToCloud(const DepthImage& depth, const CameraIntrinsics& K, PointCloud& cloud) {
   K.validate();
   if (depth.width != K.width || depth.height != K.height ||
       depth.depth_m.size() != static_cast<std::size_t>(depth.width) * depth.height) {
@@ -25,21 +32,26 @@ PointCloud depthToCloud(const DepthImage& depth, const CameraIntrinsics& K) {
                                 std::to_string(depth.height) + " but the intrinsics are " +
                                 std::to_string(K.width) + "x" + std::to_string(K.height));
   }
-  PointCloud cloud;
-  cloud.resizeOrganized(depth.width, depth.height);
+  // Every pixel is written (a point or NaN), so the buffers are resized, not filled.
+  const auto n = static_cast<std::size_t>(depth.width) * depth.height;
+  cloud.x.resize(n), cloud.y.resize(n), cloud.z.resize(n);
+  cloud.r.clear(), cloud.g.clear(), cloud.b.clear();
+  cloud.width = depth.width, cloud.height = depth.height;
+  cloud.sensor_origin.setZero();
   const float inv_fx = static_cast<float>(1.0 / K.fx), inv_fy = static_cast<float>(1.0 / K.fy);
   const float cx = static_cast<float>(K.cx), cy = static_cast<float>(K.cy);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+#pragma omp parallel for schedule(static)
   for (int v = 0; v < depth.height; ++v) {
     for (int u = 0; u < depth.width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * depth.width + u;
       const float d = depth.depth_m[i];
-      if (!(d > 0.f) || !std::isfinite(d)) continue;
-      cloud.x[i] = (static_cast<float>(u) - cx) * d * inv_fx;
-      cloud.y[i] = (static_cast<float>(v) - cy) * d * inv_fy;
-      cloud.z[i] = d;
+      const bool valid = d > 0.f && d <= std::numeric_limits<float>::max();
+      cloud.x[i] = valid ? (static_cast<float>(u) - cx) * d * inv_fx : nan;
+      cloud.y[i] = valid ? (static_cast<float>(v) - cy) * d * inv_fy : nan;
+      cloud.z[i] = valid ? d : nan;
     }
   }
-  return cloud;
 }
 
 }  // namespace upd

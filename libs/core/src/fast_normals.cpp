@@ -116,13 +116,16 @@ bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature) {
   return true;
 }
 
+inline void setUnset(Normals& out, std::size_t i) {
+  out.nx[i] = out.ny[i] = out.nz[i] = out.curvature[i] = kNaN;
+}
+
 // The angular pitch of the sensor per column (along_u: the angle between the rays of columns
 // u and u + 1) or per row [rad]: the smallest over every 16th line, so that windows sized from
 // it hold the whole ball even where the pitch shrinks (off-axis, by cos^2 of the angle for a
 // pinhole camera). Columns without a sample take the median; a pitch below half the median
 // (duplicated pixels) is raised to it. Empty when too few pairs are valid.
-std::vector<float> pitchProfile(const PointCloud& cloud, const std::vector<float>& range,
-                                bool along_u) {
+std::vector<float> pitchProfile(const PointCloud& cloud, const float* range, bool along_u) {
   const std::size_t W = cloud.width, H = cloud.height;
   const Eigen::Vector3f o = cloud.sensor_origin;
   const std::size_t lines = along_u ? H : W, len = along_u ? W : H;
@@ -234,6 +237,13 @@ bool organizedNormalsApply(const PointCloud& cloud, const NormalParams& params) 
 
 Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params,
                                 const Eigen::Vector3f& up) {
+  Normals out;
+  computeNormalsOrganized(cloud, params, up, out);
+  return out;
+}
+
+void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params,
+                             const Eigen::Vector3f& up, Normals& out) {
   params.validate();
   if (!organizedNormalsApply(cloud, params)) {
     throw std::invalid_argument(
@@ -241,12 +251,16 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
         "and NormalParams.weighting = 0 (uniform)");
   }
   const std::size_t W = cloud.width, H = cloud.height, N = cloud.size();
-  Normals out = Normals::unset(N);
+  // Every pixel's normal is written below (a normal or NaN): no fill, and the caller's
+  // buffers are reused from frame to frame.
+  out.nx.resize(N), out.ny.resize(N), out.nz.resize(N), out.curvature.resize(N);
+  out.invalid = 0;
   std::size_t first = 0;
   while (first < N && !cloud.isFinite(first)) ++first;
   if (first == N) {
+    out = Normals::unset(N);
     out.invalid = N;
-    return out;
+    return;
   }
   const auto Wi = static_cast<std::ptrdiff_t>(W), Hi = static_cast<std::ptrdiff_t>(H);
   // Points relative to the first finite one (float differences stay exact far from the
@@ -254,27 +268,38 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
   // and the range of every pixel from the sensor.
   const Eigen::Vector3f ref = cloud.point(first);
   const Eigen::Vector3f origin = cloud.sensor_origin;
-  static thread_local std::vector<float> buffer;
-  buffer.assign(3 * (N + kMaxHalf + kScanLanes * kScanSide), kFar);
-  float* const X = buffer.data();  // the calling thread's buffer, shared by the team
-  float* const Y = X + N + kMaxHalf + kScanLanes * kScanSide;
-  float* const Z = Y + N + kMaxHalf + kScanLanes * kScanSide;
-  std::vector<float> range(N, kNaN);
+  // The calling thread's buffers, kept for the next frame and shared by the team (their
+  // pointers are taken here, outside the parallel regions).
+  static thread_local std::vector<float> buffer, range_buffer;
+  const std::size_t image_len = N + kMaxHalf + kScanLanes * kScanSide;
+  buffer.resize(3 * image_len);
+  range_buffer.resize(N);
+  float* const X = buffer.data();
+  float* const Y = X + image_len;
+  float* const Z = Y + image_len;
+  float* const range = range_buffer.data();
+  for (float* pad : {X + N, Y + N, Z + N}) std::fill(pad, pad + (image_len - N), kFar);
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(N); ++ii) {
     const auto i = static_cast<std::size_t>(ii);
-    if (!cloud.isFinite(i)) continue;
-    const float rho = (cloud.point(i) - origin).norm();
-    if (!(rho > 0.f)) continue;
-    range[i] = rho;
-    X[i] = cloud.x[i] - ref.x(), Y[i] = cloud.y[i] - ref.y(), Z[i] = cloud.z[i] - ref.z();
+    const float dx = cloud.x[i] - origin.x(), dy = cloud.y[i] - origin.y(),
+                dz = cloud.z[i] - origin.z();
+    const float rho = std::sqrt(dx * dx + dy * dy + dz * dz);  // NaN for a non-finite point
+    if (rho > 0.f && rho <= std::numeric_limits<float>::max()) {
+      range[i] = rho;
+      X[i] = cloud.x[i] - ref.x(), Y[i] = cloud.y[i] - ref.y(), Z[i] = cloud.z[i] - ref.z();
+    } else {
+      range[i] = kNaN;
+      X[i] = Y[i] = Z[i] = kFar;
+    }
   }
   const std::vector<float> pitch_u = pitchProfile(cloud, range, true);
   const std::vector<float> pitch_v = pitchProfile(cloud, range, false);
   if (pitch_u.empty() || pitch_v.empty()) {
     // Not a central projection we can measure (too few neighbouring valid pixels, or all rays
     // equal): the hash grid finds the same neighbours.
-    return computeNormalsGrid(cloud, params, up);
+    out = computeNormalsGrid(cloud, params, up);
+    return;
   }
 
   // The ball of radius r around a point at range rho subtends asin(r / rho) each way: its
@@ -335,6 +360,7 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
       const std::size_t i = static_cast<std::size_t>(v) * W + static_cast<std::size_t>(u);
       const float rho = range[i];
       if (!(rho == rho)) {
+        setUnset(out, i);
         ++invalid;
         continue;
       }
@@ -343,6 +369,7 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
       const float* pick = bn + 5 * (bv * BW + bu);
       const bool is_centre = u == centreU(bu) && v == centreV(bv);
       if (is_centre && !(pick[4] == pick[4])) {  // its own scan found no plane
+        setUnset(out, i);
         ++invalid;
         continue;
       }
@@ -367,6 +394,7 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
       } else {
         const Moments m = scanMoments(u, v, i);
         if (!(m.n >= 3 && normalFromMoments(m, n, curvature))) {
+          setUnset(out, i);
           ++invalid;
           continue;
         }
@@ -379,7 +407,6 @@ Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& par
     }
   }
   out.invalid = invalid;
-  return out;
 }
 
 Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,

@@ -43,8 +43,16 @@ struct NodeSums {
   Quad q[4];
 };
 
-// The candidate cells of a block, structure of arrays padded with empty cells to a multiple
-// of kLanes, positions relative to the block origin in cell units.
+// What a cell contributes to ball sums, once per cell: the centroid's offset from the cell's
+// lower corner and the covariance of its points (cell units), the count of valid normals and
+// their sum.
+struct CellRow {
+  enum Field { kMx, kMy, kMz, kCxx, kCxy, kCxz, kCyy, kCyz, kCzz, kCount, kNx, kNy, kNz, kFields };
+  float f[kFields];
+};
+
+// The candidate cells of a group of nodes, structure of arrays padded with empty cells to a
+// multiple of kLanes, positions relative to the group's block origin in cell units.
 struct Candidates {
   enum Field {
     kLx,
@@ -68,15 +76,21 @@ struct Candidates {
   std::array<std::vector<float>, kFields> f;  // lower corner, centroid, covariance, sums
 
   const float* operator[](Field k) const { return f[k].data(); }
-  void clear() {
-    for (auto& v : f) v.clear();
-  }
   std::size_t size() const { return f[kLx].size(); }
-  void push(const std::array<float, kFields>& values) {
-    for (int k = 0; k < kFields; ++k) f[k].push_back(values[k]);
-  }
-  void pad() {
-    while (size() % kLanes != 0) push({});
+  // Rows for cells[0, n) (lower corners lx, ly, lz relative to the block origin), padded.
+  void fill(std::size_t n, const std::uint32_t* cells, const std::int32_t* cell_xyz,
+            const CellRow* rows, const std::int32_t origin[3]) {
+    const std::size_t padded = (n + kLanes - 1) / kLanes * kLanes;
+    for (auto& v : f) v.assign(padded, 0.f);
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::uint32_t c = cells[j];
+      for (int a = 0; a < 3; ++a) {
+        const auto l = static_cast<float>(cell_xyz[3 * c + a] - origin[a]);
+        f[kLx + a][j] = l;
+        f[kMx + a][j] = l + rows[c].f[CellRow::kMx + a];
+      }
+      for (int k = CellRow::kCxx; k < CellRow::kFields; ++k) f[kCxx + k - CellRow::kCxx][j] = rows[c].f[k];
+    }
   }
 };
 
@@ -223,6 +237,7 @@ bool binRange(const PointCloud& cloud, const Normals& normals, const Lattice& la
       if (std::isfinite(cloud.x[i]) && std::isfinite(cloud.y[i]) && std::isfinite(cloud.z[i])) {
         fits = false;
       }
+      cell_of[i] = kNoIndex;
       continue;
     }
     const std::int32_t ix = detail::floorToInt32(gx), iy = detail::floorToInt32(gy),
@@ -254,6 +269,12 @@ bool binRange(const PointCloud& cloud, const Normals& normals, const Lattice& la
   return fits;
 }
 
+inline void setUnscored(UpdResult& out, std::size_t i) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  out.rx[i] = out.ry[i] = out.rz[i] = out.zeta[i] = nan;
+  out.k[i] = 0;
+}
+
 // r and k of points [begin, end) from the 8 nodes of their cell: trilinear weights w_o, and
 // each node's value carried towards the point by half its gradient step. For a quadratic
 // field the trilinear blend errs by +E and the blend of first-order Taylor steps by -E, so
@@ -267,6 +288,7 @@ std::size_t interpolate(const PointCloud& cloud, const Lattice& lat, const std::
   for (std::size_t i = begin; i < end; ++i) {
     const std::uint32_t c = cell_of[i];
     if (c == kNoIndex) {
+      setUnscored(out, i);
       ++invalid;
       continue;
     }
@@ -287,6 +309,7 @@ std::size_t interpolate(const PointCloud& cloud, const Lattice& lat, const std::
     }
     const float k = acc[3];
     if (!(k + 0.5f >= min_k)) {  // k rounded to the nearest integer is below min_k
+      setUnscored(out, i);
       ++invalid;
       continue;
     }
@@ -305,6 +328,13 @@ std::size_t interpolate(const PointCloud& cloud, const Lattice& lat, const std::
 
 UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdParams& params,
                          FastUpdStats* stats) {
+  UpdResult out;
+  computeUpdFast(cloud, normals, params, out, stats);
+  return out;
+}
+
+void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdParams& params,
+                    UpdResult& out, FastUpdStats* stats) {
   params.validate();
   requireParam(params.knn == 0, "UpdParams", "knn", params.knn,
                "the fast path sums over the radius d_m: it needs knn = 0");
@@ -313,7 +343,11 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
     throw std::invalid_argument("computeUpdFast: " + std::to_string(normals.size()) +
                                 " normals for " + std::to_string(n_pts) + " points");
   }
-  UpdResult out = UpdResult::unscored(n_pts);
+  // Every point's fields are written below (scored or NaN): no fill, and the caller's
+  // buffers are reused from frame to frame.
+  out.rx.resize(n_pts), out.ry.resize(n_pts), out.rz.resize(n_pts), out.zeta.resize(n_pts);
+  out.k.resize(n_pts);
+  out.invalid = 0;
   if (stats) *stats = FastUpdStats{};
 
   const int m = params.fast_cells_per_radius;
@@ -321,15 +355,21 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
   lat.inv_cell = static_cast<float>(m / params.radius_m);
   std::size_t first = 0;
   while (first < n_pts && !cloud.isFinite(first)) ++first;
+  for (std::size_t i = 0; i < first; ++i) setUnscored(out, i);
   if (first == n_pts) {
     out.invalid = n_pts;
-    return out;
+    return;
   }
   lat.rx = cloud.x[first], lat.ry = cloud.y[first], lat.rz = cloud.z[first];
 
   // 1. Bin the points, in fixed chunks (so the result does not depend on the thread count),
   // then merge the chunks' cells in chunk order.
-  std::vector<std::uint32_t> cell_of(n_pts, kNoIndex);
+  // The cell of every point (kNoIndex: none), in a buffer kept for the next frame; its
+  // pointer is taken here, outside the parallel regions that share it.
+  static thread_local std::vector<std::uint32_t> cell_of_buffer;
+  cell_of_buffer.resize(n_pts);
+  std::uint32_t* const cell_of = cell_of_buffer.data();
+  std::fill(cell_of, cell_of + first, kNoIndex);
   constexpr std::size_t kChunk = std::size_t(1) << 15;
   const std::size_t n_chunks = (n_pts - first + kChunk - 1) / kChunk;
   std::vector<Bins> chunk_bins(n_chunks);
@@ -338,7 +378,7 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
     const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
     all_fit &= binRange(cloud, normals, lat, begin, std::min(n_pts, begin + kChunk),
-                        chunk_bins[c], cell_of.data())
+                        chunk_bins[c], cell_of)
                    ? 1
                    : 0;
   }
@@ -428,53 +468,94 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
   groupBy(cell_block, cell_start, cell_order);
   groupBy(node_block, node_start, node_order);
 
-  // The candidate cells of block b: the occupied cells of the 27 blocks around it, relative
-  // to its origin (in cell units) so that floats stay small.
-  const auto gather = [&](std::size_t b, Candidates& cand) {
-    const std::int32_t ox = block_xyz[3 * b] * B, oy = block_xyz[3 * b + 1] * B,
-                       oz = block_xyz[3 * b + 2] * B;
-    cand.clear();
+  // What every cell with valid normals contributes, once; and for every block the cells of
+  // the 27 blocks around it (every cell within d_m of one of its nodes).
+  std::vector<CellRow> rows(n_cells);
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
+    const CellSums& s = sums[static_cast<std::size_t>(cc)];
+    const float inv = s.count > 0.f ? 1.f / s.count : 0.f;
+    const float mx = s.px * inv, my = s.py * inv, mz = s.pz * inv;
+    rows[static_cast<std::size_t>(cc)] = {{mx, my, mz, std::max(0.f, s.pxx * inv - mx * mx),
+                                           s.pxy * inv - mx * my, s.pxz * inv - mx * mz,
+                                           std::max(0.f, s.pyy * inv - my * my),
+                                           s.pyz * inv - my * mz,
+                                           std::max(0.f, s.pzz * inv - mz * mz), s.count, s.nx,
+                                           s.ny, s.nz}};
+  }
+  const auto around = [&](std::size_t b, std::vector<std::uint32_t>& cells) {
+    cells.clear();
     for (int d = 0; d < 27; ++d) {
       const std::uint32_t nb = block_map.find(
           detail::packKey(block_xyz[3 * b] + d % 3 - 1, block_xyz[3 * b + 1] + (d / 3) % 3 - 1,
                           block_xyz[3 * b + 2] + d / 9 - 1));
       if (nb == kNoIndex) continue;
       for (std::uint32_t q = cell_start[nb]; q < cell_start[nb + 1]; ++q) {
-        const std::uint32_t c = cell_order[q];
-        const CellSums& s = sums[c];
-        if (s.count <= 0.f) continue;
-        const float lx = static_cast<float>(cell_xyz[3 * c] - ox),
-                    ly = static_cast<float>(cell_xyz[3 * c + 1] - oy),
-                    lz = static_cast<float>(cell_xyz[3 * c + 2] - oz);
-        const float inv = 1.f / s.count;
-        const float mx = s.px * inv, my = s.py * inv, mz = s.pz * inv;
-        cand.push({lx, ly, lz, lx + mx, ly + my, lz + mz, std::max(0.f, s.pxx * inv - mx * mx),
-                   s.pxy * inv - mx * my, s.pxz * inv - mx * mz,
-                   std::max(0.f, s.pyy * inv - my * my), s.pyz * inv - my * mz,
-                   std::max(0.f, s.pzz * inv - mz * mz), s.count, s.nx, s.ny, s.nz});
+        if (sums[cell_order[q]].count > 0.f) cells.push_back(cell_order[q]);
       }
     }
-    cand.pad();
+  };
+  const auto blockOrigin = [&](std::size_t b, std::int32_t origin[3]) {
+    for (int a = 0; a < 3; ++a) origin[a] = block_xyz[3 * b + a] * B;
   };
 
-  // 4. Ball sums at every node, block by block (the candidates gathered once per block).
+  // 4. Ball sums at every node. The nodes of a block go in 8 groups, its octants (local
+  // coordinates below or from `half` along each axis); a group sums over the cells that some
+  // ball around its part of the block may touch (box distance <= m), a third to a half of the
+  // block's candidates.
   std::vector<NodeSums> node_sums(n_nodes);
   const float mf = static_cast<float>(m);
+  const std::int32_t half = (B + 1) / 2;
 #pragma omp parallel
   {
     Candidates cand;
+    std::vector<std::uint32_t> cells, picked;
+    std::vector<std::uint8_t> near;  // per candidate cell: the octants it may touch
+    std::array<std::vector<std::uint32_t>, 8> octant;
 #pragma omp for schedule(dynamic, 2)
     for (std::ptrdiff_t bb = 0; bb < static_cast<std::ptrdiff_t>(n_blocks); ++bb) {
       const auto b = static_cast<std::size_t>(bb);
       if (node_start[b] == node_start[b + 1]) continue;
-      gather(b, cand);
-      const std::int32_t ox = block_xyz[3 * b] * B, oy = block_xyz[3 * b + 1] * B,
-                         oz = block_xyz[3 * b + 2] * B;
+      std::int32_t origin[3];
+      blockOrigin(b, origin);
+      for (auto& o : octant) o.clear();
       for (std::uint32_t q = node_start[b]; q < node_start[b + 1]; ++q) {
         const std::uint32_t v = node_order[q];
-        sumAtNode(cand, static_cast<float>(node_xyz[3 * v] - ox),
-                  static_cast<float>(node_xyz[3 * v + 1] - oy),
-                  static_cast<float>(node_xyz[3 * v + 2] - oz), mf, node_sums[v]);
+        int o = 0;
+        for (int a = 0; a < 3; ++a) o |= (node_xyz[3 * v + a] - origin[a] >= half ? 1 : 0) << a;
+        octant[o].push_back(v);
+      }
+      around(b, cells);
+      near.resize(cells.size());
+      for (std::size_t j = 0; j < cells.size(); ++j) {
+        // Squared gap along each axis between the cell [l, l + 1] and the lower [0, half - 1]
+        // or upper [half, B - 1] node range.
+        std::int32_t gap2[3][2];
+        for (int a = 0; a < 3; ++a) {
+          const std::int32_t l = cell_xyz[3 * cells[j] + a] - origin[a];
+          const std::int32_t lower = std::max({0, l - (half - 1), -(l + 1)});
+          const std::int32_t upper = std::max({0, l - (B - 1), half - (l + 1)});
+          gap2[a][0] = lower * lower, gap2[a][1] = upper * upper;
+        }
+        std::uint8_t mask = 0;
+        for (int o = 0; o < 8; ++o) {
+          const std::int32_t d2 = gap2[0][o & 1] + gap2[1][(o >> 1) & 1] + gap2[2][o >> 2];
+          mask |= static_cast<std::uint8_t>((d2 <= m * m ? 1 : 0) << o);
+        }
+        near[j] = mask;
+      }
+      for (int o = 0; o < 8; ++o) {
+        if (octant[o].empty()) continue;
+        picked.clear();
+        for (std::size_t j = 0; j < cells.size(); ++j) {
+          if ((near[j] >> o) & 1) picked.push_back(cells[j]);
+        }
+        cand.fill(picked.size(), picked.data(), cell_xyz.data(), rows.data(), origin);
+        for (const std::uint32_t v : octant[o]) {
+          sumAtNode(cand, static_cast<float>(node_xyz[3 * v] - origin[0]),
+                    static_cast<float>(node_xyz[3 * v + 1] - origin[1]),
+                    static_cast<float>(node_xyz[3 * v + 2] - origin[2]), mf, node_sums[v]);
+        }
       }
     }
   }
@@ -514,7 +595,7 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_blocks_pts); ++c) {
     const std::size_t begin = static_cast<std::size_t>(c) * kChunk;
     invalid +=
-        interpolate(cloud, lat, cell_of.data(), cell_xyz.data(), cell_nodes.data(),
+        interpolate(cloud, lat, cell_of, cell_xyz.data(), cell_nodes.data(),
                     node_sums.data(), refine.data(), static_cast<float>(params.min_neighbors),
                     begin, std::min(n_pts, begin + kChunk), out);
   }
@@ -539,22 +620,25 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
 #pragma omp parallel reduction(+ : invalid)
     {
       Candidates cand;
+      std::vector<std::uint32_t> cells;
       NodeSums sum;
 #pragma omp for schedule(dynamic, 4)
       for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
         const auto c = static_cast<std::size_t>(cc);
         if (start[c] == start[c + 1]) continue;
         const std::size_t b = cell_block[c];
-        gather(b, cand);
-        const double ox = block_xyz[3 * b] * B, oy = block_xyz[3 * b + 1] * B,
-                     oz = block_xyz[3 * b + 2] * B;
+        std::int32_t origin[3];
+        blockOrigin(b, origin);
+        around(b, cells);
+        cand.fill(cells.size(), cells.data(), cell_xyz.data(), rows.data(), origin);
         for (std::uint32_t q = start[c]; q < start[c + 1]; ++q) {
           const std::uint32_t i = members[q];
-          sumAtNode(cand, lat.gx(cloud.x[i]) - static_cast<float>(ox),
-                    lat.gy(cloud.y[i]) - static_cast<float>(oy),
-                    lat.gz(cloud.z[i]) - static_cast<float>(oz), mf, sum);
+          sumAtNode(cand, lat.gx(cloud.x[i]) - static_cast<float>(origin[0]),
+                    lat.gy(cloud.y[i]) - static_cast<float>(origin[1]),
+                    lat.gz(cloud.z[i]) - static_cast<float>(origin[2]), mf, sum);
           const Quad& v = sum.q[0];
           if (!(v[3] + 0.5f >= min_k)) {
+            setUnscored(out, i);
             ++invalid;
             continue;
           }
@@ -574,7 +658,6 @@ UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const 
     stats->blocks = n_blocks;
     stats->refined_points = refined_points;
   }
-  return out;
 }
 
 }  // namespace upd

@@ -46,22 +46,32 @@ class Stopwatch {
 }  // namespace
 
 PipelineResult runPipeline(const PointCloud& input, const PipelineParams& params) {
+  PipelineResult res;
+  runPipeline(input, params, res);
+  return res;
+}
+
+void runPipeline(const PointCloud& input, const PipelineParams& params, PipelineResult& res) {
   params.validate();
   const Eigen::Vector3f up = params.unitUp();
-  PipelineResult res;
+  res.timings = StageTimings{};
   Stopwatch total, lap;
-  res.cloud = preprocess(input, params.preprocess, &res.preprocess_stats);
+  preprocess(input, params.preprocess, res.cloud, &res.preprocess_stats);
   res.timings.preprocess_ms = lap.lapMs();
   res.method = resolveMethod(params);
   if (res.method == UpdMethod::Fast) {
     // No index to build: the normals and the UPD bin the points themselves.
     res.organized_normals = organizedNormalsApply(res.cloud, params.normals);
-    res.normals = res.organized_normals ? computeNormalsOrganized(res.cloud, params.normals, up)
-                                        : computeNormalsGrid(res.cloud, params.normals, up);
+    if (res.organized_normals) {
+      computeNormalsOrganized(res.cloud, params.normals, up, res.normals);
+    } else {
+      res.normals = computeNormalsGrid(res.cloud, params.normals, up);
+    }
     res.timings.normals_ms = lap.lapMs();
-    res.upd = computeUpdFast(res.cloud, res.normals, params.upd);
+    computeUpdFast(res.cloud, res.normals, params.upd, res.upd);
     res.timings.upd_ms = lap.lapMs();
   } else {
+    res.organized_normals = false;
     const KdTree tree(res.cloud);
     res.timings.index_ms = lap.lapMs();
     res.normals = computeNormals(res.cloud, tree, params.normals, up);
@@ -69,10 +79,9 @@ PipelineResult runPipeline(const PointCloud& input, const PipelineParams& params
     res.upd = computeUpd(res.cloud, tree, res.normals, params.upd);
     res.timings.upd_ms = lap.lapMs();
   }
-  res.classes = classify(res.upd, up, params.classify);
+  classify(res.upd, up, params.classify, res.classes);
   res.timings.classify_ms = lap.lapMs();
   res.timings.total_ms = total.lapMs();
-  return res;
 }
 
 }  // namespace upd

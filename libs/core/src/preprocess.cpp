@@ -192,8 +192,7 @@ PointCloud preprocess(const PointCloud& in, const PreprocessParams& p, Preproces
   st.points_in = in.size();
   const std::size_t finite = in.countFinite();
   st.non_finite = in.size() - finite;
-  const bool any = p.range_enabled || p.box_enabled || p.voxel_enabled || p.outlier_enabled;
-  if (!any) {
+  if (!p.anyEnabled()) {
     st.after_voxel = st.points_out = in.size();
     if (stats) *stats = st;
     return in;
@@ -211,6 +210,21 @@ PointCloud preprocess(const PointCloud& in, const PreprocessParams& p, Preproces
   st.points_out = cloud.size();
   if (stats) *stats = st;
   return cloud;
+}
+
+void preprocess(const PointCloud& in, const PreprocessParams& p, PointCloud& out,
+                PreprocessStats* stats) {
+  if (p.anyEnabled()) {
+    out = preprocess(in, p, stats);
+    return;
+  }
+  p.validate();
+  out = in;  // copy assignment keeps out's buffers when they are large enough
+  if (stats) {
+    *stats = PreprocessStats{};
+    stats->points_in = stats->after_voxel = stats->points_out = in.size();
+    stats->non_finite = in.size() - in.countFinite();
+  }
 }
 
 }  // namespace upd

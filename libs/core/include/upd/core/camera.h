@@ -33,4 +33,7 @@ struct DepthImage {
 /// with the sensor origin at 0; invalid pixels become NaN points.
 PointCloud depthToCloud(const DepthImage& depth, const CameraIntrinsics& K);
 
+/// The same into cloud, whose buffers are reused (a frame loop allocates nothing once warm).
+void depthToCloud(const DepthImage& depth, const CameraIntrinsics& K, PointCloud& cloud);
+
 }  // namespace upd

@@ -47,6 +47,10 @@ bool organizedNormalsApply(const PointCloud& cloud, const NormalParams& params);
 Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params,
                                 const Eigen::Vector3f& up);
 
+/// The same into out, whose buffers are reused (a frame loop allocates nothing once warm).
+void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params,
+                             const Eigen::Vector3f& up, Normals& out);
+
 /// Normals of any cloud with the radius neighbourhoods of computeNormals (params.knn must be 0,
 /// else std::invalid_argument), found by a hash grid instead of a k-d tree: the same normals
 /// up to the order of summation; Gaussian weights are supported. up must be unit length.

@@ -55,4 +55,8 @@ struct FastUpdStats {
 UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdParams& params,
                          FastUpdStats* stats = nullptr);
 
+/// The same into out, whose buffers are reused (a frame loop allocates nothing once warm).
+void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdParams& params,
+                    UpdResult& out, FastUpdStats* stats = nullptr);
+
 }  // namespace upd

@@ -61,4 +61,8 @@ struct PipelineResult {
 /// that pre-processing empties) gives an empty result, not an error.
 PipelineResult runPipeline(const PointCloud& input, const PipelineParams& params);
 
+/// The same into res, whose buffers are reused: a frame loop that keeps one PipelineResult
+/// allocates nothing once warm (with the fast path and no pre-processing filter).
+void runPipeline(const PointCloud& input, const PipelineParams& params, PipelineResult& res);
+
 }  // namespace upd

@@ -28,6 +28,7 @@ struct PreprocessParams {
   void validate() const;
   /// Turns every step off (`upd analyze --no-preprocess`).
   void disableAll() { range_enabled = box_enabled = voxel_enabled = outlier_enabled = false; }
+  bool anyEnabled() const { return range_enabled || box_enabled || voxel_enabled || outlier_enabled; }
   template <class V>
   void visit(V& v) {
     v("range_enabled", range_enabled, "apply the range cut-off");
@@ -64,5 +65,9 @@ PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul
 /// kept), so invalid points are scored as NaN and counted instead of silently dropped.
 PointCloud preprocess(const PointCloud& in, const PreprocessParams& p,
                       PreprocessStats* stats = nullptr);
+
+/// The same into out, whose buffers are reused when no step is enabled (the input is copied).
+void preprocess(const PointCloud& in, const PreprocessParams& p, PointCloud& out,
+                PreprocessStats* stats = nullptr);
 
 }  // namespace upd
