@@ -228,6 +228,40 @@ Moments gatedMoments(const float* X, const float* Y, const float* Z, std::size_t
   return m;
 }
 
+struct OrientConstants {
+  float ox, oy, oz;  // sensor origin
+  float ux, uy, uz;  // unit up
+  float sin_band;
+};
+
+// One row of pass 2, as a vector loop: pixel u takes the normal of its block's centre
+// (blocks + column_block[u]: normal, curvature, centre range) when its range is within
+// jump * range of the centre's, oriented as NormalOrienter does, and taken[u] says so (a NaN
+// range or centre fails the test). The others get NaN here.
+UPD_VECTOR_CLONES
+void shareBlockNormals(const float* __restrict range, const float* __restrict x,
+                       const float* __restrict y, const float* __restrict z,
+                       const float* __restrict blocks, const std::int32_t* __restrict column_block,
+                       std::size_t W, float jump, const OrientConstants& c, float* __restrict nx,
+                       float* __restrict ny, float* __restrict nz, float* __restrict curvature,
+                       std::uint8_t* __restrict taken) {
+  for (std::size_t u = 0; u < W; ++u) {
+    const float* b = blocks + column_block[u];
+    const float rho = range[u];
+    const bool good = std::fabs(b[4] - rho) <= jump * rho;
+    const float bx = b[0], by = b[1], bz = b[2];
+    const float along_up = bx * c.ux + by * c.uy + bz * c.uz;
+    const float towards = bx * (c.ox - x[u]) + by * (c.oy - y[u]) + bz * (c.oz - z[u]);
+    const bool keep = std::fabs(along_up) > c.sin_band ? along_up > 0.f : towards >= 0.f;
+    const float sign = keep ? 1.f : -1.f;
+    nx[u] = good ? sign * bx : kNaN;
+    ny[u] = good ? sign * by : kNaN;
+    nz[u] = good ? sign * bz : kNaN;
+    curvature[u] = good ? b[3] : kNaN;
+    taken[u] = good ? 1 : 0;
+  }
+}
+
 }  // namespace
 
 bool organizedNormalsApply(const PointCloud& cloud, const NormalParams& params) {
@@ -352,58 +386,75 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
       o[0] = n.x(), o[1] = n.y(), o[2] = n.z(), o[3] = curvature, o[4] = range[ci];
     }
   }
+  // Pass 2. The common case, a pixel on its own block centre's surface, runs as a vector loop
+  // per row (shareBlockNormals); the others (no valid range, a depth edge, a failed centre)
+  // then go through the general rule below.
+  std::vector<std::int32_t> column_block(W);
+  for (std::size_t u = 0; u < W; ++u) column_block[u] = static_cast<std::int32_t>(5 * (u / D));
+  const OrientConstants oc{origin.x(), origin.y(), origin.z(),     up.x(),
+                           up.y(),     up.z(),     orient.sin_band};
   std::size_t invalid = 0;
-#pragma omp parallel for schedule(dynamic, 2) reduction(+ : invalid)
-  for (std::ptrdiff_t v = 0; v < Hi; ++v) {
-    const std::ptrdiff_t bv = v / D;
-    for (std::ptrdiff_t u = 0; u < Wi; ++u) {
-      const std::size_t i = static_cast<std::size_t>(v) * W + static_cast<std::size_t>(u);
-      const float rho = range[i];
-      if (!(rho == rho)) {
-        setUnset(out, i);
-        ++invalid;
-        continue;
-      }
-      const std::ptrdiff_t bu = u / D;
-      const float tolerance = jump * rho;
-      const float* pick = bn + 5 * (bv * BW + bu);
-      const bool is_centre = u == centreU(bu) && v == centreV(bv);
-      if (is_centre && !(pick[4] == pick[4])) {  // its own scan found no plane
-        setUnset(out, i);
-        ++invalid;
-        continue;
-      }
-      if (!(std::abs(pick[4] - rho) <= tolerance)) {  // NaN (no normal there) fails too
-        pick = nullptr;
-        float best = tolerance;
-        for (std::ptrdiff_t dv = std::max<std::ptrdiff_t>(0, bv - 1);
-             dv <= std::min(BH - 1, bv + 1); ++dv) {
-          for (std::ptrdiff_t du = std::max<std::ptrdiff_t>(0, bu - 1);
-               du <= std::min(BW - 1, bu + 1); ++du) {
-            const float* c = bn + 5 * (dv * BW + du);
-            const float d = std::abs(c[4] - rho);
-            if (d <= best) best = d, pick = c;
-          }
-        }
-      }
-      Eigen::Vector3f n;
-      float curvature;
-      if (pick != nullptr) {
-        n = Eigen::Vector3f(pick[0], pick[1], pick[2]);
-        curvature = pick[3];
-      } else {
-        const Moments m = scanMoments(u, v, i);
-        if (!(m.n >= 3 && normalFromMoments(m, n, curvature))) {
+#pragma omp parallel reduction(+ : invalid)
+  {
+    std::vector<std::uint8_t> taken(W);
+#pragma omp for schedule(dynamic, 2)
+    for (std::ptrdiff_t v = 0; v < Hi; ++v) {
+      const std::ptrdiff_t bv = v / D;
+      const std::size_t row = static_cast<std::size_t>(v) * W;
+      shareBlockNormals(range + row, cloud.x.data() + row, cloud.y.data() + row,
+                        cloud.z.data() + row, bn + 5 * bv * BW, column_block.data(), W, jump, oc,
+                        out.nx.data() + row, out.ny.data() + row, out.nz.data() + row,
+                        out.curvature.data() + row, taken.data());
+      for (std::ptrdiff_t u = 0; u < Wi; ++u) {
+        if (taken[static_cast<std::size_t>(u)]) continue;
+        const std::size_t i = row + static_cast<std::size_t>(u);
+        const float rho = range[i];
+        if (!(rho == rho)) {
           setUnset(out, i);
           ++invalid;
           continue;
         }
+        const std::ptrdiff_t bu = u / D;
+        const float tolerance = jump * rho;
+        const float* pick = bn + 5 * (bv * BW + bu);
+        const bool is_centre = u == centreU(bu) && v == centreV(bv);
+        if (is_centre && !(pick[4] == pick[4])) {  // its own scan found no plane
+          setUnset(out, i);
+          ++invalid;
+          continue;
+        }
+        if (!(std::abs(pick[4] - rho) <= tolerance)) {  // NaN (no normal there) fails too
+          pick = nullptr;
+          float best = tolerance;
+          for (std::ptrdiff_t dv = std::max<std::ptrdiff_t>(0, bv - 1);
+               dv <= std::min(BH - 1, bv + 1); ++dv) {
+            for (std::ptrdiff_t du = std::max<std::ptrdiff_t>(0, bu - 1);
+                 du <= std::min(BW - 1, bu + 1); ++du) {
+              const float* c = bn + 5 * (dv * BW + du);
+              const float d = std::abs(c[4] - rho);
+              if (d <= best) best = d, pick = c;
+            }
+          }
+        }
+        Eigen::Vector3f n;
+        float curvature;
+        if (pick != nullptr) {
+          n = Eigen::Vector3f(pick[0], pick[1], pick[2]);
+          curvature = pick[3];
+        } else {
+          const Moments m = scanMoments(u, v, i);
+          if (!(m.n >= 3 && normalFromMoments(m, n, curvature))) {
+            setUnset(out, i);
+            ++invalid;
+            continue;
+          }
+        }
+        n = orient(n, cloud.point(i));
+        out.nx[i] = n.x();
+        out.ny[i] = n.y();
+        out.nz[i] = n.z();
+        out.curvature[i] = curvature;
       }
-      n = orient(n, cloud.point(i));
-      out.nx[i] = n.x();
-      out.ny[i] = n.y();
-      out.nz[i] = n.z();
-      out.curvature[i] = curvature;
     }
   }
   out.invalid = invalid;
