@@ -37,6 +37,13 @@ struct CellSums {
 
 // Four floats as one GCC vector (SSE everywhere): r_x, r_y, r_z, k.
 typedef float Quad __attribute__((vector_size(4 * sizeof(float))));
+// Sixteen and eight floats likewise (AVX-512, or split into narrower vectors).
+typedef float Vec16 __attribute__((vector_size(16 * sizeof(float))));
+typedef float Vec8 __attribute__((vector_size(8 * sizeof(float))));
+
+// Vec16 from a plain array (no 64-byte alignment asked). Through a reference: a function
+// returning a 64-byte vector has a different ABI with and without AVX-512.
+inline void loadVec16(Vec16& v, const float* p) { std::memcpy(&v, p, sizeof v); }
 
 // Ball sums at a node: (r_x, r_y, r_z, k), then their derivatives with respect to the node's
 // x, y and z (cell units), four values each: the layout the interpolation reads.
@@ -216,55 +223,87 @@ struct Bins {
   }
 };
 
+// A stripe of points in lattice terms, the first pass of binRange: each point's cell (cx, cy,
+// cz: integers as floats, exact below 2^24; cx = kOutside for a point that is not finite or
+// lies beyond the key range) and its contribution to the CellSums of its cell, in their order
+// (count, normal, position inside the cell, its products), zeros where the normal is invalid.
+constexpr float kOutside = -2.f * kMaxCoord;
+constexpr std::size_t kStripe = 256;
+struct Stripe {
+  float cx[kStripe], cy[kStripe], cz[kStripe];
+  float term[13][kStripe];  // the 13 of CellSums
+};
+
+UPD_VECTOR_CLONES
+void toLattice(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+               const float* __restrict nx, const float* __restrict ny, const float* __restrict nz,
+               const Lattice& lat, std::size_t n, Stripe& __restrict s) {
+  for (std::size_t j = 0; j < n; ++j) {
+    const float gx = lat.gx(x[j]), gy = lat.gy(y[j]), gz = lat.gz(z[j]);
+    // NaN and infinity fail this test too. (& rather than &&, floors as floats, everything
+    // loaded and computed before it is selected: no branch, so the loop vectorizes.)
+    const bool inside =
+        (std::fabs(gx) < kMaxCoord) & (std::fabs(gy) < kMaxCoord) & (std::fabs(gz) < kMaxCoord);
+    const float fx = std::floor(gx), fy = std::floor(gy), fz = std::floor(gz);
+    const float ax = nx[j], ay = ny[j], az = nz[j];
+    const bool valid = ax == ax;
+    const float px = valid ? gx - fx : 0.f, py = valid ? gy - fy : 0.f, pz = valid ? gz - fz : 0.f;
+    s.cx[j] = inside ? fx : kOutside;
+    s.cy[j] = fy, s.cz[j] = fz;
+    auto& t = s.term;
+    t[0][j] = valid ? 1.f : 0.f;
+    t[1][j] = valid ? ax : 0.f, t[2][j] = valid ? ay : 0.f, t[3][j] = valid ? az : 0.f;
+    t[4][j] = px, t[5][j] = py, t[6][j] = pz;
+    t[7][j] = px * px, t[8][j] = px * py, t[9][j] = px * pz, t[10][j] = py * py;
+    t[11][j] = py * pz, t[12][j] = pz * pz;
+  }
+}
+
 // Bins points [begin, end) into b, writing each point's cell (local to b) into cell_of.
 // Consecutive points (image rows, scan lines) mostly share a cell: the sums of such a run are
-// kept in registers and the hash map is consulted once per change of cell.
-// Returns false when a point lies beyond the lattice's key range (it is left out).
+// kept in one vector register (a point adds its 13 terms at once) and the hash map is
+// consulted once per change of cell. Returns false when a point lies beyond the lattice's key
+// range (it is left out).
 UPD_VECTOR_CLONES
 bool binRange(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
               std::size_t begin, std::size_t end, Bins& b, std::uint32_t* cell_of) {
-  std::int32_t lx = std::numeric_limits<std::int32_t>::min(), ly = 0, lz = 0;
+  float lx = kOutside, ly = 0, lz = 0;  // the cell of the run
   std::uint32_t last = kNoIndex;
   bool fits = true;
-  CellSums run;  // sums of the current run, added to b.sums[last] when the cell changes
+  float r0 = 0, r1 = 0, r2 = 0, r3 = 0, r4 = 0, r5 = 0, r6 = 0, r7 = 0, r8 = 0, r9 = 0, r10 = 0,
+        r11 = 0, r12 = 0;
   const auto flush = [&] {
-    if (last != kNoIndex && run.count > 0.f) b.sums[last].add(run);
-    run = CellSums{};
+    if (last != kNoIndex && r0 > 0.f) {
+      b.sums[last].add({r0, r1, r2, r3, r4, r5, r6, r7, r8, r9, r10, r11, r12});
+    }
+    r0 = r1 = r2 = r3 = r4 = r5 = r6 = r7 = r8 = r9 = r10 = r11 = r12 = 0.f;
   };
-  for (std::size_t i = begin; i < end; ++i) {
-    const float gx = lat.gx(cloud.x[i]), gy = lat.gy(cloud.y[i]), gz = lat.gz(cloud.z[i]);
-    // NaN and infinity fail this test too.
-    if (!(std::abs(gx) < kMaxCoord && std::abs(gy) < kMaxCoord && std::abs(gz) < kMaxCoord)) {
-      if (std::isfinite(cloud.x[i]) && std::isfinite(cloud.y[i]) && std::isfinite(cloud.z[i])) {
-        fits = false;
+  static thread_local Stripe s;
+  for (std::size_t s0 = begin; s0 < end; s0 += kStripe) {
+    const std::size_t n = std::min(kStripe, end - s0);
+    toLattice(&cloud.x[s0], &cloud.y[s0], &cloud.z[s0], &normals.nx[s0], &normals.ny[s0],
+              &normals.nz[s0], lat, n, s);
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::size_t i = s0 + j;
+      if (s.cx[j] == kOutside) {
+        if (std::isfinite(cloud.x[i]) && std::isfinite(cloud.y[i]) && std::isfinite(cloud.z[i])) {
+          fits = false;
+        }
+        cell_of[i] = kNoIndex;
+        continue;
       }
-      cell_of[i] = kNoIndex;
-      continue;
+      if (s.cx[j] != lx || s.cy[j] != ly || s.cz[j] != lz) {
+        flush();
+        lx = s.cx[j], ly = s.cy[j], lz = s.cz[j];
+        last = b.cellOf(static_cast<std::int32_t>(lx), static_cast<std::int32_t>(ly),
+                        static_cast<std::int32_t>(lz));
+      }
+      cell_of[i] = last;
+      const auto& t = s.term;
+      r0 += t[0][j], r1 += t[1][j], r2 += t[2][j], r3 += t[3][j], r4 += t[4][j];
+      r5 += t[5][j], r6 += t[6][j], r7 += t[7][j], r8 += t[8][j], r9 += t[9][j];
+      r10 += t[10][j], r11 += t[11][j], r12 += t[12][j];
     }
-    const std::int32_t ix = detail::floorToInt32(gx), iy = detail::floorToInt32(gy),
-                       iz = detail::floorToInt32(gz);
-    if (ix != lx || iy != ly || iz != lz) {
-      flush();
-      last = b.cellOf(ix, iy, iz);
-      lx = ix, ly = iy, lz = iz;
-    }
-    cell_of[i] = last;
-    if (!normals.isValid(i)) continue;
-    const float px = gx - static_cast<float>(ix), py = gy - static_cast<float>(iy),
-                pz = gz - static_cast<float>(iz);
-    run.count += 1.f;
-    run.nx += normals.nx[i];
-    run.ny += normals.ny[i];
-    run.nz += normals.nz[i];
-    run.px += px;
-    run.py += py;
-    run.pz += pz;
-    run.pxx += px * px;
-    run.pxy += px * py;
-    run.pxz += px * pz;
-    run.pyy += py * py;
-    run.pyz += py * pz;
-    run.pzz += pz * pz;
   }
   flush();
   return fits;
@@ -286,8 +325,6 @@ inline void setUnscored(UpdResult& out, std::size_t i) {
 // c4 fx fy + c5 fx fz + c6 fy fz + c7 fx fy fz. The 8 coefficients of the 4 forms of the 4
 // values (r_x, r_y, r_z, k) are kept per cell as 8 vectors of 16 floats, so a point costs 8
 // vector multiply-adds instead of reading 8 nodes.
-typedef float Vec16 __attribute__((vector_size(16 * sizeof(float))));
-typedef float Vec8 __attribute__((vector_size(8 * sizeof(float))));
 struct CellBlend {
   float c[8][16];  // c[monomial][form * 4 + value], forms A, Bx, By, Bz (read as Vec16)
 };
@@ -319,10 +356,6 @@ CellBlend cellBlend(const NodeSums* node_sums, const std::uint32_t* corner) {
   }
   return b;
 }
-
-// Vec16 from a plain array (no 64-byte alignment asked). Through a reference: a function
-// returning a 64-byte vector has a different ABI with and without AVX-512.
-inline void loadVec16(Vec16& v, const float* p) { std::memcpy(&v, p, sizeof v); }
 
 // r, k and zeta of points [begin, end) from the blends of their cells; points without a cell
 // or with k rounded below min_k get NaN. Points of cells marked in skip are left alone.
