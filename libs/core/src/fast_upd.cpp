@@ -81,24 +81,49 @@ struct Candidates {
     kNz,
     kFields
   };
-  std::array<std::vector<float>, kFields> f;  // lower corner, centroid, covariance, sums
+  // Field k of row j at buf[k * cap + j]: lower corner, centroid, covariance, sums.
+  std::vector<float> buf;
+  std::size_t cap = 0, n = 0;
 
-  const float* operator[](Field k) const { return f[k].data(); }
-  std::size_t size() const { return f[kLx].size(); }
-  // Rows for cells[0, n) (lower corners lx, ly, lz relative to the block origin), padded.
-  void fill(std::size_t n, const std::uint32_t* cells, const std::int32_t* cell_xyz,
-            const CellRow* rows, const std::int32_t origin[3]) {
-    const std::size_t padded = (n + kLanes - 1) / kLanes * kLanes;
-    for (auto& v : f) v.assign(padded, 0.f);
-    for (std::size_t j = 0; j < n; ++j) {
-      const std::uint32_t c = cells[j];
-      for (int a = 0; a < 3; ++a) {
-        const auto l = static_cast<float>(cell_xyz[3 * c + a] - origin[a]);
-        f[kLx + a][j] = l;
-        f[kMx + a][j] = l + rows[c].f[CellRow::kMx + a];
-      }
-      for (int k = CellRow::kCxx; k < CellRow::kFields; ++k) f[kCxx + k - CellRow::kCxx][j] = rows[c].f[k];
+  const float* operator[](Field k) const { return buf.data() + k * cap; }
+  std::size_t size() const { return n; }
+  // Empties the rows, with room for max_rows and the padding.
+  void reset(std::size_t max_rows) {
+    cap = (max_rows + 2 * kLanes - 1) / kLanes * kLanes;
+    if (buf.size() < kFields * cap) buf.resize(kFields * cap);
+    n = 0;
+  }
+  void append(const float (&row)[kFields]) {
+    for (int k = 0; k < kFields; ++k) buf[k * cap + n] = row[k];
+    ++n;
+  }
+  // Empty cells (count 0) up to a multiple of kLanes.
+  void pad() {
+    const float zero[kFields] = {};
+    while (n % kLanes != 0) append(zero);
+  }
+  // The row of cell c, lower corner relative to origin.
+  static void rowOf(std::uint32_t c, const std::int32_t* cell_xyz, const CellRow* rows,
+                    const std::int32_t origin[3], float (&row)[kFields]) {
+    for (int a = 0; a < 3; ++a) {
+      const auto l = static_cast<float>(cell_xyz[3 * c + a] - origin[a]);
+      row[kLx + a] = l;
+      row[kMx + a] = l + rows[c].f[CellRow::kMx + a];
     }
+    for (int k = CellRow::kCxx; k < CellRow::kFields; ++k) {
+      row[kCxx + k - CellRow::kCxx] = rows[c].f[k];
+    }
+  }
+  // Rows for cells[0, m), padded.
+  void fill(std::size_t m, const std::uint32_t* cells, const std::int32_t* cell_xyz,
+            const CellRow* rows, const std::int32_t origin[3]) {
+    reset(m);
+    float row[kFields];
+    for (std::size_t j = 0; j < m; ++j) {
+      rowOf(cells[j], cell_xyz, rows, origin, row);
+      append(row);
+    }
+    pad();
   }
 };
 
@@ -613,9 +638,8 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   const std::int32_t half = (B + 1) / 2;
 #pragma omp parallel
   {
-    Candidates cand;
-    std::vector<std::uint32_t> cells, picked;
-    std::vector<std::uint8_t> near;  // per candidate cell: the octants it may touch
+    std::array<Candidates, 8> cand;  // per octant
+    std::vector<std::uint32_t> cells;
     std::array<std::vector<std::uint32_t>, 8> octant;
 #pragma omp for schedule(dynamic, 2)
     for (std::ptrdiff_t bb = 0; bb < static_cast<std::ptrdiff_t>(n_blocks); ++bb) {
@@ -631,33 +655,29 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
         octant[o].push_back(v);
       }
       around(b, cells);
-      near.resize(cells.size());
-      for (std::size_t j = 0; j < cells.size(); ++j) {
+      for (int o = 0; o < 8; ++o) cand[o].reset(cells.size());
+      float row[Candidates::kFields];
+      for (const std::uint32_t c : cells) {
         // Squared gap along each axis between the cell [l, l + 1] and the lower [0, half - 1]
         // or upper [half, B - 1] node range.
         std::int32_t gap2[3][2];
         for (int a = 0; a < 3; ++a) {
-          const std::int32_t l = cell_xyz[3 * cells[j] + a] - origin[a];
+          const std::int32_t l = cell_xyz[3 * c + a] - origin[a];
           const std::int32_t lower = std::max({0, l - (half - 1), -(l + 1)});
           const std::int32_t upper = std::max({0, l - (B - 1), half - (l + 1)});
           gap2[a][0] = lower * lower, gap2[a][1] = upper * upper;
         }
-        std::uint8_t mask = 0;
+        Candidates::rowOf(c, cell_xyz.data(), rows.data(), origin, row);
         for (int o = 0; o < 8; ++o) {
           const std::int32_t d2 = gap2[0][o & 1] + gap2[1][(o >> 1) & 1] + gap2[2][o >> 2];
-          mask |= static_cast<std::uint8_t>((d2 <= m * m ? 1 : 0) << o);
+          if (d2 <= m * m && !octant[o].empty()) cand[o].append(row);
         }
-        near[j] = mask;
       }
       for (int o = 0; o < 8; ++o) {
         if (octant[o].empty()) continue;
-        picked.clear();
-        for (std::size_t j = 0; j < cells.size(); ++j) {
-          if ((near[j] >> o) & 1) picked.push_back(cells[j]);
-        }
-        cand.fill(picked.size(), picked.data(), cell_xyz.data(), rows.data(), origin);
+        cand[o].pad();
         for (const std::uint32_t v : octant[o]) {
-          sumAtNode(cand, static_cast<float>(node_xyz[3 * v] - origin[0]),
+          sumAtNode(cand[o], static_cast<float>(node_xyz[3 * v] - origin[0]),
                     static_cast<float>(node_xyz[3 * v + 1] - origin[1]),
                     static_cast<float>(node_xyz[3 * v + 2] - origin[2]), mf, node_sums[v]);
         }
