@@ -18,6 +18,8 @@ namespace upd {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+// Coordinate of the invalid pixels in the scanned images: farther than any radius [m].
+constexpr float kFar = 1e18f;
 
 // Moments of a set of points relative to a reference: count, sum q, sum q q^T (upper).
 struct Moments {
@@ -120,6 +122,26 @@ inline void setUnset(Normals& out, std::size_t i) {
   out.nx[i] = out.ny[i] = out.nz[i] = out.curvature[i] = kNaN;
 }
 
+// Pixels [begin, end): their range from the sensor origin, and their coordinates relative to
+// ref as scan images (NaN range and kFar coordinates where the point is not finite).
+UPD_VECTOR_CLONES
+void scanImages(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                const Eigen::Vector3f& origin, const Eigen::Vector3f& ref, std::size_t begin,
+                std::size_t end, float* __restrict range, float* __restrict X, float* __restrict Y,
+                float* __restrict Z) {
+  const float ox = origin.x(), oy = origin.y(), oz = origin.z();
+  const float rx = ref.x(), ry = ref.y(), rz = ref.z();
+  for (std::size_t i = begin; i < end; ++i) {
+    const float dx = x[i] - ox, dy = y[i] - oy, dz = z[i] - oz;
+    const float rho = std::sqrt(dx * dx + dy * dy + dz * dz);  // NaN for a non-finite point
+    const bool valid = (rho > 0.f) & (rho <= std::numeric_limits<float>::max());
+    range[i] = valid ? rho : kNaN;
+    X[i] = valid ? x[i] - rx : kFar;
+    Y[i] = valid ? y[i] - ry : kFar;
+    Z[i] = valid ? z[i] - rz : kFar;
+  }
+}
+
 // The angular pitch of the sensor per column (along_u: the angle between the rays of columns
 // u and u + 1) or per row [rad]: the smallest over every 16th line, so that windows sized from
 // it hold the whole ball even where the pitch shrinks (off-axis, by cos^2 of the angle for a
@@ -151,8 +173,6 @@ std::vector<float> pitchProfile(const PointCloud& cloud, const float* range, boo
   return lowest;
 }
 
-// Coordinate of the invalid pixels in the scanned images: farther than any radius [m].
-constexpr float kFar = 1e18f;
 // Largest half-width of a scanned window [pixels]; wider windows than kScanSide + 1 pixels are
 // sampled every 2nd or 4th row and column (at most 16 x 16 points at full rate).
 constexpr std::ptrdiff_t kMaxHalf = 96;
@@ -235,21 +255,25 @@ struct OrientConstants {
 };
 
 // One row of pass 2, as a vector loop: pixel u takes the normal of its block's centre
-// (blocks + column_block[u]: normal, curvature, centre range) when its range is within
-// jump * range of the centre's, oriented as NormalOrienter does, and taken[u] says so (a NaN
-// range or centre fails the test). The others get NaN here.
+// (block[k * W + u], k = 0..4: normal x, y, z, curvature, centre range) when its range
+// is within jump * range of the centre's, oriented as NormalOrienter does, and taken[u] says so
+// (a NaN range or centre fails the test). The others get NaN here.
 UPD_VECTOR_CLONES
 void shareBlockNormals(const float* __restrict range, const float* __restrict x,
                        const float* __restrict y, const float* __restrict z,
-                       const float* __restrict blocks, const std::int32_t* __restrict column_block,
-                       std::size_t W, float jump, const OrientConstants& c, float* __restrict nx,
-                       float* __restrict ny, float* __restrict nz, float* __restrict curvature,
+                       const float* __restrict block, std::size_t W, float jump,
+                       const OrientConstants& c, float* __restrict nx, float* __restrict ny,
+                       float* __restrict nz, float* __restrict curvature,
                        std::uint8_t* __restrict taken) {
+  const float* __restrict bnx = block;
+  const float* __restrict bny = block + W;
+  const float* __restrict bnz = block + 2 * W;
+  const float* __restrict bcurv = block + 3 * W;
+  const float* __restrict brange = block + 4 * W;
   for (std::size_t u = 0; u < W; ++u) {
-    const float* b = blocks + column_block[u];
     const float rho = range[u];
-    const bool good = std::fabs(b[4] - rho) <= jump * rho;
-    const float bx = b[0], by = b[1], bz = b[2];
+    const bool good = std::fabs(brange[u] - rho) <= jump * rho;
+    const float bx = bnx[u], by = bny[u], bz = bnz[u];
     const float along_up = bx * c.ux + by * c.uy + bz * c.uz;
     const float towards = bx * (c.ox - x[u]) + by * (c.oy - y[u]) + bz * (c.oz - z[u]);
     const bool keep = std::fabs(along_up) > c.sin_band ? along_up > 0.f : towards >= 0.f;
@@ -257,7 +281,7 @@ void shareBlockNormals(const float* __restrict range, const float* __restrict x,
     nx[u] = good ? sign * bx : kNaN;
     ny[u] = good ? sign * by : kNaN;
     nz[u] = good ? sign * bz : kNaN;
-    curvature[u] = good ? b[3] : kNaN;
+    curvature[u] = good ? bcurv[u] : kNaN;
     taken[u] = good ? 1 : 0;
   }
 }
@@ -313,19 +337,12 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   float* const Z = Y + image_len;
   float* const range = range_buffer.data();
   for (float* pad : {X + N, Y + N, Z + N}) std::fill(pad, pad + (image_len - N), kFar);
+  constexpr std::size_t kRows = 8192;  // pixels per task
 #pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(N); ++ii) {
-    const auto i = static_cast<std::size_t>(ii);
-    const float dx = cloud.x[i] - origin.x(), dy = cloud.y[i] - origin.y(),
-                dz = cloud.z[i] - origin.z();
-    const float rho = std::sqrt(dx * dx + dy * dy + dz * dz);  // NaN for a non-finite point
-    if (rho > 0.f && rho <= std::numeric_limits<float>::max()) {
-      range[i] = rho;
-      X[i] = cloud.x[i] - ref.x(), Y[i] = cloud.y[i] - ref.y(), Z[i] = cloud.z[i] - ref.z();
-    } else {
-      range[i] = kNaN;
-      X[i] = Y[i] = Z[i] = kFar;
-    }
+  for (std::ptrdiff_t t = 0; t < static_cast<std::ptrdiff_t>((N + kRows - 1) / kRows); ++t) {
+    const std::size_t begin = static_cast<std::size_t>(t) * kRows;
+    scanImages(cloud.x.data(), cloud.y.data(), cloud.z.data(), origin, ref, begin,
+               std::min(N, begin + kRows), range, X, Y, Z);
   }
   const std::vector<float> pitch_u = pitchProfile(cloud, range, true);
   const std::vector<float> pitch_v = pitchProfile(cloud, range, false);
@@ -387,73 +404,77 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
     }
   }
   // Pass 2. The common case, a pixel on its own block centre's surface, runs as a vector loop
-  // per row (shareBlockNormals); the others (no valid range, a depth edge, a failed centre)
-  // then go through the general rule below.
-  std::vector<std::int32_t> column_block(W);
-  for (std::size_t u = 0; u < W; ++u) column_block[u] = static_cast<std::int32_t>(5 * (u / D));
+  // per row (shareBlockNormals, reading its block row spread out to one value per column); the
+  // others (no valid range, a depth edge, a failed centre) then go through the general rule.
   const OrientConstants oc{origin.x(), origin.y(), origin.z(),     up.x(),
                            up.y(),     up.z(),     orient.sin_band};
   std::size_t invalid = 0;
 #pragma omp parallel reduction(+ : invalid)
   {
     std::vector<std::uint8_t> taken(W);
-#pragma omp for schedule(dynamic, 2)
-    for (std::ptrdiff_t v = 0; v < Hi; ++v) {
-      const std::ptrdiff_t bv = v / D;
-      const std::size_t row = static_cast<std::size_t>(v) * W;
-      shareBlockNormals(range + row, cloud.x.data() + row, cloud.y.data() + row,
-                        cloud.z.data() + row, bn + 5 * bv * BW, column_block.data(), W, jump, oc,
-                        out.nx.data() + row, out.ny.data() + row, out.nz.data() + row,
-                        out.curvature.data() + row, taken.data());
-      for (std::ptrdiff_t u = 0; u < Wi; ++u) {
-        if (taken[static_cast<std::size_t>(u)]) continue;
-        const std::size_t i = row + static_cast<std::size_t>(u);
-        const float rho = range[i];
-        if (!(rho == rho)) {
-          setUnset(out, i);
-          ++invalid;
-          continue;
-        }
-        const std::ptrdiff_t bu = u / D;
-        const float tolerance = jump * rho;
-        const float* pick = bn + 5 * (bv * BW + bu);
-        const bool is_centre = u == centreU(bu) && v == centreV(bv);
-        if (is_centre && !(pick[4] == pick[4])) {  // its own scan found no plane
-          setUnset(out, i);
-          ++invalid;
-          continue;
-        }
-        if (!(std::abs(pick[4] - rho) <= tolerance)) {  // NaN (no normal there) fails too
-          pick = nullptr;
-          float best = tolerance;
-          for (std::ptrdiff_t dv = std::max<std::ptrdiff_t>(0, bv - 1);
-               dv <= std::min(BH - 1, bv + 1); ++dv) {
-            for (std::ptrdiff_t du = std::max<std::ptrdiff_t>(0, bu - 1);
-                 du <= std::min(BW - 1, bu + 1); ++du) {
-              const float* c = bn + 5 * (dv * BW + du);
-              const float d = std::abs(c[4] - rho);
-              if (d <= best) best = d, pick = c;
-            }
-          }
-        }
-        Eigen::Vector3f n;
-        float curvature;
-        if (pick != nullptr) {
-          n = Eigen::Vector3f(pick[0], pick[1], pick[2]);
-          curvature = pick[3];
-        } else {
-          const Moments m = scanMoments(u, v, i);
-          if (!(m.n >= 3 && normalFromMoments(m, n, curvature))) {
+    std::vector<float> spread(5 * W);
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t bv = 0; bv < BH; ++bv) {
+      for (std::size_t u = 0; u < W; ++u) {
+        const float* b = bn + 5 * (bv * BW + static_cast<std::ptrdiff_t>(u) / D);
+        for (std::size_t k = 0; k < 5; ++k) spread[k * W + u] = b[k];
+      }
+      for (std::ptrdiff_t v = bv * D; v < std::min(Hi, bv * D + D); ++v) {
+        const std::size_t row = static_cast<std::size_t>(v) * W;
+        shareBlockNormals(range + row, cloud.x.data() + row, cloud.y.data() + row,
+                          cloud.z.data() + row, spread.data(), W, jump, oc, out.nx.data() + row,
+                          out.ny.data() + row, out.nz.data() + row, out.curvature.data() + row,
+                          taken.data());
+        for (std::ptrdiff_t u = 0; u < Wi; ++u) {
+          if (taken[static_cast<std::size_t>(u)]) continue;
+          const std::size_t i = row + static_cast<std::size_t>(u);
+          const float rho = range[i];
+          if (!(rho == rho)) {
             setUnset(out, i);
             ++invalid;
             continue;
           }
+          const std::ptrdiff_t bu = u / D;
+          const float tolerance = jump * rho;
+          const float* pick = bn + 5 * (bv * BW + bu);
+          const bool is_centre = u == centreU(bu) && v == centreV(bv);
+          if (is_centre && !(pick[4] == pick[4])) {  // its own scan found no plane
+            setUnset(out, i);
+            ++invalid;
+            continue;
+          }
+          if (!(std::abs(pick[4] - rho) <= tolerance)) {  // NaN (no normal there) fails too
+            pick = nullptr;
+            float best = tolerance;
+            for (std::ptrdiff_t dv = std::max<std::ptrdiff_t>(0, bv - 1);
+                 dv <= std::min(BH - 1, bv + 1); ++dv) {
+              for (std::ptrdiff_t du = std::max<std::ptrdiff_t>(0, bu - 1);
+                   du <= std::min(BW - 1, bu + 1); ++du) {
+                const float* c = bn + 5 * (dv * BW + du);
+                const float d = std::abs(c[4] - rho);
+                if (d <= best) best = d, pick = c;
+              }
+            }
+          }
+          Eigen::Vector3f n;
+          float curvature;
+          if (pick != nullptr) {
+            n = Eigen::Vector3f(pick[0], pick[1], pick[2]);
+            curvature = pick[3];
+          } else {
+            const Moments m = scanMoments(u, v, i);
+            if (!(m.n >= 3 && normalFromMoments(m, n, curvature))) {
+              setUnset(out, i);
+              ++invalid;
+              continue;
+            }
+          }
+          n = orient(n, cloud.point(i));
+          out.nx[i] = n.x();
+          out.ny[i] = n.y();
+          out.nz[i] = n.z();
+          out.curvature[i] = curvature;
         }
-        n = orient(n, cloud.point(i));
-        out.nx[i] = n.x();
-        out.ny[i] = n.y();
-        out.nz[i] = n.z();
-        out.curvature[i] = curvature;
       }
     }
   }
