@@ -142,6 +142,23 @@ void scanImages(const float* __restrict x, const float* __restrict y, const floa
   }
 }
 
+// The chord between the unit rays of pixels i and i + step, i = first + t * step, for t in
+// [0, n): the angle between them to 1e-6 at these sizes; NaN where either has no range.
+UPD_VECTOR_CLONES
+void lineChords(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                const float* __restrict range, std::size_t first, std::size_t step, std::size_t n,
+                const Eigen::Vector3f& origin, float* __restrict chord) {
+  const float ox = origin.x(), oy = origin.y(), oz = origin.z();
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::size_t i = first + t * step, j = i + step;
+    const float inv_i = 1.f / range[i], inv_j = 1.f / range[j];
+    const float dx = (x[i] - ox) * inv_i - (x[j] - ox) * inv_j;
+    const float dy = (y[i] - oy) * inv_i - (y[j] - oy) * inv_j;
+    const float dz = (z[i] - oz) * inv_i - (z[j] - oz) * inv_j;
+    chord[t] = std::sqrt(dx * dx + dy * dy + dz * dz);
+  }
+}
+
 // The angular pitch of the sensor per column (along_u: the angle between the rays of columns
 // u and u + 1) or per row [rad]: the smallest over every 16th line, so that windows sized from
 // it hold the whole ball even where the pitch shrinks (off-axis, by cos^2 of the angle for a
@@ -149,17 +166,23 @@ void scanImages(const float* __restrict x, const float* __restrict y, const floa
 // (duplicated pixels) is raised to it. Empty when too few pairs are valid.
 std::vector<float> pitchProfile(const PointCloud& cloud, const float* range, bool along_u) {
   const std::size_t W = cloud.width, H = cloud.height;
-  const Eigen::Vector3f o = cloud.sensor_origin;
   const std::size_t lines = along_u ? H : W, len = along_u ? W : H;
+  const std::size_t sampled = (lines + 15) / 16, pairs = len - 1;
+  std::vector<float> chords(sampled * pairs);
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(sampled); ++k) {
+    const std::size_t l = 16 * static_cast<std::size_t>(k);
+    lineChords(cloud.x.data(), cloud.y.data(), cloud.z.data(), range, along_u ? l * W : l,
+               along_u ? 1 : W, pairs, cloud.sensor_origin,
+               &chords[static_cast<std::size_t>(k) * pairs]);
+  }
   std::vector<float> lowest(len, std::numeric_limits<float>::infinity());
   std::vector<float> all;
-  for (std::size_t l = 0; l < lines; l += 16) {
-    for (std::size_t t = 0; t + 1 < len; ++t) {
-      const std::size_t i = along_u ? l * W + t : t * W + l;
-      const std::size_t j = along_u ? i + 1 : i + W;
-      if (!(range[i] == range[i]) || !(range[j] == range[j])) continue;
-      // The chord between unit rays equals the angle to 1e-6 at these sizes.
-      const float a = ((cloud.point(i) - o) / range[i] - (cloud.point(j) - o) / range[j]).norm();
+  all.reserve(chords.size());
+  for (std::size_t k = 0; k < sampled; ++k) {
+    for (std::size_t t = 0; t < pairs; ++t) {
+      const float a = chords[k * pairs + t];
+      if (!(a == a)) continue;
       lowest[t] = std::min(lowest[t], a);
       all.push_back(a);
     }
