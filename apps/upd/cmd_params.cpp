@@ -5,6 +5,7 @@
 #include "commands.h"
 
 #include "run_config.h"
+#include "upd/nav/nav_config.h"
 
 #include <cstdio>
 #include <iostream>
@@ -13,10 +14,12 @@
 namespace upd::app {
 
 const char* const kParamsUsage =
-    "usage: upd params [--markdown | --ini]\n"
-    "  Lists every parameter: ini section, key, default and meaning.\n"
-    "  --markdown  as the table in docs/PARAMETERS.md\n"
-    "  --ini       as an ini file holding every default (a starting point for a config)\n";
+    "usage: upd params [--markdown | --ini | --nav-ini]\n"
+    "  Lists every parameter: ini section, key, default and meaning (robot config, then\n"
+    "  the navigation config of upd navigate).\n"
+    "  --markdown  as the tables in docs/PARAMETERS.md (the default)\n"
+    "  --ini       the robot config as an ini file holding every default (a starting point)\n"
+    "  --nav-ini   the navigation config likewise\n";
 
 namespace {
 
@@ -46,9 +49,11 @@ struct Printer {
 
 }  // namespace
 
-void printAllParams(std::ostream& os, bool markdown) {
-  RunConfig defaults;
-  forEachSection(defaults, [&](const char* name, const char* what, auto& params) {
+namespace {
+
+template <class Sections>
+void printSections(std::ostream& os, bool markdown, Sections&& for_each) {
+  for_each([&](const char* name, const char* what, auto& params) {
     if (markdown) {
       os << "\n### [" << name << "]\n\n" << what << "\n\n| key | default | meaning |\n|---|---|---|\n";
     } else {
@@ -59,14 +64,43 @@ void printAllParams(std::ostream& os, bool markdown) {
   });
 }
 
-int runParams(const std::vector<std::string>& argv) {
-  const Args args(argv, {}, {"--markdown", "--ini"});
-  if (!args.positionals().empty()) throw UsageError("upd params takes no positional argument");
-  if (args.flag("--markdown") && args.flag("--ini")) {
-    throw UsageError("choose one of --markdown and --ini");
+void printRobotParams(std::ostream& os, bool markdown) {
+  RunConfig defaults;
+  printSections(os, markdown, [&](auto&& f) { forEachSection(defaults, f); });
+}
+
+void printNavParams(std::ostream& os, bool markdown) {
+  nav::NavConfig defaults;
+  printSections(os, markdown, [&](auto&& f) { nav::forEachNavSection(defaults, f); });
+}
+
+}  // namespace
+
+void printAllParams(std::ostream& os, bool markdown) {
+  if (markdown) os << "\n## Robot config (`--config`, e.g. `config/dune-kinect.ini`)\n";
+  printRobotParams(os, markdown);
+  if (markdown) {
+    os << "\n## Navigation config (`upd navigate --nav-config`, e.g. `config/dune-nav.ini`)\n";
   }
-  if (args.flag("--ini")) std::cout << "; UPD-Nav parameters with their defaults (upd params --ini)\n";
-  printAllParams(std::cout, !args.flag("--ini"));
+  printNavParams(os, markdown);
+}
+
+int runParams(const std::vector<std::string>& argv) {
+  const Args args(argv, {}, {"--markdown", "--ini", "--nav-ini"});
+  if (!args.positionals().empty()) throw UsageError("upd params takes no positional argument");
+  if (args.flag("--markdown") + args.flag("--ini") + args.flag("--nav-ini") > 1) {
+    throw UsageError("choose one of --markdown, --ini and --nav-ini");
+  }
+  if (args.flag("--ini")) {
+    std::cout << "; UPD-Nav robot config with every default (upd params --ini)\n";
+    printRobotParams(std::cout, false);
+  } else if (args.flag("--nav-ini")) {
+    std::cout << "; UPD-Nav navigation config with every default (upd params --nav-ini);\n"
+                 "; [NavigatorParams] also needs ptg_ini (see config/dune-nav.ini)\n";
+    printNavParams(std::cout, false);
+  } else {
+    printAllParams(std::cout, true);
+  }
   return 0;
 }
 

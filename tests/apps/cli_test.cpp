@@ -198,5 +198,22 @@ TEST_F(Cli, ParamsMarkdownMatchesTheDocs) {
       << "docs/PARAMETERS.md is out of date; regenerate with scripts/gen-docs.sh";
 }
 
+// `upd params --ini` is a complete robot config: it loads strictly (no unknown section or key)
+// and every value passes its rule. The navigation sections are listed apart (--nav-ini).
+TEST_F(Cli, ParamsIniIsAValidRobotConfig) {
+  const CmdResult ini = runUpd("params --ini");
+  ASSERT_EQ(ini.exit_code, 0) << ini.output;
+  EXPECT_EQ(ini.output.find("[NavigatorParams]"), std::string::npos);
+  std::ofstream(path("all.ini")) << ini.output;
+  ASSERT_EQ(runUpd("scene step --spacing-m 0.05 --output " + path("s.ply")).exit_code, 0);
+  const CmdResult r = runUpd("analyze " + path("s.ply") + " --config " + path("all.ini"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const CmdResult nav = runUpd("params --nav-ini");
+  ASSERT_EQ(nav.exit_code, 0) << nav.output;
+  EXPECT_NE(nav.output.find("[NavigatorParams]"), std::string::npos);
+  EXPECT_NE(nav.output.find("[LoopParams]"), std::string::npos);
+  EXPECT_NE(runUpd("params --ini --nav-ini").exit_code, 0);
+}
+
 }  // namespace
 }  // namespace upd

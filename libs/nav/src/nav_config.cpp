@@ -69,7 +69,8 @@ NavConfig loadNavConfig(const std::string& robot_ini, const std::string& nav_ini
   }
   {
     mrptbridge::IniReader ini(nav_ini);
-    forEachNavSection(c, [&](const char* name, auto& params) { ini.read(name, params); });
+    forEachNavSection(c,
+                      [&](const char* name, const char*, auto& params) { ini.read(name, params); });
     readPath(ini, "ptg_ini", c.ptg_ini);
     readPath(ini, "ptg_cache_dir", c.ptg_cache_dir);
     ini.checkAllKeysKnown();

@@ -94,19 +94,23 @@ void forEachRobotSection(NavConfig& c, F&& f) {
   f("FusionParams", c.fusion);
 }
 
-/// Calls f(section, params) for every section of the navigation config ([NavigatorParams]'s
-/// two path keys aside).
+/// Calls f(section, description, params) for every section of the navigation config
+/// ([NavigatorParams]'s two path keys aside), in documentation order.
 template <class F>
 void forEachNavSection(NavConfig& c, F&& f) {
-  f("RobotBodyParams", c.body);
-  f("CameraMountParams", c.camera);
-  f("DepthNoise", c.depth_noise);
-  f("SimulatedBaseParams", c.base);
-  f("ObstacleParams", c.obstacles);
-  f("NegativeObstacleParams", c.negative);
-  f("RoutePlannerParams", c.route);
-  f("NavigatorParams", c.navigator);
-  f("LoopParams", c.loop);
+  f("RobotBodyParams", "The robot's footprint, for the navigator's collision checks.", c.body);
+  f("CameraMountParams", "Where the depth camera sits on the robot.", c.camera);
+  f("DepthNoise", "Noise of the simulated depth camera.", c.depth_noise);
+  f("SimulatedBaseParams", "The simulated base that executes the velocity commands.", c.base);
+  f("ObstacleParams", "Which labelled points become obstacles for the reactive navigator.",
+    c.obstacles);
+  f("NegativeObstacleParams", "Drops and holes seen as missing ground.", c.negative);
+  f("RoutePlannerParams", "The global route over the traversability grid.", c.route);
+  f("NavigatorParams",
+    "MRPT's reactive navigator (its PTGs come from the file that `ptg_ini` names; "
+    "`ptg_cache_dir` holds their tables).",
+    c.navigator);
+  f("LoopParams", "The closed loop of `upd navigate`.", c.loop);
 }
 
 /// Reads the robot config's sections (absent ones keep their defaults), then the navigation
