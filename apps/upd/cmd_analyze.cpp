@@ -26,7 +26,8 @@ const char* const kAnalyzeUsage =
     "  --config FILE.ini     parameters from an ini file (see config/*.ini, docs/PARAMETERS.md);\n"
     "                        options given on the command line override it\n"
     "  --output OUT.ply      scored cloud: x y z nx ny nz rx ry rz zeta label cost\n"
-    "  --stats-json OUT.json summary: counts, zeta statistics, labels, timings\n";
+    "  --stats-json OUT.json summary: counts, zeta statistics, labels, per-stage timings and\n"
+    "                        the method used (fast or exact path)\n";
 
 int runAnalyze(const std::vector<std::string>& argv) {
   const Args args(argv,

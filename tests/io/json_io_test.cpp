@@ -217,6 +217,13 @@ TEST(JsonIo, SummaryOfARealPipelineRun) {
             r.cloud.size());
   EXPECT_GT(l["non_traversable"].get<std::size_t>(), 0u);  // the step's edges
   EXPECT_GT(l["traversable"].get<std::size_t>(), 0u);      // the floors
+  // An unorganized cloud with the defaults (method auto, radius neighbourhoods): the fast path.
+  EXPECT_EQ(j["method"], "fast");
+  EXPECT_EQ(j["normals_method"], "hash grid");
+  p.upd.method = static_cast<int>(upd::UpdMethod::Exact);
+  const json exact = upd::io::summaryJson(upd::runPipeline(cloud, p), p, cloud.size());
+  EXPECT_EQ(exact["method"], "exact");
+  EXPECT_EQ(exact["normals_method"], "exact (k-d tree)");
 
   TempDir dir;
   const std::string f = dir.file("summary.json");

@@ -142,6 +142,11 @@ json summaryJson(const PipelineResult& result, const PipelineParams& params,
   j["points_invalid"] = unscored + dropped_non_finite;
   j["points_after_preprocess"] = cloud_n;
   j["radius_m"] = doubleValue(params.upd.radius_m);
+  // Which path scored the cloud (params.upd.method 0 lets the pipeline choose).
+  j["method"] = result.method == UpdMethod::Fast ? "fast" : "exact";
+  j["normals_method"] = result.method == UpdMethod::Exact ? "exact (k-d tree)"
+                        : result.organized_normals        ? "organized window scans"
+                                                          : "hash grid";
   j["zeta"] = z;
   j["labels"] = {{"traversable", traversable},
                  {"non_traversable", non_traversable},
