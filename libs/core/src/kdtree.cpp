@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <queue>
 #include <stdexcept>
 
 namespace upd {
@@ -111,11 +110,17 @@ void KdTree::knnSearch(const Eigen::Vector3f& q_world, int k, std::vector<std::u
   if (dist_sq_m2) dist_sq_m2->clear();
   if (nodes_.empty() || k <= 0) return;
   const Eigen::Vector3f q = q_world - centre_;
-  // Max-heap of the best k so far (distance, tree position).
-  std::priority_queue<std::pair<float, std::uint32_t>> best;
+  // The best k so far (distance, tree position), sorted nearest first with ties broken by cloud
+  // index (so results are deterministic), in a buffer of the calling thread kept between
+  // queries. k is small: a new point is inserted by shifting the farther ones.
+  static thread_local std::vector<std::pair<float, std::uint32_t>> best;
+  best.clear();
+  const auto k_size = static_cast<std::size_t>(k);
+  const auto before = [&](float d, std::uint32_t j, const std::pair<float, std::uint32_t>& b) {
+    return d < b.first || (d == b.first && index_[j] < index_[b.second]);
+  };
   auto worst = [&] {
-    return static_cast<int>(best.size()) < k ? std::numeric_limits<float>::infinity()
-                                              : best.top().first;
+    return best.size() < k_size ? std::numeric_limits<float>::infinity() : best.back().first;
   };
   // Best-first descent: nearer child first, prune by box distance.
   std::pair<float, std::int32_t> stack[128];
@@ -128,12 +133,11 @@ void KdTree::knnSearch(const Eigen::Vector3f& q_world, int k, std::vector<std::u
     if (n.left < 0) {
       for (std::uint32_t j = n.begin; j < n.end; ++j) {
         const float d = (pts_[j] - q).squaredNorm();
-        if (static_cast<int>(best.size()) < k) {
-          best.emplace(d, j);
-        } else if (d < best.top().first) {
-          best.pop();
-          best.emplace(d, j);
-        }
+        if (best.size() == k_size && !before(d, j, best.back())) continue;
+        if (best.size() < k_size) best.emplace_back();
+        std::size_t pos = best.size() - 1;
+        for (; pos > 0 && before(d, j, best[pos - 1]); --pos) best[pos] = best[pos - 1];
+        best[pos] = {d, j};
       }
       continue;
     }
@@ -147,18 +151,8 @@ void KdTree::knnSearch(const Eigen::Vector3f& q_world, int k, std::vector<std::u
       stack[top++] = {dr, n.right};
     }
   }
-  std::vector<std::pair<float, std::uint32_t>> sorted;
-  sorted.reserve(best.size());
-  while (!best.empty()) {
-    sorted.push_back(best.top());
-    best.pop();
-  }
-  // Nearest first; ties broken by cloud index so results are deterministic.
-  std::sort(sorted.begin(), sorted.end(), [&](const auto& a, const auto& b) {
-    return a.first < b.first || (a.first == b.first && index_[a.second] < index_[b.second]);
-  });
-  out.reserve(sorted.size());
-  for (const auto& [d, j] : sorted) {
+  out.reserve(best.size());
+  for (const auto& [d, j] : best) {
     out.push_back(index_[j]);
     if (dist_sq_m2) dist_sq_m2->push_back(d);
   }

@@ -2,10 +2,12 @@
 
 #include "upd/core/kdtree.h"
 
+#include "fast_cell_map.h"
+#include "fast_simd.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 
 namespace upd {
 
@@ -92,53 +94,54 @@ PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
   if (first == in.size()) return out;
   const Eigen::Vector3d ref = in.point(first).cast<double>();
   const double inv = 1.0 / voxel_m;
+  // Per voxel, in order of first appearance (the dense index of the flat hash map): the sums
+  // of the points relative to ref, of the colours, and the count.
   struct Acc {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     double r = 0, g = 0, b = 0;
     std::uint32_t n = 0;
-    std::uint32_t order = 0;
   };
-  std::unordered_map<std::uint64_t, Acc> voxels;
+  std::vector<Acc> voxels;
   voxels.reserve(in.size() / 4 + 16);
+  detail::CellMap map(in.size() / 4 + 16);
   const bool colour = in.hasColor();
-  const std::int64_t bias = std::int64_t(1) << 20;
+  std::uint64_t last_key = 0;
+  Acc* acc = nullptr;  // the voxel of the last point: consecutive points mostly share one
   for (std::size_t i = first; i < in.size(); ++i) {
     if (!in.isFinite(i)) continue;
     const Eigen::Vector3d d = in.point(i).cast<double>() - ref;
-    std::uint64_t key = 0;
-    for (int a = 0; a < 3; ++a) {
-      const auto c = static_cast<std::int64_t>(std::floor(d[a] * inv)) + bias;
-      if (c < 0 || c >= (std::int64_t(1) << 21)) {
-        throw std::invalid_argument(
-            "PreprocessParams.voxel_m = " + std::to_string(voxel_m) +
-            ": the cloud spans more than 2^20 voxels along an axis; use a larger voxel or a "
-            "range cut-off");
-      }
-      key |= static_cast<std::uint64_t>(c) << (21 * a);
+    const std::int64_t cx = detail::floorToInt(d.x() * inv), cy = detail::floorToInt(d.y() * inv),
+                       cz = detail::floorToInt(d.z() * inv);
+    if (!detail::keyFits(cx, cy, cz)) {
+      throw std::invalid_argument(
+          "PreprocessParams.voxel_m = " + std::to_string(voxel_m) +
+          ": the cloud spans more than 2^20 voxels along an axis; use a larger voxel or a "
+          "range cut-off");
     }
-    auto [it, inserted] = voxels.try_emplace(key);
-    Acc& acc = it->second;
-    if (inserted) acc.order = static_cast<std::uint32_t>(voxels.size() - 1);
-    acc.sum += d;
-    ++acc.n;
+    const std::uint64_t key = detail::packKey(cx, cy, cz);
+    if (acc == nullptr || key != last_key) {
+      bool inserted = false;
+      const std::uint32_t id = map.findOrInsert(key, inserted);
+      if (inserted) voxels.emplace_back();
+      acc = &voxels[id];
+      last_key = key;
+    }
+    acc->sum += d;
+    ++acc->n;
     if (colour) {
-      acc.r += in.r[i];
-      acc.g += in.g[i];
-      acc.b += in.b[i];
+      acc->r += in.r[i];
+      acc->g += in.g[i];
+      acc->b += in.b[i];
     }
   }
-  // Output in order of first appearance: deterministic whatever the hash map's layout.
-  std::vector<const Acc*> ordered(voxels.size());
-  for (const auto& kv : voxels) ordered[kv.second.order] = &kv.second;
-  out.reserve(ordered.size());
-  for (const Acc* acc : ordered) {
-    const Eigen::Vector3d c = ref + acc->sum / acc->n;
+  // Output in order of first appearance: deterministic.
+  out.reserve(voxels.size());
+  for (const Acc& v : voxels) {
+    const Eigen::Vector3d c = ref + v.sum / v.n;
     if (colour) {
-      const auto avg = [&](double s) {
-        return static_cast<std::uint8_t>(std::lround(s / acc->n));
-      };
-      out.push_back(static_cast<float>(c.x()), static_cast<float>(c.y()),
-                    static_cast<float>(c.z()), avg(acc->r), avg(acc->g), avg(acc->b));
+      const auto avg = [&](double s) { return static_cast<std::uint8_t>(std::lround(s / v.n)); };
+      out.push_back(static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()),
+                    avg(v.r), avg(v.g), avg(v.b));
     } else {
       out.push_back(static_cast<float>(c.x()), static_cast<float>(c.y()),
                     static_cast<float>(c.z()));

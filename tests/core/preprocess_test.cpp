@@ -1,0 +1,104 @@
+// Pre-processing (paper section 3): voxel down-sampling keeps one centroid per voxel, the
+// statistical outlier removal drops isolated points, the whole chain keeps what it should.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "upd/core/preprocess.h"
+
+namespace upd {
+namespace {
+
+constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+
+TEST(Preprocess, VoxelGridKeepsTheCentroidOfEachVoxelInOrderOfFirstAppearance) {
+  PointCloud c;
+  // Voxel edge 1, anchored at the first point: two points in voxel (0, 0, 0), one in
+  // (2, 0, 0), two in (0, 1, 0), with a NaN point between them and the voxels revisited out of
+  // order.
+  c.push_back(0.f, 0.f, 0.f, 10, 20, 30);
+  c.push_back(2.5f, 0.5f, 0.5f, 0, 0, 0);
+  c.push_back(0.4f, 1.5f, 0.1f, 100, 100, 100);
+  c.push_back(kNan, kNan, kNan, 1, 1, 1);
+  c.push_back(0.6f, 0.4f, 0.8f, 30, 40, 50);
+  c.push_back(0.6f, 1.7f, 0.3f, 200, 200, 200);
+  const PointCloud v = voxelDownsample(c, 1.0);
+  ASSERT_EQ(v.size(), 3u);
+  ASSERT_TRUE(v.hasColor());
+  EXPECT_NEAR(v.x[0], 0.3f, 1e-6f);  // voxel (0, 0, 0), first seen first
+  EXPECT_NEAR(v.y[0], 0.2f, 1e-6f);
+  EXPECT_NEAR(v.z[0], 0.4f, 1e-6f);
+  EXPECT_EQ(v.r[0], 20);
+  EXPECT_EQ(v.g[0], 30);
+  EXPECT_EQ(v.b[0], 40);
+  EXPECT_NEAR(v.x[1], 2.5f, 1e-6f);  // voxel (2, 0, 0)
+  EXPECT_NEAR(v.x[2], 0.5f, 1e-6f);  // voxel (0, 1, 0)
+  EXPECT_NEAR(v.y[2], 1.6f, 1e-6f);
+  EXPECT_NEAR(v.z[2], 0.2f, 1e-6f);
+  EXPECT_EQ(v.r[2], 150);
+}
+
+TEST(Preprocess, VoxelGridIsTheSameFarFromTheOrigin) {
+  // A 1 m x 1 m plane sampled every 1/128 m, at the origin and 8 km away (UTM-like; the
+  // coordinates stay exact floats): the same voxels, the same centroids relative to the cloud.
+  PointCloud near_origin, far;
+  const float shift = 8192.f;
+  for (int i = 0; i < 128; ++i) {
+    for (int k = 0; k < 128; ++k) {
+      const float x = static_cast<float>(i) / 128.f, y = static_cast<float>(k) / 128.f;
+      near_origin.push_back(x, y, 0.25f * x);
+      far.push_back(x + shift, y - shift, 0.25f * x + shift);
+    }
+  }
+  const PointCloud a = voxelDownsample(near_origin, 0.02);
+  const PointCloud b = voxelDownsample(far, 0.02);
+  ASSERT_GT(a.size(), 2000u);
+  ASSERT_EQ(b.size(), a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_NEAR(b.x[i] - shift, a.x[i], 1e-3f);  // 1e-3: the float spacing at 8 km
+    EXPECT_NEAR(b.y[i] + shift, a.y[i], 1e-3f);
+    EXPECT_NEAR(b.z[i] - shift, a.z[i], 1e-3f);
+  }
+}
+
+TEST(Preprocess, StatisticalOutliersAreIsolatedPoints) {
+  // A dense plane and three points 0.5 m above it: only those three are dropped.
+  PointCloud c;
+  for (int i = 0; i < 50; ++i) {
+    for (int k = 0; k < 50; ++k) {
+      c.push_back(0.01f * static_cast<float>(i), 0.01f * static_cast<float>(k), 0.f);
+    }
+  }
+  c.push_back(0.1f, 0.1f, 0.5f);
+  c.push_back(0.3f, 0.2f, 0.6f);
+  c.push_back(0.4f, 0.4f, -0.5f);
+  const PointCloud kept = removeStatisticalOutliers(c, 8, 1.0);
+  ASSERT_EQ(kept.size(), 2500u);
+  for (std::size_t i = 0; i < kept.size(); ++i) EXPECT_EQ(kept.z[i], 0.f);
+}
+
+TEST(Preprocess, WithEveryStepOffTheInputComesBackUnchanged) {
+  PointCloud c;
+  c.resizeOrganized(4, 3);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (i == 5) continue;  // stays NaN
+    c.x[i] = static_cast<float>(i), c.y[i] = 1.f, c.z[i] = 2.f;
+  }
+  PreprocessParams p;
+  p.disableAll();
+  PreprocessStats stats;
+  PointCloud out;
+  out.push_back(9.f, 9.f, 9.f);  // reused buffers: overwritten, not appended to
+  preprocess(c, p, out, &stats);
+  ASSERT_EQ(out.size(), c.size());
+  EXPECT_TRUE(out.isOrganized());
+  EXPECT_TRUE(std::isnan(out.x[5]));
+  EXPECT_EQ(out.x[7], 7.f);
+  EXPECT_EQ(stats.points_in, 12u);
+  EXPECT_EQ(stats.non_finite, 1u);
+  EXPECT_EQ(stats.points_out, 12u);
+}
+
+}  // namespace
+}  // namespace upd
