@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -10,24 +11,58 @@
 #include <omp.h>
 #endif
 
+// As in upd_core's fast paths (libs/core/src/fast_simd.h): GCC compiles the marked loops for
+// AVX-512, AVX2 and the baseline x86-64, and picks the version for the running CPU when the
+// program loads. The loops are branch-free so that they vectorize.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define UPD_VECTOR_CLONES \
+  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define UPD_VECTOR_CLONES
+#endif
+
 namespace upd::maps {
 
 namespace {
 
-// One frame's points in one cell.
-struct FrameCell {
-  std::uint32_t n_nontrav = 0, n_trav = 0;
-  float zeta_min = std::numeric_limits<float>::quiet_NaN();
-  double zeta_sum = 0, slope_sum = 0, cost_sum = 0, z_sum = 0;
-  std::uint32_t n_zeta = 0, n_slope = 0, n_cost = 0;
-  float z_max = -std::numeric_limits<float>::infinity();
+static_assert(static_cast<int>(Label::Traversable) == 0 &&
+                  static_cast<int>(Label::NonTraversable) == 1,
+              "the loops below read a labelled point's label as its non-traversable count");
+
+// Cell codes of points that have no cell (above any cell index: at most 46000^2 cells).
+constexpr std::uint32_t kInvalid = 0xFFFFFFFFu, kUnknown = 0xFFFFFFFEu, kOutside = 0xFFFFFFFDu;
+constexpr std::uint32_t kNoSlot = 0xFFFFFFFFu;
+// Grid rows dealt to a thread at a time: a view covers a few bands, not half the grid.
+constexpr int kBandRows = 8;
+// Points whose cells are computed at once, then scanned for runs while still in L1.
+constexpr std::size_t kBlock = 2048;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// The per-point layers summed per cell, in this order in FrameCell and in vector lanes.
+enum Layer { kZ, kZeta, kSlope, kCost, kLayers };
+
+// One frame's points in one cell: per layer the sum of its finite values and their count (kZ:
+// the points), the least -z and zeta (+inf: none yet), the non-traversable points. One cache
+// line.
+struct alignas(64) FrameCell {
+  double sum[kLayers] = {};
+  std::uint32_t count[kLayers] = {};
+  float least[2] = {kInf, kInf};  // kZ, kZeta
+  std::uint32_t n_nontrav = 0;
 };
 
-bool finiteValue(const float* values, std::size_t i, float& v) {
-  if (values == nullptr) return false;
-  v = values[i];
-  return std::isfinite(v);
-}
+// The window in cell units: a point is in window cell (cx, cy) when floor(x / cell) = lo_x + cx
+// and floor(y / cell) = lo_y + cy.
+struct Window {
+  double inv_cell;                // GridCellIndexer::inv_cell: the same products
+  double lo_x, hi_x, lo_y, hi_y;  // whole numbers; hi = lo + cells per side
+  std::uint32_t size_x;
+};
+
+// Four floats, ints and doubles as GCC vectors: one lane per layer.
+typedef float Float4 __attribute__((vector_size(4 * sizeof(float))));
+typedef std::int32_t Int4 __attribute__((vector_size(4 * sizeof(std::int32_t))));
+typedef double Double4 __attribute__((vector_size(4 * sizeof(double))));
 
 // Running mean over old_count earlier samples and n new ones summing to sum.
 float mergeMean(float mean, std::uint32_t old_count, double sum, std::uint32_t n) {
@@ -43,6 +78,146 @@ std::uint32_t addSaturating(std::uint32_t a, std::uint32_t b) {
       std::min<std::uint64_t>(s, std::numeric_limits<std::uint32_t>::max()));
 }
 
+// v where keep, +0 elsewhere: a select that the compiler cannot turn into a branch, nor look
+// through to fuse a product into a multiply-add.
+inline double keepIf(bool keep, double v) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  bits &= 0 - static_cast<std::uint64_t>(keep);
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+
+// floor(v) - lo where inside (v in [lo, hi)), anything elsewhere. The rounded v - lo (0 - 0
+// outside, where v may be NaN or far) is at most the next whole number, so its integer part is
+// one too many at most.
+inline std::int32_t cellOffset(double v, double lo, bool inside) {
+  const auto t = static_cast<std::int32_t>(keepIf(inside, v) - keepIf(inside, lo));
+  return t - (lo + t > v);  // lo + t is exact: whole numbers
+}
+
+// The cell code of points [begin, end), the cell of GridCellIndexer exactly (the same product,
+// whole-number bounds), and the counts of invalid and unknown points among them.
+UPD_VECTOR_CLONES
+void cellCodes(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+               const Label* __restrict label, const Window& w, std::size_t begin,
+               std::size_t end, std::uint32_t* __restrict cell_of, std::uint32_t& invalid,
+               std::uint32_t& unknown) {
+  std::uint32_t n_invalid = 0, n_unknown = 0;
+  for (std::size_t i = begin; i < end; ++i) {
+    const float px = x[i], py = y[i], pz = z[i];
+    const bool finite = (px - px) + (py - py) + (pz - pz) == 0.0f;  // inf - inf, NaN: NaN
+    const bool labelled = static_cast<std::uint8_t>(label[i]) <= 1;
+    const double vx = px * w.inv_cell, vy = py * w.inv_cell;
+    // floor(v) - lo is in [0, cells) exactly when v is in [lo, hi); NaN is outside.
+    const bool inside = (vx >= w.lo_x) & (vx < w.hi_x) & (vy >= w.lo_y) & (vy < w.hi_y);
+    const auto cx = static_cast<std::uint32_t>(cellOffset(vx, w.lo_x, inside));
+    const auto cy = static_cast<std::uint32_t>(cellOffset(vy, w.lo_y, inside));
+    const bool has_cell = finite & labelled & inside;
+    const std::uint32_t none = !finite ? kInvalid : !labelled ? kUnknown : kOutside;
+    cell_of[i] = none + ((cy * w.size_x + cx - none) & (0u - has_cell));
+    n_invalid += !finite;
+    n_unknown += finite & !labelled;
+  }
+  invalid = n_invalid;
+  unknown = n_unknown;
+}
+
+// 1 where a run of points sharing a cell starts in [begin, end), 0 elsewhere (start[0] is
+// point begin): at a point with a cell other than that of the nearest of the three points
+// before it that has one. Runs so split only after three points without a cell in a row, and
+// splitting a run is harmless. begin >= 3.
+UPD_VECTOR_CLONES
+void runStarts(const std::uint32_t* __restrict cell_of, std::size_t begin, std::size_t end,
+               std::uint8_t* __restrict start) {
+  for (std::size_t i = begin; i < end; ++i) {
+    const std::uint32_t c1 = cell_of[i - 1], c2 = cell_of[i - 2], c3 = cell_of[i - 3];
+    const std::uint32_t before = c1 < kOutside ? c1 : c2 < kOutside ? c2 : c3;
+    start[i - begin] = (cell_of[i] < kOutside) & (cell_of[i] != before);
+  }
+}
+
+// Adds the points [begin, end) of the cell's run to f, in point order. The sums run in local
+// lanes that start from f's partial sums, so they round exactly as adding to f point by point;
+// a point without this cell or value adds +0.0, which leaves a sum unchanged (sums are never
+// -0.0: they start at +0.0). max z is kept as the least -z: the same comparisons, negated.
+inline void addRun(FrameCell& f, const float* const* __restrict layer,
+                   const Label* __restrict label, const std::uint32_t* __restrict cell_of,
+                   std::uint32_t cell, std::size_t begin, std::size_t end) {
+  const Int4 negate_z = {std::numeric_limits<std::int32_t>::min(), 0, 0, 0};
+  const Float4 inf = {kInf, kInf, kInf, kInf};
+  Int4 inf_bits;
+  std::memcpy(&inf_bits, &inf, sizeof inf_bits);
+  Double4 sum;
+  Int4 count;
+  Float4 least = inf;
+  std::memcpy(&sum, f.sum, sizeof sum);
+  std::memcpy(&count, f.count, sizeof count);
+  std::memcpy(&least, f.least, sizeof f.least);
+  std::uint32_t n_nontrav = f.n_nontrav;
+  const float *const z = layer[kZ], *const zeta = layer[kZeta], *const slope = layer[kSlope],
+                     *const cost = layer[kCost];
+  const Int4 run_cell = Int4{} + static_cast<std::int32_t>(cell);
+  for (std::size_t i = begin; i < end; ++i) {
+    const Int4 in = run_cell == static_cast<std::int32_t>(cell_of[i]);  // all lanes alike
+    n_nontrav += static_cast<std::uint8_t>(label[i]) & in[0];
+    const Float4 v = {z[i], zeta[i], slope[i], cost[i]};
+    const Int4 ok = (v - v == 0) & in;  // finite (inf - inf and NaN are NaN) and in the cell
+    Int4 bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    const Int4 kept_bits = bits & ok;  // the value, or +0.0
+    const Int4 candidate_bits = ((bits ^ negate_z) & ok) | (inf_bits & ~ok);  // -z, zeta or +inf
+    Float4 kept, candidate;
+    std::memcpy(&kept, &kept_bits, sizeof kept);
+    std::memcpy(&candidate, &candidate_bits, sizeof candidate);
+    sum += Double4{kept[0], kept[1], kept[2], kept[3]};
+    count -= ok;
+    least = candidate < least ? candidate : least;
+  }
+  std::memcpy(f.sum, &sum, sizeof sum);
+  std::memcpy(f.count, &count, sizeof count);
+  std::memcpy(f.least, &least, sizeof f.least);
+  f.n_nontrav = n_nontrav;
+}
+
+// What step 2 of integrateScan reads, and the tables it fills besides the FrameCells.
+struct RunInputs {
+  const std::uint32_t* cell_of;
+  const float* layer[kLayers];  // a layer the view lacks: NaN for every point
+  const Label* label;
+  double inv_size_x;
+  std::uint32_t size_x;
+  std::uint32_t* slots;     // per cell: its FrameCell, or kNoSlot
+  std::uint32_t* row_span;  // per row: the touched columns [first, end); none: 0, 0
+};
+
+// Adds the runs of one chunk (starting at run_begin[0, count), the last one ending at
+// chunk_end) that fall in the bands of this thread to their FrameCells, appending those of
+// newly touched cells to frame.
+UPD_VECTOR_CLONES
+void addChunkRuns(const std::size_t* run_begin, std::size_t count, std::size_t chunk_end,
+                  const RunInputs& in, const std::uint8_t* band_is_mine,
+                  std::vector<FrameCell>& frame) {
+  for (std::size_t r = 0; r < count; ++r) {
+    const std::uint32_t cell = in.cell_of[run_begin[r]];
+    // cell / size_x without a division: (cell + 0.5) / size_x is 0.5 / size_x or more from a
+    // whole number, far more than the product's rounding.
+    const auto row = static_cast<std::uint32_t>((cell + 0.5) * in.inv_size_x);
+    if (!band_is_mine[row / kBandRows]) continue;
+    std::uint32_t& slot = in.slots[cell];
+    if (slot == kNoSlot) {
+      slot = static_cast<std::uint32_t>(frame.size());
+      frame.emplace_back();
+      const std::uint32_t cx = cell - row * in.size_x;
+      std::uint32_t* const span = in.row_span + 2 * row;
+      span[0] = span[1] == 0 ? cx : std::min(span[0], cx);
+      span[1] = std::max(span[1], cx + 1);
+    }
+    const std::size_t end = r + 1 < count ? run_begin[r + 1] : chunk_end;
+    addRun(frame[slot], in.layer, in.label, in.cell_of, cell, run_begin[r], end);
+  }
+}
+
 }  // namespace
 
 GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& points,
@@ -55,135 +230,146 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
   stats.window_moved = grid.moveTo(robot_xy);
 
   // Aggregate first: one log-odds update per cell per frame, whatever its point count.
-  // 1. The cell of every point (in parallel), or why it has none.
-  constexpr std::uint32_t kInvalid = 0xFFFFFFFFu, kUnknown = 0xFFFFFFFEu, kOutside = 0xFFFFFFFDu;
-  const int size_x = grid.sizeX();
-  const std::size_t n_cells = static_cast<std::size_t>(size_x) * grid.sizeY();
-  const GridCellIndexer cell_index = grid.indexer();  // inline: no call per point
-  static thread_local std::vector<std::uint32_t> point_cell;
+  const int size_x = grid.sizeX(), size_y = grid.sizeY();
+  const GridCellIndexer ix = grid.indexer();
+  const Window window{ix.inv_cell, ix.i0, ix.i0 + ix.size_x, ix.j0, ix.j0 + ix.size_y,
+                      static_cast<std::uint32_t>(size_x)};
+#ifdef _OPENMP
+  const int max_team = omp_get_max_threads();
+#else
+  const int max_team = 1;
+#endif
+  // Buffers shared by the team: the calling thread's, taken before the parallel region.
+  static thread_local std::vector<std::uint32_t> point_cell, slot_of_cell, row_span_of;
+  static thread_local std::vector<std::size_t> run_begin_of, run_count_of;
+  static thread_local std::vector<float> no_values;  // NaN: the layer a view lacks
   point_cell.resize(points.size);
-  std::uint32_t* const cell_of = point_cell.data();  // the calling thread's, shared by the team
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(points.size); ++ii) {
-    const auto i = static_cast<std::size_t>(ii);
-    const float x = points.x[i], y = points.y[i], z = points.z[i];
-    std::uint32_t code;
-    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
-      code = kInvalid;
-    } else if (points.label[i] != Label::Traversable && points.label[i] != Label::NonTraversable) {
-      code = kUnknown;
-    } else if (int cx, cy; cell_index(x, y, cx, cy)) {
-      code = static_cast<std::uint32_t>(cy) * static_cast<std::uint32_t>(size_x) +
-             static_cast<std::uint32_t>(cx);
-    } else {
-      code = kOutside;
-    }
-    cell_of[i] = code;
+  run_begin_of.resize(points.size);
+  run_count_of.resize(static_cast<std::size_t>(max_team));
+  const std::size_t n_cells = static_cast<std::size_t>(size_x) * size_y;
+  if (slot_of_cell.size() < n_cells) slot_of_cell.assign(n_cells, kNoSlot);
+  if (row_span_of.size() < 2 * static_cast<std::size_t>(size_y)) {
+    row_span_of.assign(2 * static_cast<std::size_t>(size_y), 0);
   }
-  // 2. Per-frame sums per touched cell, then one update per cell. The grid's rows are dealt to
-  // the threads in bands: every thread reads all the points and takes those of its bands,
-  // in point order, so the result does not depend on the number of threads. A dense slot table
-  // over the grid (per thread, reset after use) points each touched cell to its FrameCell;
-  // consecutive points mostly share a cell.
-  std::size_t invalid = 0, unknown = 0, outside = 0, used = 0, updated = 0, hit = 0, sparse = 0;
-#pragma omp parallel reduction(+ : invalid, unknown, outside, used, updated, hit, sparse)
+  if (!(points.zeta && points.slope_rad && points.cost) && no_values.size() < points.size) {
+    no_values.assign(points.size, std::numeric_limits<float>::quiet_NaN());
+  }
+  std::uint32_t* const cell_of = point_cell.data();
+  std::size_t* const run_begin = run_begin_of.data();
+  std::size_t* const run_count = run_count_of.data();
+  std::uint32_t* const slots = slot_of_cell.data();
+  std::uint32_t* const row_span = row_span_of.data();
+  const RunInputs run_inputs{cell_of,
+                             {points.z, points.zeta ? points.zeta : no_values.data(),
+                              points.slope_rad ? points.slope_rad : no_values.data(),
+                              points.cost ? points.cost : no_values.data()},
+                             points.label,
+                             1.0 / size_x,
+                             window.size_x,
+                             slots,
+                             row_span};
+
+  std::size_t invalid = 0, unknown = 0, used = 0, updated = 0, hit = 0, sparse = 0;
+#pragma omp parallel reduction(+ : invalid, unknown, used, updated, hit, sparse)
   {
 #ifdef _OPENMP
     const int team = omp_get_num_threads(), me = omp_get_thread_num();
 #else
     const int team = 1, me = 0;
 #endif
-    static thread_local std::vector<std::uint32_t> slot_of_cell;
-    if (slot_of_cell.size() < n_cells) slot_of_cell.assign(n_cells, kInvalid);
-    std::uint32_t* const slots = slot_of_cell.data();
-    std::vector<FrameCell> frame;
-    std::vector<std::uint32_t> frame_index;
-    std::uint32_t last_cell = kInvalid;
-    bool mine = false;
-    FrameCell* cur = nullptr;
-    for (std::size_t i = 0; i < points.size; ++i) {
-      const std::uint32_t cell = cell_of[i];
-      if (cell >= kOutside) {
-        if (me == 0) {  // counted once
-          invalid += cell == kInvalid ? 1 : 0;
-          unknown += cell == kUnknown ? 1 : 0;
-          outside += cell == kOutside ? 1 : 0;
-        }
-        continue;
+    // 1. Each thread takes a chunk of the points: the cell of every point (or why it has none),
+    // and where the runs of points sharing a cell start.
+    const std::size_t chunk_begin = points.size * me / team,
+                      chunk_end = points.size * (me + 1) / team;
+    std::size_t* const my_runs = run_begin + chunk_begin;
+    std::size_t n_runs = 0;
+    std::uint8_t starts[kBlock];
+    for (std::size_t block = chunk_begin; block < chunk_end; block += kBlock) {
+      const std::size_t block_end = std::min(chunk_end, block + kBlock);
+      std::uint32_t block_invalid, block_unknown;
+      cellCodes(points.x, points.y, points.z, points.label, window, block, block_end, cell_of,
+                block_invalid, block_unknown);
+      invalid += block_invalid;
+      unknown += block_unknown;
+      // The chunk's first points have fewer than three points before them in the chunk.
+      std::size_t i = block;
+      for (std::uint32_t last = kInvalid; i < std::min(block_end, chunk_begin + 3); ++i) {
+        starts[i - block] = (cell_of[i] < kOutside) & (cell_of[i] != last);
+        last = cell_of[i] < kOutside ? cell_of[i] : last;
       }
-      if (cell != last_cell) {
-        // Bands of 8 rows, dealt round-robin: a view covers a few bands, not half the grid.
-        last_cell = cell;
-        mine = static_cast<int>((cell / static_cast<std::uint32_t>(size_x)) / 8) % team == me;
-        if (mine) {
-          std::uint32_t& slot = slots[cell];
-          if (slot == kInvalid) {
-            slot = static_cast<std::uint32_t>(frame.size());
-            frame.emplace_back();
-            frame_index.push_back(cell);
-          }
-          cur = &frame[slot];
-        }
-      }
-      if (!mine) continue;
-      ++used;
-      if (points.label[i] == Label::NonTraversable) {
-        ++cur->n_nontrav;
-      } else {
-        ++cur->n_trav;
-      }
-      const float z = points.z[i];
-      cur->z_sum += z;
-      cur->z_max = std::max(cur->z_max, z);
-      float v;
-      if (finiteValue(points.zeta, i, v)) {
-        cur->zeta_min = cur->zeta_min <= v ? cur->zeta_min : v;  // NaN (none yet) takes v
-        cur->zeta_sum += v;
-        ++cur->n_zeta;
-      }
-      if (finiteValue(points.slope_rad, i, v)) {
-        cur->slope_sum += v;
-        ++cur->n_slope;
-      }
-      if (finiteValue(points.cost, i, v)) {
-        cur->cost_sum += v;
-        ++cur->n_cost;
+      runStarts(cell_of, i, block_end, starts + (i - block));
+      for (i = block; i < block_end; ++i) {
+        my_runs[n_runs] = i;  // kept only where a run starts: no branch
+        n_runs += starts[i - block];
       }
     }
-    for (const std::uint32_t cell : frame_index) slots[cell] = kInvalid;
+    run_count[me] = n_runs;
+#pragma omp barrier
 
-    for (std::size_t s = 0; s < frame.size(); ++s) {
-      const std::uint32_t index = frame_index[s];
-      const FrameCell& f = frame[s];
-      const double update = frameLogOddsUpdate(f.n_nontrav, f.n_trav, params);
-      if (update == 0.0) {
-        ++sparse;
-        continue;
+    // 2. Per-frame sums per touched cell. The grid's rows are dealt to the threads in bands,
+    // round-robin: every thread reads the runs of all chunks and takes those of its bands, in
+    // point order, so the result does not depend on the number of threads. A dense slot table
+    // over the grid (shared: each cell belongs to one thread; reset after use) points each
+    // touched cell to its FrameCell; per row, the span of touched columns.
+    static thread_local std::vector<FrameCell> frame;  // this thread's own
+    static thread_local std::vector<std::uint8_t> band_is_mine;
+    frame.clear();
+    band_is_mine.resize(static_cast<std::size_t>((size_y + kBandRows - 1) / kBandRows));
+    for (std::size_t b = 0; b < band_is_mine.size(); ++b) {
+      band_is_mine[b] = static_cast<int>(b % team) == me;
+    }
+    for (int c = 0; c < team; ++c) {
+      addChunkRuns(run_begin + points.size * c / team, run_count[c],
+                   points.size * (c + 1) / team, run_inputs, band_is_mine.data(), frame);
+    }
+
+    // 3. One update per touched cell, in grid order: the grid is larger than the caches, and
+    // sequential access lets the hardware prefetch.
+    for (int band = me; band * kBandRows < size_y; band += team) {
+      for (int cy = band * kBandRows; cy < std::min(size_y, (band + 1) * kBandRows); ++cy) {
+        std::uint32_t* const row_slots = slots + static_cast<std::size_t>(cy) * size_x;
+        std::uint32_t* const span = row_span + 2 * cy;
+        const int first = static_cast<int>(span[0]), last = static_cast<int>(span[1]);
+        span[0] = span[1] = 0;
+        for (int cx = first; cx < last; ++cx) {
+          // FrameCells are in first-touch order, and step 2 has streamed the points through the
+          // caches since: fetch them a few cells ahead.
+          const std::uint32_t ahead = cx + 8 < last ? row_slots[cx + 8] : kNoSlot;
+          if (ahead != kNoSlot) __builtin_prefetch(frame.data() + ahead);
+          if (row_slots[cx] == kNoSlot) continue;
+          const FrameCell& f = frame[row_slots[cx]];
+          row_slots[cx] = kNoSlot;
+          const std::uint32_t n = f.count[kZ];
+          used += n;
+          const double update = frameLogOddsUpdate(f.n_nontrav, n - f.n_nontrav, params);
+          if (update == 0.0) {
+            ++sparse;
+            continue;
+          }
+          GridCell& c = grid.at(cx, cy);
+          c.logodds_nontrav = fuseLogOdds(c.logodds_nontrav, update, params);
+          ++updated;
+          if (update > 0) ++hit;
+
+          c.elevation_m = mergeMean(c.elevation_m, c.hits, f.sum[kZ], n);
+          c.elevation_max_m = std::fmax(c.elevation_max_m, -f.least[kZ]);
+          if (f.count[kZeta] > 0) c.zeta_min = std::fmin(c.zeta_min, f.least[kZeta]);
+          c.zeta_mean = mergeMean(c.zeta_mean, c.zeta_count, f.sum[kZeta], f.count[kZeta]);
+          c.slope_rad = mergeMean(c.slope_rad, c.slope_count, f.sum[kSlope], f.count[kSlope]);
+          c.cost_mean = mergeMean(c.cost_mean, c.cost_count, f.sum[kCost], f.count[kCost]);
+          c.hits = addSaturating(c.hits, n);
+          c.zeta_count = addSaturating(c.zeta_count, f.count[kZeta]);
+          c.slope_count = addSaturating(c.slope_count, f.count[kSlope]);
+          c.cost_count = addSaturating(c.cost_count, f.count[kCost]);
+          c.last_seen_s = time_s;
+        }
       }
-      GridCell& c = grid.at(static_cast<int>(index % static_cast<std::uint32_t>(size_x)),
-                            static_cast<int>(index / static_cast<std::uint32_t>(size_x)));
-      c.logodds_nontrav = fuseLogOdds(c.logodds_nontrav, update, params);
-      ++updated;
-      if (update > 0) ++hit;
-
-      const std::uint32_t n = f.n_nontrav + f.n_trav;
-      c.elevation_m = mergeMean(c.elevation_m, c.hits, f.z_sum, n);
-      c.elevation_max_m = std::fmax(c.elevation_max_m, f.z_max);
-      c.zeta_min = std::fmin(c.zeta_min, f.zeta_min);
-      c.zeta_mean = mergeMean(c.zeta_mean, c.zeta_count, f.zeta_sum, f.n_zeta);
-      c.slope_rad = mergeMean(c.slope_rad, c.slope_count, f.slope_sum, f.n_slope);
-      c.cost_mean = mergeMean(c.cost_mean, c.cost_count, f.cost_sum, f.n_cost);
-      c.hits = addSaturating(c.hits, n);
-      c.zeta_count = addSaturating(c.zeta_count, f.n_zeta);
-      c.slope_count = addSaturating(c.slope_count, f.n_slope);
-      c.cost_count = addSaturating(c.cost_count, f.n_cost);
-      c.last_seen_s = time_s;
     }
   }
   stats.points_invalid = invalid;
   stats.points_unknown = unknown;
-  stats.points_outside = outside;
   stats.points_used = used;
+  stats.points_outside = points.size - invalid - unknown - used;  // finite, labelled, outside
   stats.cells_updated = updated;
   stats.cells_hit = hit;
   stats.cells_too_sparse = sparse;
