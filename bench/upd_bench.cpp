@@ -372,44 +372,84 @@ struct FrameTiming {
 };
 
 // The frame pipeline: depth image (when there is one) -> cloud -> runPipeline -> map update.
-FrameTiming timeFramePipeline(const Frame& f, const PipelineParams& params, int repeats,
-                              PipelineResult* last = nullptr) {
-  MapStage map(f.pose_world_cloud);
-  std::vector<double> total, convert, pre, normals, upd, classify_ms, map_ms;
-  // One cloud and one result for all frames, as a sensor loop keeps them: once warm, a frame
-  // allocates nothing.
-  PipelineResult r;
-  PointCloud converted;
-  for (int run = -1; run < repeats; ++run) {
+// One loop keeps its cloud, result and map from frame to frame, as a sensor loop does: once
+// warm, a frame allocates nothing.
+class FrameLoop {
+ public:
+  FrameLoop(const Frame& f, const PipelineParams& params)
+      : f_(f), params_(params), map_(f.pose_world_cloud) {}
+
+  // One frame; its timings are kept when record.
+  void run(bool record) {
     const auto t0 = Clock::now();
-    const PointCloud* input = &f.cloud;
-    if (f.depth) {
-      depthToCloud(*f.depth, f.intrinsics, converted);
-      input = &converted;
+    const PointCloud* input = &f_.cloud;
+    if (f_.depth) {
+      depthToCloud(*f_.depth, f_.intrinsics, converted_);
+      input = &converted_;
     }
     const double t_convert = msSince(t0);
-    runPipeline(*input, params, r);
+    runPipeline(*input, params_, r_);
     const auto t_map = Clock::now();
-    map.update(r, 0.1 * (run + 1));
+    map_.update(r_, 0.1 * static_cast<double>(++frames_));
     const double map_time = msSince(t_map);
     const double t_total = msSince(t0);
-    if (run < 0) continue;  // warm-up
-    total.push_back(t_total);
-    convert.push_back(t_convert);
-    pre.push_back(r.timings.preprocess_ms);
-    normals.push_back(r.timings.index_ms + r.timings.normals_ms);
-    upd.push_back(r.timings.upd_ms);
-    classify_ms.push_back(r.timings.classify_ms);
-    map_ms.push_back(map_time);
+    if (!record) return;
+    total_.push_back(t_total);
+    convert_.push_back(t_convert);
+    pre_.push_back(r_.timings.preprocess_ms);
+    normals_.push_back(r_.timings.index_ms + r_.timings.normals_ms);
+    upd_.push_back(r_.timings.upd_ms);
+    classify_.push_back(r_.timings.classify_ms);
+    map_ms_.push_back(map_time);
   }
-  FrameTiming t;
-  t.total_ms = median(total);
-  t.stages = {{"depth_to_cloud_ms", num(median(convert))}, {"preprocess_ms", num(median(pre))},
-              {"normals_ms", num(median(normals))},        {"upd_ms", num(median(upd))},
-              {"classify_ms", num(median(classify_ms))},   {"map_update_ms", num(median(map_ms))}};
-  t.points = r.cloud.size();
-  t.scored = r.cloud.size() - r.upd.invalid;
-  if (last) *last = std::move(r);
+
+  FrameTiming timing() const {
+    FrameTiming t;
+    t.total_ms = median(total_);
+    t.stages = {
+        {"depth_to_cloud_ms", num(median(convert_))}, {"preprocess_ms", num(median(pre_))},
+        {"normals_ms", num(median(normals_))},        {"upd_ms", num(median(upd_))},
+        {"classify_ms", num(median(classify_))},      {"map_update_ms", num(median(map_ms_))}};
+    t.points = r_.cloud.size();
+    t.scored = r_.cloud.size() - r_.upd.invalid;
+    return t;
+  }
+  PipelineResult& result() { return r_; }
+
+ private:
+  const Frame& f_;
+  PipelineParams params_;
+  MapStage map_;
+  PipelineResult r_;
+  PointCloud converted_;
+  int frames_ = 0;
+  std::vector<double> total_, convert_, pre_, normals_, upd_, classify_, map_ms_;
+};
+
+// repeats frames after a warm-up frame, at the current thread count.
+FrameTiming timeFramePipeline(const Frame& f, const PipelineParams& params, int repeats,
+                              PipelineResult* last = nullptr) {
+  FrameLoop loop(f, params);
+  for (int run = -1; run < repeats; ++run) loop.run(run >= 0);
+  const FrameTiming t = loop.timing();
+  if (last) *last = std::move(loop.result());
+  return t;
+}
+
+// The same on one core and on two, frame by frame in turn: on a shared machine whose speed
+// drifts, both medians then see the same conditions and their ratio is the second core's gain.
+std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const PipelineParams& params,
+                                                       int repeats,
+                                                       PipelineResult* last = nullptr) {
+  FrameLoop one(f, params), two(f, params);
+  for (int run = -1; run < repeats; ++run) {
+    omp_set_num_threads(1);
+    one.run(run >= 0);
+    omp_set_num_threads(2);
+    two.run(run >= 0);
+  }
+  std::pair<FrameTiming, FrameTiming> t{one.timing(), two.timing()};
+  if (last) *last = std::move(one.result());
   return t;
 }
 
@@ -669,10 +709,7 @@ int run(const Options& o) {
     p.preprocess.disableAll();  // keep the image: every pixel is scored
     p.normals.radius_m = 0.05;
     p.upd.radius_m = 0.5;
-    omp_set_num_threads(1);
-    const FrameTiming t1 = timeFramePipeline(fr, p, o.repeats, &frame_results[f]);
-    omp_set_num_threads(2);
-    const FrameTiming t2 = timeFramePipeline(fr, p, o.repeats);
+    const auto [t1, t2] = timeOneAndTwoCores(fr, p, o.repeats, &frame_results[f]);
     one_core[f] = t1.total_ms;
     c["points"] = t1.points;
     c["points_scored"] = t1.scored;
