@@ -268,11 +268,19 @@ class MapStage {
     world_.width = n, world_.height = 1;
     const Eigen::Matrix3f R = pose_.linear();
     const Eigen::Vector3f t = pose_.translation();
+    // Plain arithmetic over the coordinate arrays, so that the loop vectorizes.
+    const float* __restrict x = r.cloud.x.data();
+    const float* __restrict y = r.cloud.y.data();
+    const float* __restrict z = r.cloud.z.data();
+    float* __restrict wx = world_.x.data();
+    float* __restrict wy = world_.y.data();
+    float* __restrict wz = world_.z.data();
 #pragma omp parallel for schedule(static)
     for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
       const auto i = static_cast<std::size_t>(ii);
-      const Eigen::Vector3f p = R * r.cloud.point(i) + t;
-      world_.x[i] = p.x(), world_.y[i] = p.y(), world_.z[i] = p.z();
+      wx[i] = R(0, 0) * x[i] + R(0, 1) * y[i] + R(0, 2) * z[i] + t.x();
+      wy[i] = R(1, 0) * x[i] + R(1, 1) * y[i] + R(1, 2) * z[i] + t.y();
+      wz[i] = R(2, 0) * x[i] + R(2, 1) * y[i] + R(2, 2) * z[i] + t.z();
     }
 #ifdef UPD_BENCH_HAVE_MAPS
     maps::integrateScan(*grid_, maps::viewPoints(world_, r.classes, &r.upd),
