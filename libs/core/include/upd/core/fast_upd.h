@@ -16,9 +16,12 @@
 // than that (the ball's edge meets a riser or a wall inside it, where zeta bends sharply) is
 // not interpolated: its points get the cell sums at their own position.
 //
-// Cost: binning and interpolation are O(1) per point; a node costs O(fast_cells_per_radius^2)
-// cells (those near a surface), and a surface of area A has about 2.5 A / s^2 nodes, so for a
-// fixed fast_cells_per_radius the node work falls as d_m grows. Memory is O(points + cells).
+// Cost: binning and interpolation are O(1) per point (the blend of a cell's nodes is kept as
+// the coefficients of its polynomial); a node costs O(fast_cells_per_radius^2) cells (those
+// near a surface), and a surface of area A has about 2.5 A / s^2 nodes, so for a fixed
+// fast_cells_per_radius the node work falls as d_m grows. The nodes are grouped in blocks of
+// (fast_cells_per_radius + 1)^3 cells, whose balls lie in the 27 blocks around; each octant of
+// a block sums over the cells within d_m of its part only. Memory is O(points + cells).
 // The lattice is anchored at the first finite point: coordinates relative to it are exact in
 // float wherever the input floats are, so a cloud 10 km from the origin (UTM) gives the same
 // numbers as at the origin.
