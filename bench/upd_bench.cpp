@@ -833,7 +833,7 @@ int run(const Options& o) {
                                   pclSettings(fr.up, 0.02, 0.05, 0.5), o, o.repeats, report, true));
   }
   // The outdoor LiDAR scan: the settings of config/lidar.ini (range 1-40 m, voxel 0.1 m,
-  // normals 0.5 m, d_m 1.0 m), identical on both sides.
+  // normals 0.5 m, d_m 1.0 m, 6 lattice cells per d_m), identical on both sides.
   if (const auto path = dataFile(o, "fast_gicp/251370668.pcd")) {
     const PointCloud lidar = io::readCloud(*path);
     PipelineParams p = pclSettings(Eigen::Vector3f::UnitZ(), 0.1, 0.5, 1.0);
@@ -841,6 +841,7 @@ int run(const Options& o) {
     p.preprocess.range_min_m = 1.0;
     p.preprocess.range_max_m = 40.0;
     p.upd.min_neighbors = 3;
+    p.upd.fast_cells_per_radius = 6;
     p.classify.zeta_min = 0.93;
     p.classify.zeta_caution = 0.98;
     p.classify.max_slope_rad = 20.0 * kDegToRad;
