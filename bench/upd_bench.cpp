@@ -38,6 +38,7 @@
 #endif
 
 #include <omp.h>
+#include <sched.h>
 #include <sys/resource.h>
 
 #include <Eigen/Geometry>
@@ -434,11 +435,45 @@ class FrameLoop {
   std::vector<double> total_, convert_, pre_, normals_, upd_, classify_, map_ms_;
 };
 
-// repeats frames after a warm-up frame, at the current thread count.
+// Keeps the calling thread on the CPU it runs on, for the one-core frames, and lets it go
+// again. Unpinned, the scheduler moves it between this VM's two vCPUs after the two-core
+// frames, and the one-core median rises by 20-30 % (cold caches, idle vCPUs waking up);
+// pinned, one core is one core.
+class PinnedToThisCpu {
+ public:
+  PinnedToThisCpu() {
+    pinned_ = sched_getaffinity(0, sizeof saved_, &saved_) == 0;
+    const int cpu = sched_getcpu();
+    if (!pinned_ || cpu < 0) {
+      pinned_ = false;
+      return;
+    }
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(cpu, &one);
+    pinned_ = sched_setaffinity(0, sizeof one, &one) == 0;
+  }
+  ~PinnedToThisCpu() {
+    if (pinned_) sched_setaffinity(0, sizeof saved_, &saved_);
+  }
+  PinnedToThisCpu(const PinnedToThisCpu&) = delete;
+  PinnedToThisCpu& operator=(const PinnedToThisCpu&) = delete;
+
+ private:
+  cpu_set_t saved_;
+  bool pinned_ = false;
+};
+
+// repeats frames after a warm-up frame, at the current thread count (pinned to one CPU when
+// that is 1).
 FrameTiming timeFramePipeline(const Frame& f, const PipelineParams& params, int repeats,
                               PipelineResult* last = nullptr) {
   FrameLoop loop(f, params);
-  for (int run = -1; run < repeats; ++run) loop.run(run >= 0);
+  for (int run = -1; run < repeats; ++run) {
+    std::optional<PinnedToThisCpu> pin;
+    if (omp_get_max_threads() == 1) pin.emplace();
+    loop.run(run >= 0);
+  }
   const FrameTiming t = loop.timing();
   if (last) *last = std::move(loop.result());
   return t;
@@ -452,7 +487,10 @@ std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const Pip
   FrameLoop one(f, params), two(f, params);
   for (int run = -1; run < repeats; ++run) {
     omp_set_num_threads(1);
-    one.run(run >= 0);
+    {
+      const PinnedToThisCpu pin;
+      one.run(run >= 0);
+    }
     omp_set_num_threads(2);
     two.run(run >= 0);
   }
