@@ -1,21 +1,13 @@
-// Private to the fast paths: what lets their inner loops use the machine's vector units.
-//
-// The library is compiled for the baseline x86-64 (SSE2) so that it runs anywhere. The few
-// loops that dominate the fast paths are written branch-free over fixed-width lanes and marked
-// UPD_VECTOR_CLONES: GCC then compiles them three times (AVX-512, AVX2 + FMA, baseline) and
-// picks the version for the running CPU when the program loads. std::sqrt keeps a loop scalar
-// unless the whole build sets -fno-math-errno, so the loops use rsqrtNewton instead.
+// Private to the fast paths: the arithmetic their vector loops (UPD_VECTOR_CLONES,
+// upd/core/vector_clones.h) share. The fast path sources are built with -fno-math-errno
+// (libs/core/CMakeLists.txt), so std::sqrt vectorizes there; rsqrtNewton serves where a
+// reciprocal square root is what is wanted.
 #pragma once
 
 #include <cstdint>
 #include <cstring>
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define UPD_VECTOR_CLONES \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define UPD_VECTOR_CLONES
-#endif
+#include "upd/core/vector_clones.h"
 
 namespace upd::detail {
 

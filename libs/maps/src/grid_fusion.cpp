@@ -1,5 +1,7 @@
 #include "upd/maps/grid_fusion.h"
 
+#include "upd/core/vector_clones.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -11,15 +13,6 @@
 #include <omp.h>
 #endif
 
-// As in upd_core's fast paths (libs/core/src/fast_simd.h): GCC compiles the marked loops for
-// AVX-512, AVX2 and the baseline x86-64, and picks the version for the running CPU when the
-// program loads. The loops are branch-free so that they vectorize.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define UPD_VECTOR_CLONES \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define UPD_VECTOR_CLONES
-#endif
 
 namespace upd::maps {
 
