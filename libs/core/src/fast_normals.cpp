@@ -122,6 +122,13 @@ inline void setUnset(Normals& out, std::size_t i) {
   out.nx[i] = out.ny[i] = out.nz[i] = out.curvature[i] = kNaN;
 }
 
+inline void setNormal(Normals& out, std::size_t i, const Eigen::Vector3f& n, float curvature) {
+  out.nx[i] = n.x();
+  out.ny[i] = n.y();
+  out.nz[i] = n.z();
+  out.curvature[i] = curvature;
+}
+
 // Pixels [begin, end): their range from the sensor origin, and their coordinates relative to
 // ref as scan images (NaN range and kFar coordinates where the point is not finite).
 UPD_VECTOR_CLONES
@@ -492,11 +499,7 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
               continue;
             }
           }
-          n = orient(n, cloud.point(i));
-          out.nx[i] = n.x();
-          out.ny[i] = n.y();
-          out.nz[i] = n.z();
-          out.curvature[i] = curvature;
+          setNormal(out, i, orient(n, cloud.point(i)), curvature);
         }
       }
     }
@@ -618,11 +621,7 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
           ++invalid;
           continue;
         }
-        n = orient(n, cloud.point(i));
-        out.nx[i] = n.x();
-        out.ny[i] = n.y();
-        out.nz[i] = n.z();
-        out.curvature[i] = curvature;
+        setNormal(out, i, orient(n, cloud.point(i)), curvature);
       }
     }
   }
