@@ -2,6 +2,7 @@
 // back and writes every export; the simulated run's fused map agrees with the world's ground
 // truth; bad input stops cleanly with nothing written.
 #include "run_upd.h"
+#include "temp_dir.h"
 #include "test_data.h"
 #include "upd/maps/traversability_octree.h"
 #include "upd/mrpt/rawlog_reader.h"
@@ -28,13 +29,6 @@ using test::CmdResult;
 using test::runUpd;
 
 const std::string kConfig = std::string(UPD_SOURCE_DIR) + "/config/dune-kinect.ini";
-
-fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("upd_playback_" + std::to_string(::getpid()) + "_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 
 json readJson(const fs::path& p) { return json::parse(std::ifstream(p)); }
 
@@ -63,7 +57,8 @@ TEST(Playback, EveryRawlogInSharedDataPlaysBack) {
   for (const auto& e : fs::directory_iterator(data)) {
     if (e.path().extension() != ".rawlog") continue;
     SCOPED_TRACE(e.path().string());
-    const fs::path out = tempDir(e.path().stem().string());
+    const test::TempDir tmp(e.path().stem().string());
+    const fs::path& out = tmp.path();
     const CmdResult r = runUpd("playback " + e.path().string() + " --config " + kConfig +
                                " --output " + out.string() + " --quiet");
     ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -78,7 +73,6 @@ TEST(Playback, EveryRawlogInSharedDataPlaysBack) {
       EXPECT_GE(s["frames_processed"].get<std::size_t>(), 1u);
       EXPECT_GT(s["grid"]["known"].get<std::size_t>(), 0u);
     }
-    fs::remove_all(out);
     ++n;
   }
   EXPECT_EQ(n, 4u);
@@ -86,7 +80,8 @@ TEST(Playback, EveryRawlogInSharedDataPlaysBack) {
 
 TEST(Playback, GroundRawlogFloorIsTraversableAtTheRightHeight) {
   UPD_REQUIRE_SHARED_FILE(rawlog, "mrpt/test-3d-obs-ground.rawlog");
-  const fs::path out = tempDir("ground");
+  const test::TempDir tmp("ground");
+  const fs::path& out = tmp.path();
   const CmdResult r = runUpd("playback " + rawlog + " --config " + kConfig + " --output " +
                              out.string() + " --quiet --ply --output-rawlog");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -104,13 +99,13 @@ TEST(Playback, GroundRawlogFloorIsTraversableAtTheRightHeight) {
   }
   EXPECT_EQ(entries, 2u);
   EXPECT_EQ(clouds, 1u);
-  fs::remove_all(out);
 }
 
 // The README's main job: a simulated run through the mixed world, played back with its
 // ground-truth poses, gives a map whose non-traversable cells match the world's truth.
 TEST(Playback, SimulatedRunAgreesWithGroundTruth) {
-  const fs::path dir = tempDir("sim");
+  const test::TempDir tmp("sim");
+  const fs::path& dir = tmp.path();
   const std::string rawlog = (dir / "mixed.rawlog").string();
   const CmdResult sim = runUpd("simulate --world mixed --output " + rawlog);
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
@@ -130,23 +125,23 @@ TEST(Playback, SimulatedRunAgreesWithGroundTruth) {
   EXPECT_GE(s["ground_truth"]["scores"]["precision"].get<double>(), 0.9);
   EXPECT_GE(s["ground_truth"]["scores"]["recall"].get<double>(), 0.9);
   EXPECT_GT(s["ground_truth"]["scores"]["truth_non_traversable_cells_observed"].get<int>(), 50);
-  fs::remove_all(dir);
 }
 
 TEST(Playback, FrameSelectionAndOdometryPoses) {
   UPD_REQUIRE_SHARED_FILE(rawlog, "mrpt/2006-01ENE-21-SENA_Telecom_Faculty_one_loop_only.rawlog");
-  const fs::path out = tempDir("select");
+  const test::TempDir tmp("select");
+  const fs::path& out = tmp.path();
   const CmdResult r = runUpd("playback " + rawlog + " --config " + kConfig + " --output " +
                              out.string() + " --quiet --from 10 --to 49 --every 5");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json s = readJson(out / "summary.json");
   EXPECT_EQ(s["frames_skipped"]["outside --from/--to/--every"], 225 - 8);
   EXPECT_EQ(s["pose_source"], "odometry actions");
-  fs::remove_all(out);
 }
 
 TEST(Playback, BadInputStopsWithOneLineAndWritesNothing) {
-  const fs::path dir = tempDir("bad");
+  const test::TempDir tmp("bad");
+  const fs::path& dir = tmp.path();
   // A truncated rawlog.
   UPD_REQUIRE_SHARED_FILE(good, "mrpt/tests_rgbd.rawlog");
   {
@@ -174,7 +169,6 @@ TEST(Playback, BadInputStopsWithOneLineAndWritesNothing) {
     EXPECT_TRUE(!fs::exists(out) || fs::is_empty(out)) << "outputs written despite the error";
     fs::remove_all(out);
   }
-  fs::remove_all(dir);
 }
 
 }  // namespace

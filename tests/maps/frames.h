@@ -2,9 +2,8 @@
 // would give, owned here, viewed as PointsWorld.
 #pragma once
 
+#include "temp_dir.h"
 #include "upd/maps/fusion.h"
-
-#include <unistd.h>
 
 #include <filesystem>
 #include <limits>
@@ -47,38 +46,6 @@ struct Frame {
     v.cost = cost.data();
     return v;
   }
-};
-
-/// A fresh empty directory under the system temp dir, removed by the destructor.
-class TempDir {
- public:
-  explicit TempDir(const std::string& tag) {
-    static int counter = 0;
-    path_ =
-        std::filesystem::temp_directory_path() /
-        ("upd_maps_" + tag + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  /// Names of the files in the directory (to check that no temporary file is left).
-  std::vector<std::string> listing() const {
-    std::vector<std::string> names;
-    for (const auto& e : std::filesystem::directory_iterator(path_)) {
-      names.push_back(e.path().filename().string());
-    }
-    return names;
-  }
-
- private:
-  std::filesystem::path path_;
 };
 
 }  // namespace upd::test

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "temp_dir.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -16,11 +18,8 @@ namespace {
 class IniFile : public ::testing::Test {
  protected:
   std::string write(const std::string& text) {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("upd_ini_test_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    path_ = (dir / (std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
-                    ".ini")).string();
+    path_ = dir_.file(std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+                      ".ini");
     std::ofstream(path_) << text;
     return path_;
   }
@@ -34,6 +33,7 @@ class IniFile : public ::testing::Test {
     }
     return "";
   }
+  test::TempDir dir_;  // removed with its files after each test
   std::string path_;
 };
 

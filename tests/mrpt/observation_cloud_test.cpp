@@ -1,5 +1,6 @@
 // Each MRPT observation type converts to a cloud in the robot frame (x forward, y left, z up).
 #include "upd/mrpt/observation_cloud.h"
+#include "temp_dir.h"
 #include "test_data.h"
 #include "upd/mrpt/pose_source.h"
 #include "upd/mrpt/rawlog_reader.h"
@@ -25,8 +26,6 @@
 #include <cmath>
 #include <filesystem>
 #include <vector>
-
-#include <unistd.h>
 
 namespace {
 
@@ -164,9 +163,8 @@ TEST(ObservationCloud, ExternallyStoredImagesAreLoaded) {
   ASSERT_TRUE(reference.ok());
 
   namespace fs = std::filesystem;
-  const fs::path dir =
-      fs::temp_directory_path() / ("upd_external_images_test_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
+  const upd::test::TempDir tmp("external_images");
+  const fs::path& dir = tmp.path();
   const fs::path images = dir / "ext_Images";
   fs::create_directories(images);
   const fs::path rawlog = dir / "ext.rawlog";
@@ -207,7 +205,6 @@ TEST(ObservationCloud, ExternallyStoredImagesAreLoaded) {
     EXPECT_FALSE(oc.ok());
     EXPECT_NE(oc.skipped_reason.find("externally stored"), std::string::npos) << oc.skipped_reason;
   }
-  fs::remove_all(dir);
 }
 
 TEST(ObservationCloud, RangeScanRangeIsNotDepth) {

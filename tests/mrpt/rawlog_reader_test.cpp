@@ -1,6 +1,7 @@
 // The streaming rawlog reader on every rawlog of the shared data, on truncated and corrupt
 // copies, and on files written here in both layouts.
 #include "upd/mrpt/rawlog_reader.h"
+#include "temp_dir.h"
 #include "test_data.h"
 
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -19,8 +20,6 @@
 #include <fstream>
 #include <iterator>
 
-#include <unistd.h>
-
 namespace {
 
 using upd::mrptbridge::RawlogEntry;
@@ -29,21 +28,7 @@ using upd::mrptbridge::RawlogLayout;
 using upd::mrptbridge::RawlogReader;
 namespace fs = std::filesystem;
 
-// A fresh directory under the system temp dir, removed at the end of the test.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path = fs::temp_directory_path() /
-           ("upd_rawlog_test_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
+using upd::test::TempDir;
 
 void writePrefix(const std::string& from, const fs::path& to, double fraction) {
   std::ifstream in(from, std::ios::binary);
@@ -137,7 +122,7 @@ TEST(RawlogReader, EverySharedRawlogReadsToTheEnd) {
 TEST(RawlogReader, TruncatedFileGivesCleanErrorNamingFileAndObject) {
   UPD_REQUIRE_SHARED_FILE(path, "mrpt/2006-01ENE-21-SENA_Telecom_Faculty_one_loop_only.rawlog");
   TempDir tmp;
-  const fs::path cut = tmp.path / "sena_half.rawlog";
+  const fs::path cut = tmp.path() / "sena_half.rawlog";
   writePrefix(path, cut, 0.5);
   RawlogReader reader(cut.string());
   RawlogEntry e;
@@ -168,7 +153,7 @@ TEST(RawlogReader, TruncatedSingleObservationFiles) {
     TempDir tmp;
     for (double fraction : {0.1, 0.5, 0.9, 0.999}) {
       const fs::path cut =
-          tmp.path / ("cut_" + std::to_string(static_cast<int>(fraction * 1000)) + ".rawlog");
+          tmp.path() / ("cut_" + std::to_string(static_cast<int>(fraction * 1000)) + ".rawlog");
       writePrefix(path, cut, fraction);
       try {
         upd::mrptbridge::scanRawlog(cut.string());
@@ -183,7 +168,7 @@ TEST(RawlogReader, TruncatedSingleObservationFiles) {
 
 TEST(RawlogReader, GarbageAndMissingFiles) {
   TempDir tmp;
-  const fs::path garbage = tmp.path / "garbage.rawlog";
+  const fs::path garbage = tmp.path() / "garbage.rawlog";
   {
     std::ofstream out(garbage, std::ios::binary);
     std::uint32_t x = 12345u;  // fixed-seed LCG bytes
@@ -201,11 +186,11 @@ TEST(RawlogReader, GarbageAndMissingFiles) {
     EXPECT_EQ(what.find('\n'), std::string::npos);
     for (char c : what) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "non-printable in: " << what;
   }
-  const fs::path text = tmp.path / "text.rawlog";
+  const fs::path text = tmp.path() / "text.rawlog";
   std::ofstream(text) << "this is not a rawlog\n";
   EXPECT_THROW(upd::mrptbridge::scanRawlog(text.string()), RawlogError);
 
-  const std::string missing = (tmp.path / "nope.rawlog").string();
+  const std::string missing = (tmp.path() / "nope.rawlog").string();
   try {
     RawlogReader reader(missing);
     FAIL() << "a missing file opened";
@@ -213,7 +198,7 @@ TEST(RawlogReader, GarbageAndMissingFiles) {
     EXPECT_EQ(std::string(err.what()), "rawlog " + missing + ": not found");
   }
 
-  const fs::path empty = tmp.path / "empty.rawlog";
+  const fs::path empty = tmp.path() / "empty.rawlog";
   std::ofstream(empty).close();
   const auto stats = upd::mrptbridge::scanRawlog(empty.string());
   EXPECT_EQ(stats.objects, 0u);
@@ -225,7 +210,7 @@ TEST(RawlogReader, GarbageAndMissingFiles) {
 TEST(RawlogReader, WrittenLayoutsAndSkipReasons) {
   using namespace mrpt::obs;
   TempDir tmp;
-  const fs::path file = tmp.path / "mixed.rawlog";
+  const fs::path file = tmp.path() / "mixed.rawlog";
   const auto movement = [](double x, double y, double phi) {
     CActionRobotMovement2D act;
     CActionRobotMovement2D::TMotionModelOptions opts;
@@ -293,11 +278,12 @@ namespace {
 
 TEST(RawlogReader, ImagesDirectoryFollowsMrptConvention) {
   TempDir tmp;
-  const fs::path rawlog = tmp.path / "run.rawlog";
-  EXPECT_EQ(fs::path(upd::mrptbridge::detectImagesDirectory(rawlog.string())), tmp.path / "Images");
-  fs::create_directories(tmp.path / "run_Images");
+  const fs::path rawlog = tmp.path() / "run.rawlog";
   EXPECT_EQ(fs::path(upd::mrptbridge::detectImagesDirectory(rawlog.string())),
-            tmp.path / "run_Images");
+            tmp.path() / "Images");
+  fs::create_directories(tmp.path() / "run_Images");
+  EXPECT_EQ(fs::path(upd::mrptbridge::detectImagesDirectory(rawlog.string())),
+            tmp.path() / "run_Images");
 }
 
 }  // namespace
