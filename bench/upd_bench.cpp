@@ -276,12 +276,17 @@ class MapStage {
     float* __restrict wx = world_.x.data();
     float* __restrict wy = world_.y.data();
     float* __restrict wz = world_.z.data();
+    // The pose as plain floats: read through the matrix, they would be reloaded after every
+    // store (the compiler cannot rule out aliasing) and the loop would stay scalar.
+    const float r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2), tx = t.x();
+    const float r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2), ty = t.y();
+    const float r20 = R(2, 0), r21 = R(2, 1), r22 = R(2, 2), tz = t.z();
 #pragma omp parallel for schedule(static)
     for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
       const auto i = static_cast<std::size_t>(ii);
-      wx[i] = R(0, 0) * x[i] + R(0, 1) * y[i] + R(0, 2) * z[i] + t.x();
-      wy[i] = R(1, 0) * x[i] + R(1, 1) * y[i] + R(1, 2) * z[i] + t.y();
-      wz[i] = R(2, 0) * x[i] + R(2, 1) * y[i] + R(2, 2) * z[i] + t.z();
+      wx[i] = r00 * x[i] + r01 * y[i] + r02 * z[i] + tx;
+      wy[i] = r10 * x[i] + r11 * y[i] + r12 * z[i] + ty;
+      wz[i] = r20 * x[i] + r21 * y[i] + r22 * z[i] + tz;
     }
 #ifdef UPD_BENCH_HAVE_MAPS
     maps::integrateScan(*grid_, maps::viewPoints(world_, r.classes, &r.upd),

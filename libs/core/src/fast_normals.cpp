@@ -26,27 +26,33 @@ struct Moments {
   double n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
 };
 
-// The unoriented PCA normal of the covariance in m (eqs. 4-5; m.n is the sum of the weights)
-// and its curvature, or false for a neighbourhood without a plane (lambda_1 ~ 0, as
-// pcaNormal). The caller checks that there are at least 3 points.
+// The covariance of the moments, scaled to unit trace (a, b, c / d, e / f: its upper triangle),
+// or false when it has no spread.
+bool unitCovariance(const Moments& m, double (&cov)[6]) {
+  if (!(m.n > 0)) return false;
+  const double inv = 1.0 / m.n;
+  const double mx = m.x * inv, my = m.y * inv, mz = m.z * inv;
+  const double a = m.xx * inv - mx * mx, b = m.xy * inv - mx * my, c = m.xz * inv - mx * mz;
+  const double d = m.yy * inv - my * my, e = m.yz * inv - my * mz, f = m.zz * inv - mz * mz;
+  const double trace = a + d + f;
+  if (!(trace > 0)) return false;
+  const double s = 1.0 / trace;
+  cov[0] = a * s, cov[1] = b * s, cov[2] = c * s, cov[3] = d * s, cov[4] = e * s, cov[5] = f * s;
+  return true;
+}
+
+// The unoriented PCA normal of a covariance C scaled to unit trace (eqs. 4-5) and its
+// curvature, or false for a neighbourhood without a plane (lambda_1 ~ 0, as pcaNormal).
 //
 // The eigenvector of the smallest eigenvalue of C is the dominant one of adj(C), whose
 // eigenvalues are l1 l2 >= l0 l2 >= l0 l1 for l0 <= l1 <= l2, and so of B = adj(C)^2. The
 // largest column of B is within (l0 / l1)^2 of it, and each product with B shrinks the error by
 // (l0 / l1)^2 again: after three, (l0 / l1)^8, below 0.3 degrees even where l0 = l1 / 2 (a
 // rounded edge) and at float precision on a surface; it goes on until it settles, and where
-// l0 is close to l1 (no clear plane) the general eigen solver takes over. C is scaled to unit
-// trace first, so the products neither overflow nor underflow.
-bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature) {
-  if (!(m.n > 0)) return false;
-  const double inv = 1.0 / m.n;
-  const double mx = m.x * inv, my = m.y * inv, mz = m.z * inv;
-  double a = m.xx * inv - mx * mx, b = m.xy * inv - mx * my, c = m.xz * inv - mx * mz;
-  double d = m.yy * inv - my * my, e = m.yz * inv - my * mz, f = m.zz * inv - mz * mz;
-  const double trace = a + d + f;
-  if (!(trace > 0)) return false;
-  const double s = 1.0 / trace;
-  a *= s, b *= s, c *= s, d *= s, e *= s, f *= s;
+// l0 is close to l1 (no clear plane) the general eigen solver takes over. With unit trace the
+// products neither overflow nor underflow.
+bool normalFromUnitCovariance(const double (&cov)[6], Eigen::Vector3f& n, float& curvature) {
+  const double a = cov[0], b = cov[1], c = cov[2], d = cov[3], e = cov[4], f = cov[5];
   const double A00 = d * f - e * e, A01 = c * e - b * f, A02 = b * e - c * d;
   const double A11 = a * f - c * c, A12 = b * c - a * e, A22 = a * d - b * b;
   // |adj| ~ l1 l2 / trace^2: a neighbourhood without a plane has l1 ~ 0 (pcaNormal's test).
@@ -89,7 +95,10 @@ bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature) {
   if (l1 < 2.0 * q0) {
     Eigen::Matrix3d C;
     C << a, b, c, b, d, e, c, e, f;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
+    // The closed-form 3 x 3 solver: in double, and with unit trace, its error (~1e-9 rad
+    // over the gap of the eigenvalues) is far below what separates l0 from l1 here.
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(C);
     if (es.info() != Eigen::Success) return false;
     const Eigen::Vector3d ev = es.eigenvalues();  // ascending, trace 1
     if (ev[1] <= 1e-10) return false;
@@ -116,6 +125,66 @@ bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature) {
   n = Eigen::Vector3f(static_cast<float>(vx), static_cast<float>(vy), static_cast<float>(vz));
   curvature = static_cast<float>(l0);  // lambda_0 / trace: C has unit trace here
   return true;
+}
+
+// The same from the moments of a neighbourhood (m.n is the sum of the weights). The caller
+// checks that there are at least 3 points.
+bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature) {
+  double cov[6];
+  return unitCovariance(m, cov) && normalFromUnitCovariance(cov, n, curvature);
+}
+
+// normalFromUnitCovariance for count covariances at once (cov[k][i]: entry k of the i-th), in
+// float vector lanes, for the common case of a plane: where l1 >= 2 l0, nine products with B
+// leave an error below (1/2)^20 rad, 1e-6, the float precision. Elsewhere (l1 < 2 l0: no clear
+// plane; or a degenerate covariance) plane[i] = 0 and the lane's output is to be ignored: the
+// caller takes normalFromUnitCovariance, whose general eigen solver decides.
+UPD_VECTOR_CLONES
+void planeNormals(const double* __restrict a_, const double* __restrict b_,
+                  const double* __restrict c_, const double* __restrict d_,
+                  const double* __restrict e_, const double* __restrict f_, std::size_t count,
+                  float* __restrict nx, float* __restrict ny, float* __restrict nz,
+                  float* __restrict curvature, std::uint8_t* __restrict plane) {
+  for (std::size_t i = 0; i < count; ++i) {
+    const auto a = static_cast<float>(a_[i]), b = static_cast<float>(b_[i]),
+               c = static_cast<float>(c_[i]), d = static_cast<float>(d_[i]),
+               e = static_cast<float>(e_[i]), f = static_cast<float>(f_[i]);
+    const float A00 = d * f - e * e, A01 = c * e - b * f, A02 = b * e - c * d;
+    const float A11 = a * f - c * c, A12 = b * c - a * e, A22 = a * d - b * b;
+    const float adj_norm2 =
+        A00 * A00 + A11 * A11 + A22 * A22 + 2.f * (A01 * A01 + A02 * A02 + A12 * A12);
+    const float B00 = A00 * A00 + A01 * A01 + A02 * A02;
+    const float B01 = A00 * A01 + A01 * A11 + A02 * A12;
+    const float B02 = A00 * A02 + A01 * A12 + A02 * A22;
+    const float B11 = A01 * A01 + A11 * A11 + A12 * A12;
+    const float B12 = A01 * A02 + A11 * A12 + A12 * A22;
+    const float B22 = A02 * A02 + A12 * A12 + A22 * A22;
+    const bool col0 = B00 >= B11 && B00 >= B22, col1 = !col0 && B11 >= B22;
+    float vx = col0 ? B00 : col1 ? B01 : B02;
+    float vy = col0 ? B01 : col1 ? B11 : B12;
+    float vz = col0 ? B02 : col1 ? B12 : B22;
+    for (int it = 0; it < 9; ++it) {
+      // Normalized at every step: float has less room than double.
+      const float wx = B00 * vx + B01 * vy + B02 * vz;
+      const float wy = B01 * vx + B11 * vy + B12 * vz;
+      const float wz = B02 * vx + B12 * vy + B22 * vz;
+      const float k = 1.f / std::sqrt(wx * wx + wy * wy + wz * wz);
+      vx = wx * k, vy = wy * k, vz = wz * k;
+    }
+    const float q0 = vx * (a * vx + b * vy + c * vz) + vy * (b * vx + d * vy + e * vz) +
+                     vz * (c * vx + e * vy + f * vz);
+    // l1 and l2 from their sum 1 - l0 and their product, v's Rayleigh quotient of adj(C) (v is
+    // its eigenvector of eigenvalue l1 l2): l1 = 2 p / (sum + sqrt(sum^2 - 4 p)), a form
+    // without the cancellation that float would suffer on a flat surface (l0 ~ 1e-6).
+    const float p = vx * (A00 * vx + A01 * vy + A02 * vz) + vy * (A01 * vx + A11 * vy + A12 * vz) +
+                    vz * (A02 * vx + A12 * vy + A22 * vz);
+    const float sum = 1.f - q0;
+    const float l1 = 2.f * p / (sum + std::sqrt(std::max(0.f, sum * sum - 4.f * p)));
+    const bool finite = vx == vx && vy == vy && vz == vz && l1 == l1;
+    plane[i] = adj_norm2 > 1e-20f && l1 >= 2.f * q0 && finite ? 1 : 0;
+    nx[i] = vx, ny[i] = vy, nz[i] = vz;
+    curvature[i] = std::max(0.f, q0);  // lambda_0 / trace
+  }
 }
 
 inline void setUnset(Normals& out, std::size_t i) {
@@ -419,16 +488,40 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   // The centre pixel of block (bu, bv) along u or v (clamped to the image).
   const auto centreU = [&](std::ptrdiff_t bu) { return std::min(Wi - 1, bu * D + D / 2); };
   const auto centreV = [&](std::ptrdiff_t bv) { return std::min(Hi - 1, bv * D + D / 2); };
-#pragma omp parallel for schedule(dynamic, 16)
-  for (std::ptrdiff_t b = 0; b < static_cast<std::ptrdiff_t>(n_blocks); ++b) {
-    const std::ptrdiff_t bu = b % BW, bv = b / BW;
-    const std::ptrdiff_t cu = centreU(bu), cv = centreV(bv);
-    const std::size_t ci = static_cast<std::size_t>(cv) * W + static_cast<std::size_t>(cu);
-    if (!(range[ci] == range[ci])) continue;
-    const Moments m = scanMoments(cu, cv, ci);
-    Eigen::Vector3f n;
-    float curvature;
-    if (m.n >= 3 && normalFromMoments(m, n, curvature)) {
+  // Pass 1, in tasks of kTask blocks: the moments of each centre's ball, then the normals of
+  // the task's clear planes at once (planeNormals, vector lanes), then the rest one by one.
+  constexpr std::size_t kTask = 64;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t t = 0; t < static_cast<std::ptrdiff_t>((n_blocks + kTask - 1) / kTask); ++t) {
+    const std::size_t b0 = static_cast<std::size_t>(t) * kTask;
+    const std::size_t count = std::min(kTask, n_blocks - b0);
+    double cov[6][kTask];
+    float nx[kTask], ny[kTask], nz[kTask], curv[kTask];
+    std::uint8_t has_cov[kTask], plane[kTask];
+    for (std::size_t j = 0; j < count; ++j) {
+      const auto b = static_cast<std::ptrdiff_t>(b0 + j);
+      const std::ptrdiff_t cu = centreU(b % BW), cv = centreV(b / BW);
+      const std::size_t ci = static_cast<std::size_t>(cv) * W + static_cast<std::size_t>(cu);
+      double c[6] = {1, 0, 0, 0, 0, 0};  // (a placeholder where there is none)
+      has_cov[j] = range[ci] == range[ci] && [&] {
+        const Moments m = scanMoments(cu, cv, ci);
+        return m.n >= 3 && unitCovariance(m, c);
+      }();
+      for (int k = 0; k < 6; ++k) cov[k][j] = c[k];
+    }
+    planeNormals(cov[0], cov[1], cov[2], cov[3], cov[4], cov[5], count, nx, ny, nz, curv, plane);
+    for (std::size_t j = 0; j < count; ++j) {
+      if (!has_cov[j]) continue;
+      const std::size_t b = b0 + j;
+      Eigen::Vector3f n(nx[j], ny[j], nz[j]);
+      float curvature = curv[j];
+      if (!plane[j]) {
+        const double c[6] = {cov[0][j], cov[1][j], cov[2][j], cov[3][j], cov[4][j], cov[5][j]};
+        if (!normalFromUnitCovariance(c, n, curvature)) continue;
+      }
+      const auto bb = static_cast<std::ptrdiff_t>(b);
+      const std::size_t ci = static_cast<std::size_t>(centreV(bb / BW)) * W +
+                             static_cast<std::size_t>(centreU(bb % BW));
       float* const o = bn + 5 * b;
       o[0] = n.x(), o[1] = n.y(), o[2] = n.z(), o[3] = curvature, o[4] = range[ci];
     }
