@@ -286,46 +286,24 @@ typedef int LaneI __attribute__((vector_size(kScanLanes * sizeof(int))));
 static_assert(kScanLanes == 8, "the shuffles below pick 8 lanes");
 
 inline void loadLanes(LaneF& v, const float* p) { std::memcpy(&v, p, sizeof v); }
-// Every 2nd (4th) of the 16 (32) floats from p, by shuffles of whole vectors: a gather
-// through memory would stall on store forwarding.
-inline void evenLanes(LaneF& v, const float* p) {
-  LaneF a, b;
-  loadLanes(a, p), loadLanes(b, p + kScanLanes);
-  v = __builtin_shuffle(a, b, LaneI{0, 2, 4, 6, 8, 10, 12, 14});
-}
-inline void fourthLanes(LaneF& v, const float* p) {
-  LaneF a, b, c, d;
-  loadLanes(a, p), loadLanes(b, p + kScanLanes), loadLanes(c, p + 2 * kScanLanes),
-      loadLanes(d, p + 3 * kScanLanes);
-  const LaneF lo = __builtin_shuffle(a, b, LaneI{0, 4, 8, 12, 0, 4, 8, 12});
-  const LaneF hi = __builtin_shuffle(c, d, LaneI{0, 4, 8, 12, 0, 4, 8, 12});
-  v = __builtin_shuffle(lo, hi, LaneI{0, 1, 2, 3, 8, 9, 10, 11});
-}
-
-// Moments, relative to p, of the points within sqrt(radius2) of p among rows [v0, v1] and
-// columns [a0, a1] of the coordinate images (row stride W), every stride-th row and column.
-// Non-finite pixels hold kFar, so they fail the distance test like any far point; the columns
-// read past a1 (a vector at a time) are real points of the cloud or kFar padding, and the ones
-// within the radius are neighbours of p like any other (the window only bounds the ball).
+// Moments, relative to p, of the points within sqrt(radius2) of p among rows [v0, v1] (every
+// row_step-th) and columns [a0, a1] of the coordinate images (row stride W). Non-finite pixels
+// hold kFar, so they fail the distance test like any far point; the columns read past a1 (a
+// vector at a time) are real points of the cloud or kFar padding, and the ones within the
+// radius are neighbours of p like any other (the window only bounds the ball).
 UPD_VECTOR_CLONES
 Moments gatedMoments(const float* X, const float* Y, const float* Z, std::size_t W,
                      std::ptrdiff_t v0, std::ptrdiff_t v1, std::ptrdiff_t a0, std::ptrdiff_t a1,
-                     std::ptrdiff_t stride, float px, float py, float pz, float radius2) {
+                     std::ptrdiff_t row_step, float px, float py, float pz, float radius2) {
   const LaneF zero = {}, one = zero + 1.f;
   LaneF n = zero, sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero,
         syz = zero, szz = zero;
-  for (std::ptrdiff_t b = v0; b <= v1; b += stride) {
+  for (std::ptrdiff_t b = v0; b <= v1; b += row_step) {
     const std::size_t row = static_cast<std::size_t>(b) * W;
-    for (std::ptrdiff_t a = a0; a <= a1; a += kScanLanes * stride) {
+    for (std::ptrdiff_t a = a0; a <= a1; a += kScanLanes) {
       const std::size_t at = row + static_cast<std::size_t>(a);
       LaneF x, y, z;
-      if (stride == 1) {
-        loadLanes(x, X + at), loadLanes(y, Y + at), loadLanes(z, Z + at);
-      } else if (stride == 2) {
-        evenLanes(x, X + at), evenLanes(y, Y + at), evenLanes(z, Z + at);
-      } else {
-        fourthLanes(x, X + at), fourthLanes(y, Y + at), fourthLanes(z, Z + at);
-      }
+      loadLanes(x, X + at), loadLanes(y, Y + at), loadLanes(z, Z + at);
       const LaneF qx = x - px, qy = y - py, qz = z - pz;
       const LaneF d2 = qx * qx + qy * qy + qz * qz;
       const LaneF w = d2 <= radius2 ? one : zero;
@@ -443,6 +421,30 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
     scanImages(cloud.x.data(), cloud.y.data(), cloud.z.data(), origin, ref, begin,
                std::min(N, begin + kRows), range, X, Y, Z);
   }
+  // Every 2nd and every 4th column of the coordinate images, as images of their own (all the
+  // rows, kFar padding after the last): a window scanned every s-th column reads them whole
+  // vectors at a time.
+  static thread_local std::vector<float> sparse_buffer;
+  const std::size_t W2 = (W + 1) / 2, W4 = (W + 3) / 4;
+  const std::size_t len2 = H * W2 + kScanLanes, len4 = H * W4 + kScanLanes;
+  sparse_buffer.resize(3 * (len2 + len4));
+  float* const X2 = sparse_buffer.data();
+  float* const X4 = X2 + 3 * len2;
+  for (int k = 0; k < 3; ++k) {
+    std::fill(X2 + k * len2 + H * W2, X2 + (k + 1) * len2, kFar);
+    std::fill(X4 + k * len4 + H * W4, X4 + (k + 1) * len4, kFar);
+  }
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t v = 0; v < Hi; ++v) {
+    const auto row = static_cast<std::size_t>(v);
+    for (int k = 0; k < 3; ++k) {
+      const float* __restrict from = X + k * image_len + row * W;
+      float* __restrict to2 = X2 + k * len2 + row * W2;
+      float* __restrict to4 = X4 + k * len4 + row * W4;
+      for (std::size_t c = 0; c < W2; ++c) to2[c] = from[2 * c];
+      for (std::size_t c = 0; c < W4; ++c) to4[c] = from[4 * c];
+    }
+  }
   const std::vector<float> pitch_u = pitchProfile(cloud, range, true);
   const std::vector<float> pitch_v = pitchProfile(cloud, range, false);
   if (pitch_u.empty() || pitch_v.empty()) {
@@ -465,13 +467,21 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
         kMaxHalf, static_cast<std::ptrdiff_t>(angle / pitch_u[static_cast<std::size_t>(u)]) + 1);
     const auto ev = std::min<std::ptrdiff_t>(
         kMaxHalf, static_cast<std::ptrdiff_t>(angle / pitch_v[static_cast<std::size_t>(v)]) + 1);
-    // Every stride-th row and column (1, 2 or 4) so that at most kScanSide + 1 of each.
+    // Every stride-th row and column (1, 2 or 4) so that at most kScanSide + 1 of each: the
+    // columns of the sparse images, the window's first one rounded down to them.
     const std::ptrdiff_t side = 2 * std::max(eu, ev) + 1;
     const std::ptrdiff_t stride = side <= kScanSide + 1 ? 1 : side <= 2 * (kScanSide + 1) ? 2 : 4;
-    return gatedMoments(
-        X, Y, Z, W, std::max<std::ptrdiff_t>(0, v - ev), std::min<std::ptrdiff_t>(Hi - 1, v + ev),
-        std::max<std::ptrdiff_t>(0, u - eu), std::min<std::ptrdiff_t>(Wi - 1, u + eu), stride, X[i],
-        Y[i], Z[i], radius2);
+    const std::ptrdiff_t v0 = std::max<std::ptrdiff_t>(0, v - ev);
+    const std::ptrdiff_t v1 = std::min<std::ptrdiff_t>(Hi - 1, v + ev);
+    const std::ptrdiff_t a0 = std::max<std::ptrdiff_t>(0, u - eu) / stride;
+    const std::ptrdiff_t a1 = std::min<std::ptrdiff_t>(Wi - 1, u + eu) / stride;
+    if (stride == 1) {
+      return gatedMoments(X, Y, Z, W, v0, v1, a0, a1, 1, X[i], Y[i], Z[i], radius2);
+    }
+    const float* const S = stride == 2 ? X2 : X4;
+    const std::size_t len = stride == 2 ? len2 : len4;
+    return gatedMoments(S, S + len, S + 2 * len, stride == 2 ? W2 : W4, v0, v1, a0, a1, stride,
+                        X[i], Y[i], Z[i], radius2);
   };
   // A normal is computed at the centre of every block of D x D pixels (pass 1). A pixel takes
   // the normal of the nearest block centre on its surface (ranges within max_depth_jump_ratio
