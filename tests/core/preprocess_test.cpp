@@ -12,6 +12,24 @@ namespace {
 
 constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
 
+TEST(PointCloud, CountFiniteCountsPointsWithThreeFiniteCoordinates) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const float big = std::numeric_limits<float>::max();
+  PointCloud c;
+  c.push_back(0.f, 0.f, 0.f);      // finite
+  c.push_back(big, -big, 1e-38f);  // finite, at the ends of the range
+  c.push_back(inf, 0.f, 0.f);
+  c.push_back(0.f, -inf, 0.f);
+  c.push_back(0.f, 0.f, kNan);
+  c.push_back(-0.f, 5.f, -3.f);                                  // finite
+  for (int i = 0; i < 37; ++i) c.push_back(1.f * i, kNan, 2.f);  // past any vector width
+  c.push_back(1.f, 2.f, 3.f);                                    // finite
+  EXPECT_EQ(c.countFinite(), 4u);
+  std::size_t by_point = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) by_point += c.isFinite(i) ? 1 : 0;
+  EXPECT_EQ(by_point, 4u);
+}
+
 TEST(Preprocess, VoxelGridKeepsTheCentroidOfEachVoxelInOrderOfFirstAppearance) {
   PointCloud c;
   // Voxel edge 1, anchored at the first point: two points in voxel (0, 0, 0), one in
