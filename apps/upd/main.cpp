@@ -3,6 +3,8 @@
 #include "cli.h"
 #include "commands.h"
 
+#include <malloc.h>
+
 #include <cstring>
 #include <iostream>
 
@@ -36,6 +38,12 @@ void printHelp(std::ostream& os) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A frame loop frees and allocates buffers of a few MB per frame. By default glibc serves
+  // such blocks with fresh pages from the kernel every time (mmap, or a heap trimmed after
+  // each free), and the page faults and zeroing cost more than the UPD itself (playback of
+  // 640 x 480 frames: 18-30 ms per stage instead of 4-9). Keep them in the heap for reuse.
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
       !std::strcmp(argv[1], "help")) {
     printHelp(std::cout);

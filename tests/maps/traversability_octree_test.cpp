@@ -151,6 +151,60 @@ TEST(TraversabilityOctree, StoresTraversabilityBesideOccupancy) {
   EXPECT_EQ(stats.occupied_leaves, 30u * 20u + 4u * 5u + 1u);  // + the Unknown point
 }
 
+// Occupancy of the voxel at c in tree a equals that in tree b, for every leaf of a (a pruned
+// leaf is looked up at its centre: the same value covers the whole node).
+template <class A, class B>
+void expectSameOccupancy(const A& a, const B& b, const char* what) {
+  std::size_t leaves = 0;
+  for (auto it = a.begin_leafs(), end = a.end_leafs(); it != end; ++it, ++leaves) {
+    const auto* other = b.search(it.getCoordinate());
+    ASSERT_NE(other, nullptr) << what << " at " << it.getCoordinate();
+    EXPECT_FLOAT_EQ(it->getLogOdds(), other->getLogOdds()) << what << " at " << it.getCoordinate();
+  }
+  EXPECT_GT(leaves, 100u) << what;
+}
+
+TEST(TraversabilityOctree, DiscretizedInsertMatchesOctomapsOwnAndCountsEveryPoint) {
+  // Nine points per ground voxel, off the voxel centres, and a wall: many points per end
+  // voxel, as in a depth image.
+  Frame f;
+  for (int i = 10; i < 30; ++i) {
+    for (int j = -8; j < 8; ++j) {
+      for (int k = 0; k < 9; ++k) {
+        f.add((i + 0.1f + 0.1f * (k % 3)) * 0.1f, (j + 0.15f + 0.3f * (k / 3)) * 0.1f,
+              0.02f + 0.005f * k, k == 4 ? Label::NonTraversable : Label::Traversable, 1.0f, 0.0f,
+              0.1f);
+      }
+    }
+  }
+  for (int j = -3; j < 3; ++j) {
+    for (int k = 1; k < 6; ++k) {
+      f.add(3.07f, (j + 0.4f) * 0.1f, (k + 0.6f) * 0.1f, Label::NonTraversable, 0.8f, 1.2f, 1.0f);
+    }
+  }
+  for (const bool discretize : {true, false}) {
+    OctreeParams p = fixedParams();
+    p.discretize = discretize;
+    TraversabilityOcTree ours(p);
+    upd::maps::insertScan(ours, f.view(), kSensor, p, FusionParams{});
+    // OctoMap's own insert of the same points with the same option.
+    octomap::OcTree reference(p.resolution_m);
+    octomap::Pointcloud cloud;
+    for (std::size_t i = 0; i < f.x.size(); ++i) cloud.push_back(f.x[i], f.y[i], f.z[i]);
+    reference.insertPointCloud(cloud, octomap::point3d(0.f, 0.f, 1.f), p.max_range_m, false,
+                               discretize);
+    const char* what = discretize ? "discretized" : "one ray per point";
+    expectSameOccupancy(ours, reference, what);
+    expectSameOccupancy(reference, ours, what);
+    // Traversability still counts every labelled point of a voxel: 1 of 9 non-traversable.
+    const TraversabilityOcTreeNode* ground = ours.search(1.55, 0.05, 0.05);
+    ASSERT_NE(ground, nullptr) << what;
+    EXPECT_TRUE(ground->hasTraversability()) << what;
+    EXPECT_LT(ground->getNonTraversableProbability(), 0.5f) << what;
+    EXPECT_EQ(ground->getObservations(), 1u) << what;
+  }
+}
+
 TEST(TraversabilityOctree, InnerNodesHoldTheWorstChild) {
   const auto tree = sceneTree();
   float max_trav = -INFINITY, min_zeta = INFINITY, max_cost = -INFINITY;

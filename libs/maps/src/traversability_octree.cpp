@@ -329,29 +329,52 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
                                 static_cast<float>(sensor_origin_world.y()),
                                 static_cast<float>(sensor_origin_world.z()));
   const double max_range = params.max_range_m > 0 ? params.max_range_m : -1.0;
+  // The rays: one per point, or (discretize) one per end voxel from its centre, as OctoMap's
+  // computeDiscreteUpdate makes them. Consecutive points (image rows) mostly end in the same
+  // voxel: what depends only on the voxel is worked out once per change of voxel.
   octomap::Pointcloud cloud;
-  cloud.reserve(points.size);
+  cloud.reserve(params.discretize ? points.size / 16 + 16 : points.size);
+  octomap::KeySet ends;
   std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash> frame;
+  // The voxel of the previous finite point in the tree, whether OctoMap marks it as hit (with
+  // discretize: its centre within range and inside the box, as computeUpdate tests), and its
+  // FrameVoxel once a labelled point has used it.
+  octomap::OcTreeKey last_key;
+  bool have_last = false, last_hit = false;
+  FrameVoxel* last_voxel = nullptr;
+  const auto marksHit = [&](const octomap::point3d& end) {
+    return !(max_range > 0 && (end - origin).norm() > max_range) &&
+           !(tree.bbxSet() && !tree.inBBX(end));
+  };
   for (std::size_t i = 0; i < points.size; ++i) {
     const float x = points.x[i], y = points.y[i], z = points.z[i];
     if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
       ++stats.points_invalid;
       continue;
     }
-    cloud.push_back(x, y, z);
     ++stats.points_inserted;
+    const octomap::point3d p(x, y, z);
+    octomap::OcTreeKey key;
+    const bool in_tree = tree.coordToKeyChecked(p, key);
+    if (!params.discretize) cloud.push_back(p);
+    if (in_tree && !(have_last && key == last_key)) {
+      last_key = key;
+      have_last = true;
+      last_voxel = nullptr;
+      if (params.discretize) {
+        const octomap::point3d centre = tree.keyToCoord(key);
+        if (ends.insert(key).second) cloud.push_back(centre);
+        last_hit = marksHit(centre);
+      }
+    }
     const Label label = points.label[i];
     if (label != Label::Traversable && label != Label::NonTraversable) {
       ++stats.points_unknown;
       continue;
     }
-    // The voxels OctoMap marks as hit: within range and inside the box (as computeUpdate).
-    const octomap::point3d p(x, y, z);
-    if (max_range > 0 && (p - origin).norm() > max_range) continue;
-    if (tree.bbxSet() && !tree.inBBX(p)) continue;
-    octomap::OcTreeKey key;
-    if (!tree.coordToKeyChecked(p, key)) continue;
-    FrameVoxel& v = frame[key];
+    if (!in_tree || !(params.discretize ? last_hit : marksHit(p))) continue;
+    if (last_voxel == nullptr) last_voxel = &frame[key];
+    FrameVoxel& v = *last_voxel;
     if (label == Label::NonTraversable) {
       ++v.n_nontrav;
     } else {

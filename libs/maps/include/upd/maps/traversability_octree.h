@@ -91,6 +91,10 @@ struct OctreeParams {
   double prob_miss = 0.4;          ///< OctoMap occupancy update of the voxels a ray crosses
   double prob_clamp_min = 0.1192;  ///< OctoMap's default clamping (log-odds -2)
   double prob_clamp_max = 0.971;   ///< OctoMap's default clamping (log-odds 3.5)
+  /// true: one ray per end voxel, cast from its centre (OctoMap's discretized insert: the
+  /// same occupied voxels, free space carved from voxel centres; a 640 x 480 frame at 0.1 m
+  /// casts a few thousand rays instead of 300,000). false: one ray per point.
+  bool discretize = true;
   bool follow_robot = true;        ///< true: the update box follows the sensor; false: fixed box
   double extent_m = 40.0;          ///< side of the update box along x and y [m]
   double height_m = 10.0;          ///< size of the update box along z [m]
@@ -110,6 +114,9 @@ struct OctreeParams {
     v("prob_miss", prob_miss, "OctoMap occupancy probability of a crossed voxel (0..0.5)");
     v("prob_clamp_min", prob_clamp_min, "lower occupancy clamp (0..0.5)");
     v("prob_clamp_max", prob_clamp_max, "upper occupancy clamp (0.5..1)");
+    v("discretize", discretize,
+      "true: one ray per end voxel (OctoMap's discretized insert, much faster); false: one "
+      "ray per point");
     v("follow_robot", follow_robot, "true: the update box follows the sensor; false: fixed");
     v("extent_m", extent_m, "side of the update box along x and y [m] (memory bound)");
     v("height_m", height_m, "size of the update box along z [m] (memory bound)");
