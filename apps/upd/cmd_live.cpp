@@ -122,8 +122,8 @@ int runLive(const std::vector<std::string>& argv) {
     nav::BaseState s;
     base.readState(s);
     const PointCloud cloud_world =
-        nav::transformCloud(depthToCloud(frame.depth, frame.K),
-                            nav::bodyPoseFlat(s.pose_world_robot) * camera_on_robot);
+        transformCloud(depthToCloud(frame.depth, frame.K),
+                       nav::bodyPoseFlat(s.pose_world_robot) * camera_on_robot);
     const nav::FrameEvidence& ev = loop.addFrame(cloud_world, base.timeS());
     score_ms += ev.score_ms;
     ++frames;

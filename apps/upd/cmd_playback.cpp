@@ -264,6 +264,7 @@ int runPlayback(const std::vector<std::string>& argv) {
 
   try {
     mrptbridge::RawlogEntry entry;
+    mrptbridge::ObserverResult res;  // reused frame to frame
     while (reader.next(entry)) {
       ++read;
       // Every entry updates the pose tracker, so odometry between selected frames is kept.
@@ -278,7 +279,7 @@ int runPlayback(const std::vector<std::string>& argv) {
         continue;
       }
       const auto frame_start = std::chrono::steady_clock::now();
-      const mrptbridge::ObserverResult res = observer.observe(*entry.observation, pose.pose_world_robot);
+      observer.observe(*entry.observation, pose.pose_world_robot, res);
       if (!res.ok()) {
         ++skipped[res.skipped_reason];
         continue;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "upd/core/preprocess.h"
 
@@ -116,6 +117,50 @@ TEST(Preprocess, WithEveryStepOffTheInputComesBackUnchanged) {
   EXPECT_EQ(stats.points_in, 12u);
   EXPECT_EQ(stats.non_finite, 1u);
   EXPECT_EQ(stats.points_out, 12u);
+}
+
+}  // namespace
+}  // namespace upd
+
+namespace upd {
+namespace {
+
+// transformCloud and rotateVectors equal Eigen's per-point products; NaN stays NaN; the layout,
+// the colour and the sensor origin follow.
+TEST(PointCloud, TransformAndRotateEqualEigenPerPoint) {
+  PointCloud c;
+  for (int i = 0; i < 70000; ++i) {  // over the size that runs in parallel
+    c.push_back(0.001f * i, std::sin(0.01f * i), 2.f - 0.0005f * i, i % 256, 7, 9);
+  }
+  c.x[5] = std::numeric_limits<float>::quiet_NaN();
+  c.width = 700, c.height = 100;
+  c.sensor_origin = {0.1f, 0.2f, 0.3f};
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  t.translation() = Eigen::Vector3d(100.0, -5.0, 2.5);
+  PointCloud out;
+  out.x.assign(3, 42.f);  // stale contents are replaced
+  transformCloud(c, t, out);
+  ASSERT_EQ(out.size(), c.size());
+  EXPECT_EQ(out.width, 700u);
+  EXPECT_EQ(out.height, 100u);
+  EXPECT_EQ(out.r, c.r);
+  EXPECT_TRUE(std::isnan(out.x[5]) && std::isnan(out.y[5]) && std::isnan(out.z[5]));
+  const Eigen::Matrix3f r = t.linear().cast<float>();
+  const Eigen::Vector3f tr = t.translation().cast<float>();
+  for (std::size_t i = 0; i < c.size(); i += 997) {
+    if (i == 5) continue;
+    EXPECT_TRUE(out.point(i).isApprox(r * c.point(i) + tr, 1e-5f)) << i;
+  }
+  EXPECT_TRUE(out.sensor_origin.isApprox(r * c.sensor_origin + tr, 1e-6f));
+  EXPECT_THROW(transformCloud(c, t, c), std::invalid_argument);
+
+  std::vector<float> ox(c.size()), oy(c.size()), oz(c.size());
+  rotateVectors(r, c.size(), c.x.data(), c.y.data(), c.z.data(), ox.data(), oy.data(), oz.data());
+  EXPECT_TRUE(std::isnan(ox[5]));
+  for (std::size_t i = 1; i < c.size(); i += 1009) {
+    EXPECT_TRUE(Eigen::Vector3f(ox[i], oy[i], oz[i]).isApprox(r * c.point(i), 1e-5f)) << i;
+  }
 }
 
 }  // namespace

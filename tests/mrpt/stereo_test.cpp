@@ -189,7 +189,7 @@ TEST(Stereo, ObservationPathGivesTheSameCloudInTheRobotFrame) {
   ASSERT_TRUE(oc.organized());
   const PointCloud direct =
       upd::mrptbridge::stereoToCloud(pair.left, right_grey, pair.calib, StereoMatchParams(), true);
-  const PointCloud expected = upd::mrptbridge::transformCloud(
+  const PointCloud expected = upd::transformCloud(
       direct, upd::mrptbridge::toIsometry(mrpt::poses::CPose3D(obs.cameraPose)));
   ASSERT_EQ(oc.cloud_in_robot.size(), expected.size());
   EXPECT_EQ(oc.cloud_in_robot.countFinite(), expected.countFinite());

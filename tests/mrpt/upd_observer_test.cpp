@@ -107,6 +107,43 @@ TEST(UpdObserver, ScoresDoNotDependOnThePlanarRobotPose) {
   }
 }
 
+// A frame loop passes one result every frame: each call rewrites every field, as a fresh
+// result would hold them, whatever the previous frame left there.
+TEST(UpdObserver, ReusedResultEqualsAFreshOne) {
+  REQUIRE_GROUND_SCAN(obs);
+  const UpdObserver observer;
+  // The first frame pitched by 30 deg: other slopes, labels and costs than the second.
+  const Eigen::Isometry3d a =
+      upd::mrptbridge::toIsometry(mrpt::poses::CPose3D(0, 0, 0, 0, 30.0 * M_PI / 180.0, 0));
+  const Eigen::Isometry3d b =
+      upd::mrptbridge::toIsometry(mrpt::poses::CPose3D(3.0, -2.0, 0.0, 1.0, 0, 0));
+  ObserverResult reused;
+  observer.observe(*obs, a, reused);
+  observer.observe(*obs, b, reused);
+  const ObserverResult fresh = observer.observe(*obs, b);
+  ASSERT_EQ(reused.size(), fresh.size());
+  ASSERT_GT(fresh.size(), 0u);
+  EXPECT_EQ(reused.points_in_world.x, fresh.points_in_world.x);
+  EXPECT_EQ(reused.points_in_world.z, fresh.points_in_world.z);
+  EXPECT_TRUE(reused.points_in_world.sensor_origin.isApprox(fresh.points_in_world.sensor_origin));
+  const auto same = [](const std::vector<float>& u, const std::vector<float>& v) {
+    if (u.size() != v.size()) return false;
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      if (!(u[i] == v[i] || (std::isnan(u[i]) && std::isnan(v[i])))) return false;
+    }
+    return true;
+  };
+  EXPECT_TRUE(same(reused.normals_in_world.nx, fresh.normals_in_world.nx));
+  EXPECT_TRUE(same(reused.upd_in_world.ry, fresh.upd_in_world.ry));
+  EXPECT_TRUE(same(reused.upd_in_world.zeta, fresh.upd_in_world.zeta));
+  EXPECT_EQ(reused.upd_in_world.k, fresh.upd_in_world.k);
+  EXPECT_EQ(reused.classes.label, fresh.classes.label);
+  EXPECT_TRUE(same(reused.classes.cost, fresh.classes.cost));
+  EXPECT_EQ(reused.classes.traversable, fresh.classes.traversable);
+  EXPECT_EQ(reused.upd_in_world.invalid, fresh.upd_in_world.invalid);
+  EXPECT_TRUE(reused.pose_world_sensor.isApprox(fresh.pose_world_sensor));
+}
+
 // A robot pitched 10 deg in the world sees its own floor tilted: slope measured against gravity.
 TEST(UpdObserver, SlopeIsMeasuredAgainstGravity) {
   REQUIRE_GROUND_SCAN(obs);

@@ -49,20 +49,6 @@ void SourceParams::validate() const {
   stereo.validate();
 }
 
-PointCloud transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform) {
-  PointCloud out = cloud;
-  const Eigen::Matrix3f r = transform.linear().cast<float>();
-  const Eigen::Vector3f t = transform.translation().cast<float>();
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const Eigen::Vector3f p = r * Eigen::Vector3f(cloud.x[i], cloud.y[i], cloud.z[i]) + t;
-    out.x[i] = p.x();
-    out.y[i] = p.y();
-    out.z[i] = p.z();
-  }
-  out.sensor_origin = r * cloud.sensor_origin + t;
-  return out;
-}
-
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();

@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <stdexcept>
+#include <utility>
 
 namespace upd::mrptbridge {
 
@@ -65,26 +66,47 @@ ObserverResult UpdObserver::observe(const mrpt::obs::CObservation& obs,
 
 ObserverResult UpdObserver::observe(const mrpt::obs::CObservation& obs,
                                     const Eigen::Isometry3d& pose_world_robot) const {
+  ObserverResult result;
+  observe(obs, pose_world_robot, result);
+  return result;
+}
+
+void UpdObserver::observe(const mrpt::obs::CObservation& obs,
+                          const Eigen::Isometry3d& pose_world_robot, ObserverResult& result) const {
   const auto start = std::chrono::steady_clock::now();
   const ObservationCloud cloud = toCloud(obs, params_.source);
   const double convert_ms = detail::elapsedMs(start);
-  ObserverResult result = observeCloud(cloud, pose_world_robot);
+  observeCloud(cloud, pose_world_robot, result);
   result.timings.convert_ms = convert_ms;
   result.timings.total_ms = detail::elapsedMs(start);
-  return result;
 }
 
 ObserverResult UpdObserver::observeCloud(const ObservationCloud& cloud,
                                          const Eigen::Isometry3d& pose_world_robot) const {
-  const auto start = std::chrono::steady_clock::now();
   ObserverResult result;
+  observeCloud(cloud, pose_world_robot, result);
+  return result;
+}
+
+void UpdObserver::observeCloud(const ObservationCloud& cloud,
+                               const Eigen::Isometry3d& pose_world_robot,
+                               ObserverResult& result) const {
+  const auto start = std::chrono::steady_clock::now();
   result.source_class = cloud.source_class;
   result.skipped_reason = cloud.skipped_reason;
   result.pose_world_robot = pose_world_robot;
   result.pose_world_sensor = composeSensorPose(pose_world_robot, cloud.sensor_pose_on_robot);
+  result.organized_input = false;
+  result.points_input = 0;
+  result.timings = ObserverTimings{};
   if (!cloud.ok()) {
+    result.points_in_world = PointCloud{};
+    result.normals_in_world = Normals{};
+    result.upd_in_world = UpdResult{};
+    result.classes = Classification{};
+    result.preprocess_stats = PreprocessStats{};
     result.timings.total_ms = detail::elapsedMs(start);
-    return result;
+    return;
   }
   result.organized_input = cloud.organized();
   result.points_input = cloud.cloud_in_robot.countFinite();
@@ -92,30 +114,34 @@ ObserverResult UpdObserver::observeCloud(const ObservationCloud& cloud,
   PipelineParams pipeline = params_.pipeline;
   // Gravity (world +z) seen from the robot: +z for planar poses.
   pipeline.up = (pose_world_robot.linear().transpose() * Eigen::Vector3d::UnitZ()).cast<float>();
-  PipelineResult scored = runPipeline(cloud.cloud_in_robot, pipeline);
+  // The robot-frame results: the calling thread's, kept for its next frame.
+  static thread_local PipelineResult scored;
+  runPipeline(cloud.cloud_in_robot, pipeline, scored);
   result.timings.pipeline = scored.timings;
 
   const auto to_world_start = std::chrono::steady_clock::now();
-  result.points_in_world = transformCloud(scored.cloud, pose_world_robot);
+  transformCloud(scored.cloud, pose_world_robot, result.points_in_world);
   const Eigen::Matrix3f rotation = pose_world_robot.linear().cast<float>();
-  const auto rotate = [&rotation](std::vector<float>& x, std::vector<float>& y,
-                                  std::vector<float>& z) {
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      const Eigen::Vector3f v = rotation * Eigen::Vector3f(x[i], y[i], z[i]);  // NaN stays NaN
-      x[i] = v.x();
-      y[i] = v.y();
-      z[i] = v.z();
-    }
-  };
-  result.normals_in_world = std::move(scored.normals);
-  rotate(result.normals_in_world.nx, result.normals_in_world.ny, result.normals_in_world.nz);
-  result.upd_in_world = std::move(scored.upd);
-  rotate(result.upd_in_world.rx, result.upd_in_world.ry, result.upd_in_world.rz);
-  result.classes = std::move(scored.classes);
+  const std::size_t n = scored.cloud.size();
+  Normals& normals = result.normals_in_world;
+  normals.nx.resize(n), normals.ny.resize(n), normals.nz.resize(n);
+  rotateVectors(rotation, n, scored.normals.nx.data(), scored.normals.ny.data(),
+                scored.normals.nz.data(), normals.nx.data(), normals.ny.data(), normals.nz.data());
+  normals.curvature = scored.normals.curvature;
+  normals.invalid = scored.normals.invalid;
+  UpdResult& upd = result.upd_in_world;
+  upd.rx.resize(n), upd.ry.resize(n), upd.rz.resize(n);
+  rotateVectors(rotation, n, scored.upd.rx.data(), scored.upd.ry.data(), scored.upd.rz.data(),
+                upd.rx.data(), upd.ry.data(), upd.rz.data());
+  upd.zeta = scored.upd.zeta;
+  upd.k = scored.upd.k;
+  upd.invalid = scored.upd.invalid;
+  // Labels, costs and slopes are the same in both frames: the buffers change hands (the
+  // scratch gets result's previous ones, of the same size, to fill next frame).
+  std::swap(result.classes, scored.classes);
   result.preprocess_stats = scored.preprocess_stats;
   result.timings.to_world_ms = detail::elapsedMs(to_world_start);
   result.timings.total_ms = detail::elapsedMs(start);
-  return result;
 }
 
 }  // namespace upd::mrptbridge

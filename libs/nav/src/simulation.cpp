@@ -93,21 +93,6 @@ Eigen::Isometry3d bodyPoseFlat(const Pose2D& pose_world_robot) {
   return T;
 }
 
-PointCloud transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& pose_world_frame) {
-  PointCloud out = cloud;
-  const Eigen::Matrix3f R = pose_world_frame.linear().cast<float>();
-  const Eigen::Vector3f t = pose_world_frame.translation().cast<float>();
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    if (!cloud.isFinite(i)) continue;
-    const Eigen::Vector3f p = R * cloud.point(i) + t;
-    out.x[i] = p.x();
-    out.y[i] = p.y();
-    out.z[i] = p.z();
-  }
-  out.sensor_origin = R * cloud.sensor_origin + t;
-  return out;
-}
-
 PointCloud renderCameraWorld(const Terrain& terrain, const Eigen::Isometry3d& pose_world_body,
                              const CameraMountParams& mount, const DepthNoise& noise,
                              std::uint32_t seed) {

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <cstddef>
@@ -77,6 +78,17 @@ struct PointCloud {
     return n;
   }
 };
+
+/// Moves a cloud by a rigid transform: its points (NaN stays NaN; layout and colour kept) and
+/// its sensor origin. Into out, reusing its buffers (a frame loop allocates nothing after the
+/// first frame); out must not be cloud.
+void transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform, PointCloud& out);
+PointCloud transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform);
+
+/// out_i = rotation * (x_i, y_i, z_i) for n vectors (normals, UPD vectors r; NaN stays NaN).
+/// The output arrays must not overlap the input ones.
+void rotateVectors(const Eigen::Matrix3f& rotation, std::size_t n, const float* x, const float* y,
+                   const float* z, float* out_x, float* out_y, float* out_z);
 
 /// Per-point ground truth and classification labels (values are stable: written to PLY files).
 enum class Label : std::uint8_t { Traversable = 0, NonTraversable = 1, Unknown = 2 };

@@ -85,7 +85,4 @@ struct ObservationCloud {
 /// params.
 ObservationCloud toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params = {});
 
-/// Moves a cloud by a rigid transform (points and sensor_origin; layout, NaN and colour kept).
-PointCloud transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform);
-
 }  // namespace upd::mrptbridge

@@ -10,6 +10,9 @@
 // (odometry); a robot tilted in 3D (a ground-truth pose) still measures slope against gravity.
 //
 // The observer holds only its parameters: observe() is const and may run on several threads.
+// In a frame loop, pass the same ObserverResult to observe(obs, pose, result) every frame: its
+// buffers and the calling thread's robot-frame scratch are reused, and once warm a frame
+// allocates nothing for the scores (only the observation's conversion to a cloud does).
 #pragma once
 
 #include "upd/core/pipeline.h"
@@ -88,9 +91,14 @@ class UpdObserver {
                          const mrpt::poses::CPose3D& pose_world_robot) const;
   ObserverResult observe(const mrpt::obs::CObservation& obs,
                          const Eigen::Isometry3d& pose_world_robot) const;
+  /// The same into result, reusing its buffers (every field is rewritten).
+  void observe(const mrpt::obs::CObservation& obs, const Eigen::Isometry3d& pose_world_robot,
+               ObserverResult& result) const;
   /// For clouds already in the robot frame (e.g. stereoToCloud moved by the camera pose).
   ObserverResult observeCloud(const ObservationCloud& cloud,
                               const Eigen::Isometry3d& pose_world_robot) const;
+  void observeCloud(const ObservationCloud& cloud, const Eigen::Isometry3d& pose_world_robot,
+                    ObserverResult& result) const;
 
  private:
   ObserverParams params_;

@@ -71,10 +71,6 @@ Eigen::Isometry3d bodyPoseOnTerrain(const Terrain& terrain, const Pose2D& pose_w
 /// pose_world_robot in 3D for flat ground at z = 0 (live mode without terrain knowledge).
 Eigen::Isometry3d bodyPoseFlat(const Pose2D& pose_world_robot);
 
-/// Transforms an organized cloud with pose_world_frame (NaN points stay NaN, the layout is
-/// kept) and moves its sensor origin along.
-PointCloud transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& pose_world_frame);
-
 /// Renders what the camera sees from the body pose, as a cloud in the world frame with its
 /// sensor origin at the camera.
 PointCloud renderCameraWorld(const Terrain& terrain, const Eigen::Isometry3d& pose_world_body,
