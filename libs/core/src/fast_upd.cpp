@@ -544,7 +544,14 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   const std::size_t n_cells = sums.size();
 
   // 2. Lattice nodes: the 8 corners of every occupied cell.
-  std::vector<std::uint32_t> cell_nodes(8 * n_cells);
+  // The per-cell and per-node tables below live in the calling thread's buffers, kept for the
+  // next frame (as cell_of): a frame loop does not fault fresh pages in for them every frame.
+  // Every element read is written first. (Referenced through locals: inside a parallel region
+  // the name of a thread_local would be another thread's buffer.)
+  static thread_local std::vector<std::uint32_t> cell_nodes_buffer;
+  std::vector<std::uint32_t>& cell_nodes =
+      cell_nodes_buffer;  // shared by the parallel regions below
+  cell_nodes.resize(8 * n_cells);
   std::vector<std::int32_t> node_xyz;
   {
     CellMap node_map(4 * n_cells);
@@ -601,7 +608,9 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
 
   // What every cell with valid normals contributes, once; and for every block the cells of
   // the 27 blocks around it (every cell within d_m of one of its nodes).
-  std::vector<CellRow> rows(n_cells);
+  static thread_local std::vector<CellRow> rows_buffer;
+  std::vector<CellRow>& rows = rows_buffer;  // shared by the parallel regions below
+  rows.resize(n_cells);
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
     const CellSums& s = sums[static_cast<std::size_t>(cc)];
@@ -634,7 +643,9 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   // coordinates below or from `half` along each axis); a group sums over the cells that some
   // ball around its part of the block may touch (box distance <= m), a third to a half of the
   // block's candidates.
-  std::vector<NodeSums> node_sums(n_nodes);
+  static thread_local std::vector<NodeSums> node_sums_buffer;
+  std::vector<NodeSums>& node_sums = node_sums_buffer;  // shared by the parallel regions below
+  node_sums.resize(n_nodes);
   const float mf = static_cast<float>(m);
   const std::int32_t half = (B + 1) / 2;
 #pragma omp parallel
@@ -715,7 +726,9 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   }
 
   // 5. Every point from the blend of its cell's 8 nodes (interpolate, above), in chunks.
-  std::vector<CellBlend> blends(n_cells);
+  static thread_local std::vector<CellBlend> blends_buffer;
+  std::vector<CellBlend>& blends = blends_buffer;  // shared by the parallel regions below
+  blends.resize(n_cells);
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
     const auto c = static_cast<std::size_t>(cc);
