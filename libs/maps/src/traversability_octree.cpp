@@ -253,6 +253,14 @@ struct FrameVoxel {
   float zeta_min = std::numeric_limits<float>::quiet_NaN();
   double cost_sum = 0;
   std::uint32_t n_cost = 0;
+
+  void add(const FrameVoxel& o) {
+    n_nontrav += o.n_nontrav;
+    n_trav += o.n_trav;
+    zeta_min = std::fmin(zeta_min, o.zeta_min);  // NaN (none yet) gives the other
+    cost_sum += o.cost_sum;
+    n_cost += o.n_cost;
+  }
 };
 
 // Key of a coordinate, clamped to the tree's key range (box corners may lie beyond it). OctoMap's
@@ -336,12 +344,17 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
   cloud.reserve(params.discretize ? points.size / 16 + 16 : points.size);
   octomap::KeySet ends;
   std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash> frame;
-  // The voxel of the previous finite point in the tree, whether OctoMap marks it as hit (with
-  // discretize: its centre within range and inside the box, as computeUpdate tests), and its
-  // FrameVoxel once a labelled point has used it.
+  // The voxel of the previous finite point in the tree and whether OctoMap marks it as hit
+  // (with discretize: its centre within range and inside the box, as computeUpdate tests). The
+  // labelled points of a run in one voxel are summed in `run` and added to the frame's voxel
+  // when the run ends: one hash lookup per run.
   octomap::OcTreeKey last_key;
   bool have_last = false, last_hit = false;
-  FrameVoxel* last_voxel = nullptr;
+  FrameVoxel run;
+  const auto flush = [&] {
+    if (run.n_nontrav + run.n_trav > 0) frame[last_key].add(run);
+    run = FrameVoxel{};
+  };
   const auto marksHit = [&](const octomap::point3d& end) {
     return !(max_range > 0 && (end - origin).norm() > max_range) &&
            !(tree.bbxSet() && !tree.inBBX(end));
@@ -358,9 +371,9 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
     const bool in_tree = tree.coordToKeyChecked(p, key);
     if (!params.discretize) cloud.push_back(p);
     if (in_tree && !(have_last && key == last_key)) {
+      flush();
       last_key = key;
       have_last = true;
-      last_voxel = nullptr;
       if (params.discretize) {
         const octomap::point3d centre = tree.keyToCoord(key);
         if (ends.insert(key).second) cloud.push_back(centre);
@@ -373,21 +386,20 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
       continue;
     }
     if (!in_tree || !(params.discretize ? last_hit : marksHit(p))) continue;
-    if (last_voxel == nullptr) last_voxel = &frame[key];
-    FrameVoxel& v = *last_voxel;
     if (label == Label::NonTraversable) {
-      ++v.n_nontrav;
+      ++run.n_nontrav;
     } else {
-      ++v.n_trav;
+      ++run.n_trav;
     }
     if (points.zeta != nullptr && std::isfinite(points.zeta[i])) {
-      v.zeta_min = std::fmin(v.zeta_min, points.zeta[i]);
+      run.zeta_min = std::fmin(run.zeta_min, points.zeta[i]);
     }
     if (points.cost != nullptr && std::isfinite(points.cost[i])) {
-      v.cost_sum += points.cost[i];
-      ++v.n_cost;
+      run.cost_sum += points.cost[i];
+      ++run.n_cost;
     }
   }
+  flush();
 
   tree.insertPointCloud(cloud, origin, max_range, /*lazy_eval=*/true);
   for (const auto& [key, v] : frame) {
