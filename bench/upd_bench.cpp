@@ -264,30 +264,9 @@ class MapStage {
 #endif
   }
   void update(const PipelineResult& r, double time_s) {
-    const std::size_t n = r.cloud.size();
-    world_.x.resize(n), world_.y.resize(n), world_.z.resize(n);
-    world_.width = n, world_.height = 1;
-    const Eigen::Matrix3f R = pose_.linear();
+    // Into the world frame (upd::transformCloud: vectorized, into the buffers of the last frame).
+    transformCloud(r.cloud, pose_.cast<double>(), world_);
     const Eigen::Vector3f t = pose_.translation();
-    // Plain arithmetic over the coordinate arrays, so that the loop vectorizes.
-    const float* __restrict x = r.cloud.x.data();
-    const float* __restrict y = r.cloud.y.data();
-    const float* __restrict z = r.cloud.z.data();
-    float* __restrict wx = world_.x.data();
-    float* __restrict wy = world_.y.data();
-    float* __restrict wz = world_.z.data();
-    // The pose as plain floats: read through the matrix, they would be reloaded after every
-    // store (the compiler cannot rule out aliasing) and the loop would stay scalar.
-    const float r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2), tx = t.x();
-    const float r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2), ty = t.y();
-    const float r20 = R(2, 0), r21 = R(2, 1), r22 = R(2, 2), tz = t.z();
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
-      const auto i = static_cast<std::size_t>(ii);
-      wx[i] = r00 * x[i] + r01 * y[i] + r02 * z[i] + tx;
-      wy[i] = r10 * x[i] + r11 * y[i] + r12 * z[i] + ty;
-      wz[i] = r20 * x[i] + r21 * y[i] + r22 * z[i] + tz;
-    }
 #ifdef UPD_BENCH_HAVE_MAPS
     maps::integrateScan(*grid_, maps::viewPoints(world_, r.classes, &r.upd),
                         Eigen::Vector2d(t.x(), t.y()), time_s, fusion_);
@@ -295,7 +274,7 @@ class MapStage {
     (void)time_s;
     constexpr int kSide = 400;
     counts_.assign(2 * kSide * kSide, 0);
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < world_.size(); ++i) {
       const Label l = r.classes.label[i];
       if (l == Label::Unknown) continue;
       const int cx = static_cast<int>(std::floor((world_.x[i] - t.x()) / 0.05f)) + kSide / 2;
