@@ -549,8 +549,7 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   // Every element read is written first. (Referenced through locals: inside a parallel region
   // the name of a thread_local would be another thread's buffer.)
   static thread_local std::vector<std::uint32_t> cell_nodes_buffer;
-  std::vector<std::uint32_t>& cell_nodes =
-      cell_nodes_buffer;  // shared by the parallel regions below
+  std::vector<std::uint32_t>& cell_nodes = cell_nodes_buffer;
   cell_nodes.resize(8 * n_cells);
   std::vector<std::int32_t> node_xyz;
   {
@@ -609,7 +608,7 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   // What every cell with valid normals contributes, once; and for every block the cells of
   // the 27 blocks around it (every cell within d_m of one of its nodes).
   static thread_local std::vector<CellRow> rows_buffer;
-  std::vector<CellRow>& rows = rows_buffer;  // shared by the parallel regions below
+  std::vector<CellRow>& rows = rows_buffer;
   rows.resize(n_cells);
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
@@ -644,7 +643,7 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   // ball around its part of the block may touch (box distance <= m), a third to a half of the
   // block's candidates.
   static thread_local std::vector<NodeSums> node_sums_buffer;
-  std::vector<NodeSums>& node_sums = node_sums_buffer;  // shared by the parallel regions below
+  std::vector<NodeSums>& node_sums = node_sums_buffer;
   node_sums.resize(n_nodes);
   const float mf = static_cast<float>(m);
   const std::int32_t half = (B + 1) / 2;
@@ -727,7 +726,7 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
 
   // 5. Every point from the blend of its cell's 8 nodes (interpolate, above), in chunks.
   static thread_local std::vector<CellBlend> blends_buffer;
-  std::vector<CellBlend>& blends = blends_buffer;  // shared by the parallel regions below
+  std::vector<CellBlend>& blends = blends_buffer;
   blends.resize(n_cells);
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {

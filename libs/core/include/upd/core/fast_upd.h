@@ -32,9 +32,10 @@
 // of the points; the differences gather where zeta crosses zeta_min within a few cm of a sharp
 // step. Their number is about the density of points per unit of zeta at zeta_min times the
 // mean error there: a cluttered frame with a fifth of its points within 0.01 of zeta_min
-// (region_growing) flips the most. With 8 cells per d_m and fast_refine_spread = 0.02 the generated scenes agree on >= 99.6 %
-// of the labels, at about 4x the node work. On a plane every normal is equal, so r = k n exactly
-// and zeta = 1 at any slope. UpdResult::k is the interpolated count rounded to an integer.
+// (region_growing) flips the most. With 8 cells per d_m and fast_refine_spread = 0.02 the
+// generated scenes agree on >= 99.6 % of the labels, at about 4x the node work. On a plane every
+// normal is equal, so r = k n exactly and zeta = 1 at any slope. UpdResult::k is the
+// interpolated count rounded to an integer.
 #pragma once
 
 #include <cstddef>

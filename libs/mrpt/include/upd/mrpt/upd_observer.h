@@ -11,8 +11,9 @@
 //
 // The observer holds only its parameters: observe() is const and may run on several threads.
 // In a frame loop, pass the same ObserverResult to observe(obs, pose, result) every frame: its
-// buffers and the calling thread's robot-frame scratch are reused, and once warm a frame
-// allocates nothing for the scores (only the observation's conversion to a cloud does).
+// buffers and the calling thread's robot-frame scratch are reused. Once warm, a frame with
+// pre-processing off allocates nothing for the scores; the observation's conversion to a cloud
+// and the voxel grid / outlier filter, when enabled, still build fresh clouds.
 #pragma once
 
 #include "upd/core/pipeline.h"
