@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "fast_cell_map.h"
 #include "fast_simd.h"
 
@@ -245,12 +249,26 @@ std::vector<float> pitchProfile(const PointCloud& cloud, const float* range, boo
   const std::size_t lines = along_u ? H : W, len = along_u ? W : H;
   const std::size_t sampled = (lines + 15) / 16, pairs = len - 1;
   std::vector<float> chords(sampled * pairs);
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(sampled); ++k) {
-    const std::size_t l = 16 * static_cast<std::size_t>(k);
-    lineChords(cloud.x.data(), cloud.y.data(), cloud.z.data(), range, along_u ? l * W : l,
-               along_u ? 1 : W, pairs, cloud.sensor_origin,
-               &chords[static_cast<std::size_t>(k) * pairs]);
+  // Each thread reads the rows of its static share of the image, as in the stages after: rows
+  // are dealt out whole, columns by their pairs' rows. (Reading lines of the image that the
+  // other core writes next frame made that write twice as slow.)
+#pragma omp parallel
+  {
+#ifdef _OPENMP
+    const int team = omp_get_num_threads(), me = omp_get_thread_num();
+#else
+    const int team = 1, me = 0;
+#endif
+    const std::size_t k0 = along_u ? sampled * me / team : 0,
+                      k1 = along_u ? sampled * (me + 1) / team : sampled;
+    const std::size_t t0 = along_u ? 0 : pairs * me / team,
+                      t1 = along_u ? pairs : pairs * (me + 1) / team;
+    for (std::size_t k = k0; k < k1; ++k) {
+      const std::size_t l = 16 * k;
+      lineChords(cloud.x.data(), cloud.y.data(), cloud.z.data(), range,
+                 along_u ? l * W : l + t0 * W, along_u ? 1 : W, t1 - t0, cloud.sensor_origin,
+                 &chords[k * pairs + t0]);
+    }
   }
   std::vector<float> lowest(len, std::numeric_limits<float>::infinity());
   std::vector<float> all;
@@ -501,6 +519,8 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   // Pass 1, in tasks of kTask blocks: the moments of each centre's ball, then the normals of
   // the task's clear planes at once (planeNormals, vector lanes), then the rest one by one.
   constexpr std::size_t kTask = 64;
+  // (Dynamic: a near block's window holds many more pixels than a far one's. It reads the
+  // images and writes only the block table; pass 2, which writes every pixel, is static.)
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::ptrdiff_t t = 0; t < static_cast<std::ptrdiff_t>((n_blocks + kTask - 1) / kTask); ++t) {
     const std::size_t b0 = static_cast<std::size_t>(t) * kTask;
@@ -546,7 +566,7 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   {
     std::vector<std::uint8_t> taken(W);
     std::vector<float> spread(5 * W);
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(static)
     for (std::ptrdiff_t bv = 0; bv < BH; ++bv) {
       for (std::size_t u = 0; u < W; ++u) {
         const float* b = bn + 5 * (bv * BW + static_cast<std::ptrdiff_t>(u) / D);

@@ -501,11 +501,18 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   cell_of_buffer.resize(n_pts);
   std::uint32_t* const cell_of = cell_of_buffer.data();
   std::fill(cell_of, cell_of + first, kNoIndex);
-  constexpr std::size_t kChunk = std::size_t(1) << 15;
-  const std::size_t n_chunks = (n_pts - first + kChunk - 1) / kChunk;
+  // Chunks of equal size, at most 2^15 points (a multiple of 256), from the number of points
+  // alone: the same for any number of threads, and a static schedule gives two threads an
+  // equal share.
+  const std::size_t n_chunks = (n_pts - first + (std::size_t(1) << 15) - 1) >> 15;
+  const std::size_t kChunk = ((n_pts - first + n_chunks - 1) / n_chunks + 255) / 256 * 256;
   std::vector<Bins> chunk_bins(n_chunks);
   int all_fit = 1;
-#pragma omp parallel for schedule(dynamic, 1) reduction(& : all_fit)
+  // Static schedules here and below: every stage of a frame deals the points out to the threads
+  // in the same contiguous shares, so that a point's data stay in one core's cache (see
+  // copyCloud). Dynamic schedules scattered them, and on a two-vCPU VM a line the other core
+  // has read costs twice as much to write again.
+#pragma omp parallel for schedule(static) reduction(& : all_fit)
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
     const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
     all_fit &= binRange(cloud, normals, lat, begin, std::min(n_pts, begin + kChunk),
@@ -530,8 +537,9 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
       remap[c][j] = id;
     }
   }
-#pragma omp parallel for schedule(dynamic, 1)
-  for (std::ptrdiff_t c = 1; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
+    if (c == 0) continue;  // (from 0: the same shares as the binning)
     const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
     const std::size_t end = std::min(n_pts, begin + kChunk);
     for (std::size_t i = begin; i < end; ++i) {
@@ -733,11 +741,11 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
     const auto c = static_cast<std::size_t>(cc);
     if (!refine[c]) blends[c] = cellBlend(node_sums.data(), &cell_nodes[8 * c]);
   }
-  std::size_t invalid = 0;
-  const std::size_t n_blocks_pts = (n_pts + kChunk - 1) / kChunk;
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : invalid)
+  std::size_t invalid = first;  // the points before the first finite one
+  const std::size_t n_blocks_pts = (n_pts - first + kChunk - 1) / kChunk;
+#pragma omp parallel for schedule(static) reduction(+ : invalid)
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_blocks_pts); ++c) {
-    const std::size_t begin = static_cast<std::size_t>(c) * kChunk;
+    const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
     const std::size_t end = std::min(n_pts, begin + kChunk);
     invalid += interpolate(cloud, lat, cell_of, cell_xyz.data(), blends.data(), refine.data(),
                            static_cast<float>(params.min_neighbors), begin, end, out);

@@ -1,6 +1,11 @@
 #include "upd/core/point_cloud.h"
 
+#include <cstring>
 #include <stdexcept>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace upd {
 
@@ -22,13 +27,56 @@ void applyTransform(const Eigen::Matrix3f& r, const Eigen::Vector3f& t, std::siz
     oz[i] = r20 * x[i] + r21 * y[i] + r22 * z[i] + tz;
   }
 }
+
+// Each thread of the team copies its static share of the colour arrays (none when absent).
+void copyColour(const PointCloud& in, PointCloud& out) {
+  out.r.resize(in.r.size()), out.g.resize(in.g.size()), out.b.resize(in.b.size());
+  const std::size_t n = in.r.size();
+  if (n == 0 || in.g.size() != n || in.b.size() != n) {
+    out.r = in.r, out.g = in.g, out.b = in.b;
+    return;
+  }
+#pragma omp parallel if (n > 65536)
+  {
+#ifdef _OPENMP
+    const int team = omp_get_num_threads(), me = omp_get_thread_num();
+#else
+    const int team = 1, me = 0;
+#endif
+    const std::size_t begin = n * me / team, len = n * (me + 1) / team - begin;
+    std::memcpy(out.r.data() + begin, in.r.data() + begin, len);
+    std::memcpy(out.g.data() + begin, in.g.data() + begin, len);
+    std::memcpy(out.b.data() + begin, in.b.data() + begin, len);
+  }
+}
 }  // namespace
+
+std::size_t copyCloud(const PointCloud& in, PointCloud& out) {
+  if (&out == &in) return in.countFinite();
+  const std::size_t n = in.size();
+  out.x.resize(n), out.y.resize(n), out.z.resize(n);
+  copyColour(in, out);
+  out.width = in.width;
+  out.height = in.height;
+  out.sensor_origin = in.sensor_origin;
+  const float *x = in.x.data(), *y = in.y.data(), *z = in.z.data();
+  float *ox = out.x.data(), *oy = out.y.data(), *oz = out.z.data();
+  std::size_t finite = 0;
+  // The same static split as applyTransform and the stages after it.
+#pragma omp parallel for schedule(static) if (n > 65536) reduction(+ : finite)
+  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    ox[i] = x[i], oy[i] = y[i], oz[i] = z[i];
+    finite += x[i] * 0.f + y[i] * 0.f + z[i] * 0.f == 0.f ? 1 : 0;  // as countFinite
+  }
+  return finite;
+}
 
 void transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform, PointCloud& out) {
   if (&out == &cloud) throw std::invalid_argument("transformCloud: out must not be the input");
   const std::size_t n = cloud.size();
   out.x.resize(n), out.y.resize(n), out.z.resize(n);
-  out.r = cloud.r, out.g = cloud.g, out.b = cloud.b;
+  copyColour(cloud, out);
   out.width = cloud.width;
   out.height = cloud.height;
   const Eigen::Matrix3f r = transform.linear().cast<float>();

@@ -222,11 +222,11 @@ void preprocess(const PointCloud& in, const PreprocessParams& p, PointCloud& out
     return;
   }
   p.validate();
-  out = in;  // copy assignment keeps out's buffers when they are large enough
+  const std::size_t finite = copyCloud(in, out);
   if (stats) {
     *stats = PreprocessStats{};
     stats->points_in = stats->after_voxel = stats->points_out = in.size();
-    stats->non_finite = in.size() - in.countFinite();
+    stats->non_finite = in.size() - finite;
   }
 }
 

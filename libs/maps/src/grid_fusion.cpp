@@ -25,8 +25,6 @@ static_assert(static_cast<int>(Label::Traversable) == 0 &&
 // Cell codes of points that have no cell (above any cell index: at most 46000^2 cells).
 constexpr std::uint32_t kInvalid = 0xFFFFFFFFu, kUnknown = 0xFFFFFFFEu, kOutside = 0xFFFFFFFDu;
 constexpr std::uint32_t kNoSlot = 0xFFFFFFFFu;
-// Grid rows dealt to a thread at a time: a view covers a few bands, not half the grid.
-constexpr int kBandRows = 8;
 // Points whose cells are computed at once, then scanned for runs while still in L1.
 constexpr std::size_t kBlock = 2048;
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -185,18 +183,18 @@ struct RunInputs {
 };
 
 // Adds the runs of one chunk (starting at run_begin[0, count), the last one ending at
-// chunk_end) that fall in the bands of this thread to their FrameCells, appending those of
-// newly touched cells to frame.
+// chunk_end) that fall in the rows [row_lo, row_hi) of this thread to their FrameCells,
+// appending those of newly touched cells to frame.
 UPD_VECTOR_CLONES
 void addChunkRuns(const std::size_t* run_begin, std::size_t count, std::size_t chunk_end,
-                  const RunInputs& in, const std::uint8_t* band_is_mine,
+                  const RunInputs& in, std::uint32_t row_lo, std::uint32_t row_hi,
                   std::vector<FrameCell>& frame) {
   for (std::size_t r = 0; r < count; ++r) {
     const std::uint32_t cell = in.cell_of[run_begin[r]];
     // cell / size_x without a division: (cell + 0.5) / size_x is 0.5 / size_x or more from a
     // whole number, far more than the product's rounding.
     const auto row = static_cast<std::uint32_t>((cell + 0.5) * in.inv_size_x);
-    if (!band_is_mine[row / kBandRows]) continue;
+    if (row < row_lo || row >= row_hi) continue;
     std::uint32_t& slot = in.slots[cell];
     if (slot == kNoSlot) {
       slot = static_cast<std::uint32_t>(frame.size());
@@ -235,10 +233,12 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
   // Buffers shared by the team: the calling thread's, taken before the parallel region.
   static thread_local std::vector<std::uint32_t> point_cell, slot_of_cell, row_span_of;
   static thread_local std::vector<std::size_t> run_begin_of, run_count_of;
+  static thread_local std::vector<std::uint32_t> runs_per_row_of;  // per thread, per grid row
   static thread_local std::vector<float> no_values;  // NaN: the layer a view lacks
   point_cell.resize(points.size);
   run_begin_of.resize(points.size);
   run_count_of.resize(static_cast<std::size_t>(max_team));
+  runs_per_row_of.resize(static_cast<std::size_t>(max_team) * size_y);
   const std::size_t n_cells = static_cast<std::size_t>(size_x) * size_y;
   if (slot_of_cell.size() < n_cells) slot_of_cell.assign(n_cells, kNoSlot);
   if (row_span_of.size() < 2 * static_cast<std::size_t>(size_y)) {
@@ -250,6 +250,7 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
   std::uint32_t* const cell_of = point_cell.data();
   std::size_t* const run_begin = run_begin_of.data();
   std::size_t* const run_count = run_count_of.data();
+  std::uint32_t* const runs_per_row = runs_per_row_of.data();
   std::uint32_t* const slots = slot_of_cell.data();
   std::uint32_t* const row_span = row_span_of.data();
   const RunInputs run_inputs{cell_of,
@@ -276,6 +277,8 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
                       chunk_end = points.size * (me + 1) / team;
     std::size_t* const my_runs = run_begin + chunk_begin;
     std::size_t n_runs = 0;
+    std::uint32_t* const my_rows = runs_per_row + static_cast<std::size_t>(me) * size_y;
+    std::fill(my_rows, my_rows + size_y, 0u);
     std::uint8_t starts[kBlock];
     for (std::size_t block = chunk_begin; block < chunk_end; block += kBlock) {
       const std::size_t block_end = std::min(chunk_end, block + kBlock);
@@ -291,71 +294,84 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
         last = cell_of[i] < kOutside ? cell_of[i] : last;
       }
       runStarts(cell_of, i, block_end, starts + (i - block));
+      const std::size_t block_runs = n_runs;
       for (i = block; i < block_end; ++i) {
         my_runs[n_runs] = i;  // kept only where a run starts: no branch
         n_runs += starts[i - block];
+      }
+      for (std::size_t r = block_runs; r < n_runs; ++r) {
+        ++my_rows[static_cast<std::uint32_t>((cell_of[my_runs[r]] + 0.5) * run_inputs.inv_size_x)];
       }
     }
     run_count[me] = n_runs;
 #pragma omp barrier
 
-    // 2. Per-frame sums per touched cell. The grid's rows are dealt to the threads in bands,
-    // round-robin: every thread reads the runs of all chunks and takes those of its bands, in
-    // point order, so the result does not depend on the number of threads. A dense slot table
-    // over the grid (shared: each cell belongs to one thread; reset after use) points each
-    // touched cell to its FrameCell; per row, the span of touched columns.
-    static thread_local std::vector<FrameCell> frame;  // this thread's own
-    static thread_local std::vector<std::uint8_t> band_is_mine;
-    frame.clear();
-    band_is_mine.resize(static_cast<std::size_t>((size_y + kBandRows - 1) / kBandRows));
-    for (std::size_t b = 0; b < band_is_mine.size(); ++b) {
-      band_is_mine[b] = static_cast<int>(b % team) == me;
+    // 2. Per-frame sums per touched cell. Each thread takes a range of the grid's rows holding
+    // about its share of the runs: every thread reads the runs of all chunks and takes those
+    // in its rows, in point order, so the result does not depend on the number of threads. A
+    // dense slot table over the grid (shared: each cell belongs to one thread; reset after
+    // use) points each touched cell to its FrameCell; per row, the span of touched columns.
+    std::size_t total_runs = 0;
+    for (int c = 0; c < team; ++c) total_runs += run_count[c];
+    const std::size_t share_lo = total_runs * me / team, share_hi = total_runs * (me + 1) / team;
+    std::uint32_t row_lo = static_cast<std::uint32_t>(size_y), row_hi = row_lo;
+    std::size_t before = 0;  // runs in the rows before
+    for (std::uint32_t row = 0; row < static_cast<std::uint32_t>(size_y); ++row) {
+      if (before >= share_lo && row_lo == static_cast<std::uint32_t>(size_y)) row_lo = row;
+      if (before >= share_hi) {
+        row_hi = row;
+        break;
+      }
+      for (int c = 0; c < team; ++c)
+        before += runs_per_row[static_cast<std::size_t>(c) * size_y + row];
     }
+    if (me == 0) row_lo = 0;
+    if (me == team - 1) row_hi = static_cast<std::uint32_t>(size_y);
+    static thread_local std::vector<FrameCell> frame;  // this thread's own
+    frame.clear();
     for (int c = 0; c < team; ++c) {
-      addChunkRuns(run_begin + points.size * c / team, run_count[c],
-                   points.size * (c + 1) / team, run_inputs, band_is_mine.data(), frame);
+      addChunkRuns(run_begin + points.size * c / team, run_count[c], points.size * (c + 1) / team,
+                   run_inputs, row_lo, row_hi, frame);
     }
 
     // 3. One update per touched cell, in grid order: the grid is larger than the caches, and
     // sequential access lets the hardware prefetch.
-    for (int band = me; band * kBandRows < size_y; band += team) {
-      for (int cy = band * kBandRows; cy < std::min(size_y, (band + 1) * kBandRows); ++cy) {
-        std::uint32_t* const row_slots = slots + static_cast<std::size_t>(cy) * size_x;
-        std::uint32_t* const span = row_span + 2 * cy;
-        const int first = static_cast<int>(span[0]), last = static_cast<int>(span[1]);
-        span[0] = span[1] = 0;
-        for (int cx = first; cx < last; ++cx) {
-          // FrameCells are in first-touch order, and step 2 has streamed the points through the
-          // caches since: fetch them a few cells ahead.
-          const std::uint32_t ahead = cx + 8 < last ? row_slots[cx + 8] : kNoSlot;
-          if (ahead != kNoSlot) __builtin_prefetch(frame.data() + ahead);
-          if (row_slots[cx] == kNoSlot) continue;
-          const FrameCell& f = frame[row_slots[cx]];
-          row_slots[cx] = kNoSlot;
-          const std::uint32_t n = f.count[kZ];
-          used += n;
-          const double update = frameLogOddsUpdate(f.n_nontrav, n - f.n_nontrav, params);
-          if (update == 0.0) {
-            ++sparse;
-            continue;
-          }
-          GridCell& c = grid.at(cx, cy);
-          c.logodds_nontrav = fuseLogOdds(c.logodds_nontrav, update, params);
-          ++updated;
-          if (update > 0) ++hit;
-
-          c.elevation_m = mergeMean(c.elevation_m, c.hits, f.sum[kZ], n);
-          c.elevation_max_m = std::fmax(c.elevation_max_m, -f.least[kZ]);
-          if (f.count[kZeta] > 0) c.zeta_min = std::fmin(c.zeta_min, f.least[kZeta]);
-          c.zeta_mean = mergeMean(c.zeta_mean, c.zeta_count, f.sum[kZeta], f.count[kZeta]);
-          c.slope_rad = mergeMean(c.slope_rad, c.slope_count, f.sum[kSlope], f.count[kSlope]);
-          c.cost_mean = mergeMean(c.cost_mean, c.cost_count, f.sum[kCost], f.count[kCost]);
-          c.hits = addSaturating(c.hits, n);
-          c.zeta_count = addSaturating(c.zeta_count, f.count[kZeta]);
-          c.slope_count = addSaturating(c.slope_count, f.count[kSlope]);
-          c.cost_count = addSaturating(c.cost_count, f.count[kCost]);
-          c.last_seen_s = time_s;
+    for (int cy = static_cast<int>(row_lo); cy < static_cast<int>(row_hi); ++cy) {
+      std::uint32_t* const row_slots = slots + static_cast<std::size_t>(cy) * size_x;
+      std::uint32_t* const span = row_span + 2 * cy;
+      const int first = static_cast<int>(span[0]), last = static_cast<int>(span[1]);
+      span[0] = span[1] = 0;
+      for (int cx = first; cx < last; ++cx) {
+        // FrameCells are in first-touch order, and step 2 has streamed the points through the
+        // caches since: fetch them a few cells ahead.
+        const std::uint32_t ahead = cx + 8 < last ? row_slots[cx + 8] : kNoSlot;
+        if (ahead != kNoSlot) __builtin_prefetch(frame.data() + ahead);
+        if (row_slots[cx] == kNoSlot) continue;
+        const FrameCell& f = frame[row_slots[cx]];
+        row_slots[cx] = kNoSlot;
+        const std::uint32_t n = f.count[kZ];
+        used += n;
+        const double update = frameLogOddsUpdate(f.n_nontrav, n - f.n_nontrav, params);
+        if (update == 0.0) {
+          ++sparse;
+          continue;
         }
+        GridCell& c = grid.at(cx, cy);
+        c.logodds_nontrav = fuseLogOdds(c.logodds_nontrav, update, params);
+        ++updated;
+        if (update > 0) ++hit;
+
+        c.elevation_m = mergeMean(c.elevation_m, c.hits, f.sum[kZ], n);
+        c.elevation_max_m = std::fmax(c.elevation_max_m, -f.least[kZ]);
+        if (f.count[kZeta] > 0) c.zeta_min = std::fmin(c.zeta_min, f.least[kZeta]);
+        c.zeta_mean = mergeMean(c.zeta_mean, c.zeta_count, f.sum[kZeta], f.count[kZeta]);
+        c.slope_rad = mergeMean(c.slope_rad, c.slope_count, f.sum[kSlope], f.count[kSlope]);
+        c.cost_mean = mergeMean(c.cost_mean, c.cost_count, f.sum[kCost], f.count[kCost]);
+        c.hits = addSaturating(c.hits, n);
+        c.zeta_count = addSaturating(c.zeta_count, f.count[kZeta]);
+        c.slope_count = addSaturating(c.slope_count, f.count[kSlope]);
+        c.cost_count = addSaturating(c.cost_count, f.count[kCost]);
+        c.last_seen_s = time_s;
       }
     }
   }
