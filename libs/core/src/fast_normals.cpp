@@ -561,11 +561,26 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   // others (no valid range, a depth edge, a failed centre) then go through the general rule.
   const OrientConstants oc{origin.x(), origin.y(), origin.z(),     up.x(),
                            up.y(),     up.z(),     orient.sin_band};
+  // The pixels that need a scan of their own (no block centre on their surface) gather in
+  // per-thread lists and are scanned after the rows, shared out dynamically: they cluster at
+  // depth edges, and a static share of them left one thread with most of the work.
   std::size_t invalid = 0;
+#ifdef _OPENMP
+  const int max_team = omp_get_max_threads();
+#else
+  const int max_team = 1;
+#endif
+  std::vector<std::vector<std::uint32_t>> own_scan(static_cast<std::size_t>(max_team));
+  std::vector<std::uint32_t> to_scan;
 #pragma omp parallel reduction(+ : invalid)
   {
     std::vector<std::uint8_t> taken(W);
     std::vector<float> spread(5 * W);
+#ifdef _OPENMP
+    std::vector<std::uint32_t>& my_scan = own_scan[static_cast<std::size_t>(omp_get_thread_num())];
+#else
+    std::vector<std::uint32_t>& my_scan = own_scan[0];
+#endif
 #pragma omp for schedule(static)
     for (std::ptrdiff_t bv = 0; bv < BH; ++bv) {
       for (std::size_t u = 0; u < W; ++u) {
@@ -609,22 +624,32 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
               }
             }
           }
-          Eigen::Vector3f n;
-          float curvature;
-          if (pick != nullptr) {
-            n = Eigen::Vector3f(pick[0], pick[1], pick[2]);
-            curvature = pick[3];
-          } else {
-            const Moments m = scanMoments(u, v, i);
-            if (!(m.n >= 3 && normalFromMoments(m, n, curvature))) {
-              setUnset(out, i);
-              ++invalid;
-              continue;
-            }
+          if (pick == nullptr) {
+            my_scan.push_back(static_cast<std::uint32_t>(i));
+            continue;
           }
-          setNormal(out, i, orient(n, cloud.point(i)), curvature);
+          setNormal(out, i, orient(Eigen::Vector3f(pick[0], pick[1], pick[2]), cloud.point(i)),
+                    pick[3]);
         }
       }
+    }
+#pragma omp single
+    {
+      for (const auto& list : own_scan) to_scan.insert(to_scan.end(), list.begin(), list.end());
+    }
+#pragma omp for schedule(dynamic, 16)
+    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(to_scan.size()); ++k) {
+      const std::size_t i = to_scan[static_cast<std::size_t>(k)];
+      const auto u = static_cast<std::ptrdiff_t>(i % W), v = static_cast<std::ptrdiff_t>(i / W);
+      Eigen::Vector3f n;
+      float curvature;
+      const Moments m = scanMoments(u, v, i);
+      if (!(m.n >= 3 && normalFromMoments(m, n, curvature))) {
+        setUnset(out, i);
+        ++invalid;
+        continue;
+      }
+      setNormal(out, i, orient(n, cloud.point(i)), curvature);
     }
   }
   out.invalid = invalid;
