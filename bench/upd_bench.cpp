@@ -46,6 +46,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -701,12 +702,17 @@ int run(const Options& o) {
   json& root = report.root;
   std::printf("upd_bench: data from %s%s\n", o.data_dir.c_str(), o.quick ? " (--quick)" : "");
   const double bandwidth = copyBandwidthGBs();
+  // The OpenMP wait policy changes the two-core timings: threads woken from sleep for each
+  // parallel region (passive) cost more than threads that spin a while first (the default).
+  const char* policy_env = std::getenv("OMP_WAIT_POLICY");
+  const std::string policy = policy_env && *policy_env ? policy_env : "default";
   root["machine"] = {{"cpu", cpuModel()},
                      {"logical_cpus", omp_get_num_procs()},
                      {"copy_bandwidth_GBps", bandwidth},
-                     {"compiler", __VERSION__}};
-  std::printf("machine: %s, %d logical CPUs, copy bandwidth %.1f GB/s\n", cpuModel().c_str(),
-              omp_get_num_procs(), bandwidth);
+                     {"compiler", __VERSION__},
+                     {"omp_wait_policy", policy}};
+  std::printf("machine: %s, %d logical CPUs, copy bandwidth %.1f GB/s, OMP_WAIT_POLICY %s\n",
+              cpuModel().c_str(), omp_get_num_procs(), bandwidth, policy.c_str());
   root["map_stage"] = MapStage::kind();
 
   // ------------------------------------------------------------------ Kinect frames.
