@@ -119,6 +119,56 @@ TEST(Preprocess, WithEveryStepOffTheInputComesBackUnchanged) {
   EXPECT_EQ(stats.points_out, 12u);
 }
 
+// A sensor-rate config (range cut and box only) on an organized frame runs in the caller's
+// buffers; it must give what the copying path gives, point for point, stats included.
+TEST(Preprocess, RangeCutIntoReusedBuffersEqualsTheCopyingPath) {
+  PointCloud c;
+  c.resizeOrganized(400, 200);  // over the size that runs in parallel
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (i % 97 == 3) continue;  // stays NaN
+    const float t = 0.001f * static_cast<float>(i);
+    c.x[i] = std::sin(t) * 3.f, c.y[i] = std::cos(1.3f * t) * 2.f, c.z[i] = 0.5f + 0.07f * t;
+  }
+  c.x[10] = std::numeric_limits<float>::infinity();
+  c.sensor_origin = {0.1f, -0.2f, 0.3f};
+  for (const bool box : {false, true}) {
+    PreprocessParams p;
+    p.disableAll();
+    p.range_enabled = true;
+    p.range_min_m = 0.7;
+    p.range_max_m = 3.0;
+    p.box_enabled = box;
+    p.box_min_m = {-2.f, -1.5f, -1.f};
+    p.box_max_m = {2.5f, 1.5f, 4.f};
+    PreprocessStats expected_stats, stats;
+    const PointCloud expected = preprocess(c, p, &expected_stats);
+    PointCloud out;
+    preprocess(c, p, out, &stats);  // twice: the second run reuses the first one's buffers
+    preprocess(c, p, out, &stats);
+    ASSERT_EQ(out.size(), expected.size()) << "box " << box;
+    EXPECT_EQ(out.width, expected.width);
+    EXPECT_EQ(out.height, expected.height);
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const bool nan_expected = std::isnan(expected.x[i]);
+      ASSERT_EQ(std::isnan(out.x[i]), nan_expected) << "point " << i << ", box " << box;
+      if (!nan_expected) {
+        ASSERT_EQ(out.x[i], expected.x[i]);
+        ASSERT_EQ(out.y[i], expected.y[i]);
+        ASSERT_EQ(out.z[i], expected.z[i]);
+      }
+      removed += nan_expected && c.isFinite(i) ? 1 : 0;
+    }
+    EXPECT_GT(removed, 1000u) << "the cut must remove points for the test to mean anything";
+    EXPECT_EQ(stats.points_in, expected_stats.points_in);
+    EXPECT_EQ(stats.non_finite, expected_stats.non_finite);
+    EXPECT_EQ(stats.range_removed, expected_stats.range_removed);
+    EXPECT_EQ(stats.after_voxel, expected_stats.after_voxel);
+    EXPECT_EQ(stats.outliers_removed, expected_stats.outliers_removed);
+    EXPECT_EQ(stats.points_out, expected_stats.points_out);
+  }
+}
+
 }  // namespace
 }  // namespace upd
 

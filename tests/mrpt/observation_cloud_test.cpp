@@ -152,6 +152,48 @@ TEST(ObservationCloud, RgbdRawlogIsOrganized640x480) {
   EXPECT_FALSE(toCloud(*obs, no_color).cloud_in_robot.hasColor());
 }
 
+// One ObservationCloud reused across observations of different kinds (a colour RGB-D frame, an
+// observation without points, a points-only scan, the RGB-D frame again) holds what a fresh
+// conversion gives each time: nothing left over from the one before.
+bool sameCloud(const PointCloud& a, const PointCloud& b) {
+  if (a.size() != b.size() || a.width != b.width || a.height != b.height || a.r != b.r ||
+      a.g != b.g || a.b != b.b || a.sensor_origin != b.sensor_origin) {
+    return false;
+  }
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const bool nan = std::isnan(a.x[i]);
+    if (nan != std::isnan(b.x[i])) return false;
+    if (!nan && (a.x[i] != b.x[i] || a.y[i] != b.y[i] || a.z[i] != b.z[i])) return false;
+  }
+  return true;
+}
+
+TEST(ObservationCloud, ReusedConversionEqualsAFreshOne) {
+  UPD_REQUIRE_SHARED_FILE(path, "mrpt/tests_rgbd.rawlog");
+  const auto rgbd = firstObservation(path);
+  ASSERT_TRUE(rgbd);
+  mrpt::obs::CObservation3DRangeScan points_only;
+  points_only.hasPoints3D = true;
+  points_only.resizePoints3DVectors(2);
+  points_only.points3D_x = {1.f, 2.f};
+  points_only.points3D_y = {0.f, 1.f};
+  points_only.points3D_z = {0.f, -1.f};
+  mrpt::obs::CObservation2DRangeScan planar;
+  const SourceParams params;
+  ObservationCloud reused;
+  const std::vector<const mrpt::obs::CObservation*> sequence = {rgbd.get(), &planar, &points_only,
+                                                                rgbd.get()};
+  for (std::size_t k = 0; k < sequence.size(); ++k) {
+    toCloud(*sequence[k], params, reused);
+    const ObservationCloud fresh = toCloud(*sequence[k], params);
+    EXPECT_EQ(reused.skipped_reason, fresh.skipped_reason) << "observation " << k;
+    EXPECT_EQ(reused.source_class, fresh.source_class) << "observation " << k;
+    EXPECT_TRUE(reused.sensor_pose_on_robot.isApprox(fresh.sensor_pose_on_robot));
+    EXPECT_TRUE(sameCloud(reused.cloud_in_robot, fresh.cloud_in_robot)) << "observation " << k;
+  }
+  EXPECT_TRUE(reused.cloud_in_robot.hasColor());  // the last one is the colour frame
+}
+
 // A rawlog whose range and intensity images live in "<name>_Images/" next to it (what MRPT's
 // grabbers write): the reader points MRPT there and the conversion loads them; a missing file
 // is a skip with a reason, not a crash.

@@ -215,19 +215,65 @@ PointCloud preprocess(const PointCloud& in, const PreprocessParams& p, Preproces
   return cloud;
 }
 
+namespace {
+// cropRange in place on an organized cloud: the points outside the range or the box, and the
+// non-finite ones, become NaN (the same tests, in the same precision). Returns the finite points
+// left. In the static shares of the other frame stages.
+std::size_t cropOrganizedInPlace(PointCloud& c, const PreprocessParams& p) {
+  const double rmin2 = p.range_min_m * p.range_min_m, rmax2 = p.range_max_m * p.range_max_m;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const std::size_t n = c.size();
+  float *x = c.x.data(), *y = c.y.data(), *z = c.z.data();
+  std::size_t kept = 0;
+#pragma omp parallel for schedule(static) if (n > 65536) reduction(+ : kept)
+  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
+    const auto i = static_cast<std::size_t>(ii);
+    const Eigen::Vector3f q(x[i], y[i], z[i]);
+    bool ok = q.allFinite();  // a non-finite point becomes NaN, as in cropRange
+    if (!ok) {
+      x[i] = y[i] = z[i] = nan;
+      continue;
+    }
+    if (p.range_enabled) {
+      const double d2 = (q - c.sensor_origin).cast<double>().squaredNorm();
+      ok = d2 >= rmin2 && d2 <= rmax2;
+    }
+    if (ok && p.box_enabled) {
+      ok = (q.array() >= p.box_min_m.array()).all() && (q.array() <= p.box_max_m.array()).all();
+    }
+    if (ok) {
+      ++kept;
+    } else {
+      x[i] = y[i] = z[i] = nan;
+    }
+  }
+  return kept;
+}
+}  // namespace
+
 void preprocess(const PointCloud& in, const PreprocessParams& p, PointCloud& out,
                 PreprocessStats* stats) {
-  if (p.anyEnabled()) {
+  // The voxel grid, the outlier filter and an unorganized cloud's compaction build new clouds;
+  // the rest (a sensor-rate config: the range cut alone, or nothing) reuses out's buffers.
+  if (p.voxel_enabled || p.outlier_enabled ||
+      ((p.range_enabled || p.box_enabled) && !in.isOrganized())) {
     out = preprocess(in, p, stats);
     return;
   }
   p.validate();
   const std::size_t finite = copyCloud(in, out);
-  if (stats) {
-    *stats = PreprocessStats{};
-    stats->points_in = stats->after_voxel = stats->points_out = in.size();
-    stats->non_finite = in.size() - finite;
+  PreprocessStats st;
+  st.points_in = in.size();
+  st.non_finite = in.size() - finite;
+  if (p.range_enabled || p.box_enabled) {
+    const std::size_t after_crop = cropOrganizedInPlace(out, p);  // as preprocess() counts
+    st.range_removed = finite - after_crop;
+    st.after_voxel = after_crop;
+    st.points_out = out.size();
+  } else {
+    st.after_voxel = st.points_out = in.size();
   }
+  if (stats) *stats = st;
 }
 
 }  // namespace upd

@@ -97,40 +97,52 @@ bool usableImage(const cv::Mat& m) {
 // Colours the points of the range scan from its intensity image: directly when the depth and
 // intensity cameras coincide and the images have the same size, else by projecting each point
 // (in the depth sensor frame) into the intensity camera, like MRPT's unprojectInto. Points that
-// fall outside the image stay white (MRPT's choice).
-void colorRangeScan(const mrpt::obs::CObservation3DRangeScan& o,
-                    const std::vector<Eigen::Vector3f>& points_in_sensor,
-                    const std::vector<int>& pixel_of_point, PointCloud& c) {
-  if (!o.hasIntensityImage) return;
-  const cv::Mat& img = o.intensityImage.asCvMatRef();
-  if (!usableImage(img)) return;
-  allocateColor(c);
-  const int w = static_cast<int>(o.rangeImage.cols());
-  const int h = static_cast<int>(o.rangeImage.rows());
-  if (o.doDepthAndIntensityCamerasCoincide() && img.cols == w && img.rows == h) {
-    for (std::size_t k = 0; k < pixel_of_point.size(); ++k) {
-      const int pix = pixel_of_point[k];
-      pixelColor(img, pix % w, pix / w, c.r[pix], c.g[pix], c.b[pix]);
+// fall outside the image stay white (MRPT's choice). Set up once per scan (allocating the
+// cloud's colour), then paint() per point, from any thread.
+class RangeScanColour {
+ public:
+  RangeScanColour(const mrpt::obs::CObservation3DRangeScan& o, bool enabled, PointCloud& c) {
+    if (!enabled || !o.hasIntensityImage) return;
+    img_ = &o.intensityImage.asCvMatRef();
+    if (!usableImage(*img_)) {
+      img_ = nullptr;
+      return;
     }
-    return;
+    allocateColor(c);
+    w_ = static_cast<int>(o.rangeImage.cols());
+    const int h = static_cast<int>(o.rangeImage.rows());
+    direct_ = o.doDepthAndIntensityCamerasCoincide() && img_->cols == w_ && img_->rows == h;
+    const auto& cam = o.cameraParamsIntensity;
+    // The intensity calibration may be given for another resolution than the stored image.
+    const double sx = cam.ncols > 0 ? static_cast<double>(img_->cols) / cam.ncols : 1.0;
+    const double sy = cam.nrows > 0 ? static_cast<double>(img_->rows) / cam.nrows : 1.0;
+    fx_ = static_cast<float>(cam.fx() * sx), fy_ = static_cast<float>(cam.fy() * sy);
+    cx_ = static_cast<float>(cam.cx() * sx), cy_ = static_cast<float>(cam.cy() * sy);
+    intensity_from_depth_ = Transform(toIsometry(o.relativePoseIntensityWRTDepth).inverse());
   }
-  const auto& cam = o.cameraParamsIntensity;
-  // The intensity calibration may be given for another resolution than the stored image.
-  const double sx = cam.ncols > 0 ? static_cast<double>(img.cols) / cam.ncols : 1.0;
-  const double sy = cam.nrows > 0 ? static_cast<double>(img.rows) / cam.nrows : 1.0;
-  const float fx = static_cast<float>(cam.fx() * sx), fy = static_cast<float>(cam.fy() * sy);
-  const float cx = static_cast<float>(cam.cx() * sx), cy = static_cast<float>(cam.cy() * sy);
-  const Transform intensity_from_depth(toIsometry(o.relativePoseIntensityWRTDepth).inverse());
-  for (std::size_t k = 0; k < pixel_of_point.size(); ++k) {
-    const Eigen::Vector3f q = intensity_from_depth(points_in_sensor[k]);
-    if (!(q.z() > 0.f)) continue;
-    const int u = static_cast<int>(std::lround(cx + fx * q.x() / q.z()));
-    const int v = static_cast<int>(std::lround(cy + fy * q.y() / q.z()));
-    if (u < 0 || v < 0 || u >= img.cols || v >= img.rows) continue;
-    const int pix = pixel_of_point[k];
-    pixelColor(img, u, v, c.r[pix], c.g[pix], c.b[pix]);
+
+  // Colours point pix (p_sensor: in the depth sensor frame).
+  void paint(const Eigen::Vector3f& p_sensor, int pix, PointCloud& c) const {
+    if (img_ == nullptr) return;
+    if (direct_) {
+      pixelColor(*img_, pix % w_, pix / w_, c.r[pix], c.g[pix], c.b[pix]);
+      return;
+    }
+    const Eigen::Vector3f q = intensity_from_depth_(p_sensor);
+    if (!(q.z() > 0.f)) return;
+    const int u = static_cast<int>(std::lround(cx_ + fx_ * q.x() / q.z()));
+    const int v = static_cast<int>(std::lround(cy_ + fy_ * q.y() / q.z()));
+    if (u < 0 || v < 0 || u >= img_->cols || v >= img_->rows) return;
+    pixelColor(*img_, u, v, c.r[pix], c.g[pix], c.b[pix]);
   }
-}
+
+ private:
+  const cv::Mat* img_ = nullptr;
+  bool direct_ = false;
+  int w_ = 0;
+  float fx_ = 0, fy_ = 0, cx_ = 0, cy_ = 0;
+  Transform intensity_from_depth_{Eigen::Isometry3d::Identity()};
+};
 
 void convertRangeScan(const mrpt::obs::CObservation3DRangeScan& o, const SourceParams& params,
                       ObservationCloud& out) {
@@ -165,9 +177,9 @@ void convertRangeScan(const mrpt::obs::CObservation3DRangeScan& o, const SourceP
     // frame, with the lens distortion undone: the same numbers unprojectInto() uses.
     const auto& lut = o.get_unproj_lut();
     c.resizeOrganized(static_cast<std::size_t>(w), static_cast<std::size_t>(h));
-    std::vector<Eigen::Vector3f> points_in_sensor;
-    std::vector<int> pixel_of_point;
-    const bool color = params.color_enabled && o.hasIntensityImage;
+    const RangeScanColour colour(o, params.color_enabled, c);
+    // Rows in parallel, in the static shares of the frame stages after (each pixel is its own).
+#pragma omp parallel for schedule(static)
     for (int v = 0; v < h; ++v) {
       for (int u = 0; u < w; ++u) {
         const std::uint16_t raw = o.rangeImage.coeff(v, u);
@@ -177,13 +189,9 @@ void convertRangeScan(const mrpt::obs::CObservation3DRangeScan& o, const SourceP
         const Eigen::Vector3f p_sensor(lut.Kxs[pix] * range, lut.Kys[pix] * range,
                                        lut.Kzs[pix] * range);
         setPoint(c, static_cast<std::size_t>(pix), robot_from_sensor(p_sensor));
-        if (color) {
-          points_in_sensor.push_back(p_sensor);
-          pixel_of_point.push_back(pix);
-        }
+        colour.paint(p_sensor, pix, c);
       }
     }
-    if (color) colorRangeScan(o, points_in_sensor, pixel_of_point, c);
     return;
   }
   if (o.hasPoints3D && !o.points3D_x.empty()) {
@@ -503,8 +511,20 @@ void convertStereo(const mrpt::obs::CObservationStereoImages& o, const SourcePar
 }  // namespace
 
 ObservationCloud toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params) {
-  params.validate();
   ObservationCloud out;
+  toCloud(obs, params, out);
+  return out;
+}
+
+void toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params,
+             ObservationCloud& out) {
+  params.validate();
+  // Emptied, its buffers kept: a sensor loop's range images convert without allocating.
+  PointCloud& c = out.cloud_in_robot;
+  c.x.clear(), c.y.clear(), c.z.clear(), c.r.clear(), c.g.clear(), c.b.clear();
+  c.width = 0, c.height = 1;
+  c.sensor_origin.setZero();
+  out.skipped_reason.clear();
   out.source_class = detail::shortClassName(obs);
   out.sensor_pose_on_robot = sensorPoseOnRobot(obs);
   if (const auto* o = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
@@ -523,7 +543,6 @@ ObservationCloud toCloud(const mrpt::obs::CObservation& obs, const SourceParams&
     out.skipped_reason = out.source_class + " carries no 3D points";
   }
   if (!out.ok()) out.cloud_in_robot = PointCloud();
-  return out;
 }
 
 }  // namespace upd::mrptbridge

@@ -74,7 +74,9 @@ ObserverResult UpdObserver::observe(const mrpt::obs::CObservation& obs,
 void UpdObserver::observe(const mrpt::obs::CObservation& obs,
                           const Eigen::Isometry3d& pose_world_robot, ObserverResult& result) const {
   const auto start = std::chrono::steady_clock::now();
-  const ObservationCloud cloud = toCloud(obs, params_.source);
+  // The calling thread's converted cloud, kept for its next frame.
+  static thread_local ObservationCloud cloud;
+  toCloud(obs, params_.source, cloud);
   const double convert_ms = detail::elapsedMs(start);
   observeCloud(cloud, pose_world_robot, result);
   result.timings.convert_ms = convert_ms;

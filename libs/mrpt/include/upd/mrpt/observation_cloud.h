@@ -85,4 +85,8 @@ struct ObservationCloud {
 /// params.
 ObservationCloud toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params = {});
 
+/// The same into out, reusing its cloud's buffers (a sensor loop converts a range image
+/// without allocating once warm).
+void toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params, ObservationCloud& out);
+
 }  // namespace upd::mrptbridge
