@@ -43,6 +43,17 @@ std::shared_ptr<mrpt::obs::CObservation> firstObservation(const std::string& pat
   return e.observation;
 }
 
+// A 3D range scan with two points and no range image.
+mrpt::obs::CObservation3DRangeScan twoPointScan() {
+  mrpt::obs::CObservation3DRangeScan scan;
+  scan.hasPoints3D = true;
+  scan.resizePoints3DVectors(2);
+  scan.points3D_x = {1.f, 2.f};
+  scan.points3D_y = {0.f, 1.f};
+  scan.points3D_z = {0.f, -1.f};
+  return scan;
+}
+
 double median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
@@ -172,12 +183,7 @@ TEST(ObservationCloud, ReusedConversionEqualsAFreshOne) {
   UPD_REQUIRE_SHARED_FILE(path, "mrpt/tests_rgbd.rawlog");
   const auto rgbd = firstObservation(path);
   ASSERT_TRUE(rgbd);
-  mrpt::obs::CObservation3DRangeScan points_only;
-  points_only.hasPoints3D = true;
-  points_only.resizePoints3DVectors(2);
-  points_only.points3D_x = {1.f, 2.f};
-  points_only.points3D_y = {0.f, 1.f};
-  points_only.points3D_z = {0.f, -1.f};
+  const mrpt::obs::CObservation3DRangeScan points_only = twoPointScan();
   mrpt::obs::CObservation2DRangeScan planar;
   const SourceParams params;
   ObservationCloud reused;
@@ -289,12 +295,7 @@ TEST(ObservationCloud, RangeScanRangeIsNotDepth) {
 }
 
 TEST(ObservationCloud, RangeScanWithOnlyPoints3DIsUnorganized) {
-  mrpt::obs::CObservation3DRangeScan scan;
-  scan.hasPoints3D = true;
-  scan.resizePoints3DVectors(2);
-  scan.points3D_x = {1.f, 2.f};
-  scan.points3D_y = {0.f, 1.f};
-  scan.points3D_z = {0.f, -1.f};
+  mrpt::obs::CObservation3DRangeScan scan = twoPointScan();
   scan.sensorPose = mrpt::poses::CPose3D(0, 0, 1.0, 0, 0, 0);
   const ObservationCloud oc = toCloud(scan);
   ASSERT_TRUE(oc.ok()) << oc.skipped_reason;
