@@ -9,13 +9,19 @@
 #include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -33,6 +39,7 @@ namespace {
 using LeafId = std::tuple<int, int, int, unsigned>;  // key x, y, z, depth
 
 const Eigen::Vector3d kSensor(0.0, 0.0, 1.0);
+constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
 const octomap::point3d kObstacle(3.05f, 0.05f, 0.35f);
 const octomap::point3d kGround(2.05f, 0.05f, 0.05f);
 
@@ -162,6 +169,57 @@ void expectSameOccupancy(const A& a, const B& b, const char* what) {
     EXPECT_FLOAT_EQ(it->getLogOdds(), other->getLogOdds()) << what << " at " << it.getCoordinate();
   }
   EXPECT_GT(leaves, 100u) << what;
+}
+
+// The insert works out keys and runs in fixed chunks of points, in parallel: a scan of several
+// chunks, with runs of one voxel across the chunk boundaries, gives the same tree (occupancy and
+// traversability, byte for byte) on one thread and on two, and OctoMap's own occupancy.
+TEST(TraversabilityOctree, InsertIsTheSameOnOneThreadAndTwoAcrossChunks) {
+  Frame f;
+  for (int row = 0; row < 240; ++row) {  // image rows across the ground and up a wall
+    for (int col = 0; col < 250; ++col) {
+      const float u = 0.004f * static_cast<float>(col), v = 0.01f * static_cast<float>(row);
+      if ((row * 250 + col) % 211 == 5) {
+        f.add(kNan, kNan, kNan, Label::Unknown);
+        continue;
+      }
+      const bool wall = v > 1.6f;
+      const Label l = (row + col) % 13 == 0  ? Label::Unknown
+                      : wall || col % 5 == 0 ? Label::NonTraversable
+                                             : Label::Traversable;
+      f.add(wall ? 1.6f + 0.001f * col : 0.4f + v, -0.5f + u, wall ? v - 1.6f : 0.01f, l,
+            0.9f + 0.0003f * col, 0.01f * row, 0.001f * (row + col));
+    }
+  }
+  ASSERT_GT(f.x.size(), 3u * 16384u);  // several chunks
+  for (const bool discretize : {true, false}) {
+    OctreeParams p = fixedParams();
+    p.discretize = discretize;
+    std::string bytes[2];
+    for (int threads = 1; threads <= 2; ++threads) {
+#ifdef _OPENMP
+      omp_set_num_threads(threads);
+#endif
+      TraversabilityOcTree tree(p);
+      const auto stats = upd::maps::insertScan(tree, f.view(), kSensor, p, FusionParams{});
+      EXPECT_EQ(stats.points_inserted + stats.points_invalid, f.x.size());
+      std::ostringstream out;
+      tree.write(out);
+      bytes[threads - 1] = out.str();
+      if (threads == 1) {
+        octomap::OcTree reference(p.resolution_m);
+        octomap::Pointcloud cloud;
+        for (std::size_t i = 0; i < f.x.size(); ++i) {
+          if (std::isfinite(f.x[i])) cloud.push_back(f.x[i], f.y[i], f.z[i]);
+        }
+        reference.insertPointCloud(cloud, octomap::point3d(0.f, 0.f, 1.f), p.max_range_m, false,
+                                   discretize);
+        expectSameOccupancy(tree, reference, discretize ? "discretized" : "per point");
+        expectSameOccupancy(reference, tree, discretize ? "discretized" : "per point");
+      }
+    }
+    EXPECT_EQ(bytes[0], bytes[1]) << (discretize ? "discretized" : "one ray per point");
+  }
 }
 
 TEST(TraversabilityOctree, DiscretizedInsertMatchesOctomapsOwnAndCountsEveryPoint) {

@@ -340,66 +340,94 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
   // The rays: one per point, or (discretize) one per end voxel from its centre, as OctoMap's
   // computeDiscreteUpdate makes them. Consecutive points (image rows) mostly end in the same
   // voxel: what depends only on the voxel is worked out once per change of voxel.
-  octomap::Pointcloud cloud;
-  cloud.reserve(params.discretize ? points.size / 16 + 16 : points.size);
-  octomap::KeySet ends;
-  std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash> frame;
-  // The voxel of the previous finite point in the tree and whether OctoMap marks it as hit
-  // (with discretize: its centre within range and inside the box, as computeUpdate tests). The
-  // labelled points of a run in one voxel are summed in `run` and added to the frame's voxel
-  // when the run ends: one hash lookup per run.
-  octomap::OcTreeKey last_key;
-  bool have_last = false, last_hit = false;
-  FrameVoxel run;
-  const auto flush = [&] {
-    if (run.n_nontrav + run.n_trav > 0) frame[last_key].add(run);
-    run = FrameVoxel{};
-  };
+  // 1. In fixed chunks of points, in parallel (the result does not depend on the thread
+  // count): each point's voxel key, the changes of voxel, and the labelled points of each run
+  // in one voxel summed (with discretize, a voxel marks hit when its centre is within range
+  // and inside the box, as computeUpdate tests).
   const auto marksHit = [&](const octomap::point3d& end) {
     return !(max_range > 0 && (end - origin).norm() > max_range) &&
            !(tree.bbxSet() && !tree.inBBX(end));
   };
-  for (std::size_t i = 0; i < points.size; ++i) {
-    const float x = points.x[i], y = points.y[i], z = points.z[i];
-    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
-      ++stats.points_invalid;
-      continue;
-    }
-    ++stats.points_inserted;
-    const octomap::point3d p(x, y, z);
-    octomap::OcTreeKey key;
-    const bool in_tree = tree.coordToKeyChecked(p, key);
-    if (!params.discretize) cloud.push_back(p);
-    if (in_tree && !(have_last && key == last_key)) {
-      flush();
-      last_key = key;
-      have_last = true;
-      if (params.discretize) {
-        const octomap::point3d centre = tree.keyToCoord(key);
-        if (ends.insert(key).second) cloud.push_back(centre);
-        last_hit = marksHit(centre);
+  struct Chunk {
+    std::vector<octomap::point3d> ray_ends;  // points, or the centres of new voxels
+    std::vector<octomap::OcTreeKey> voxels;  // discretize: each change of voxel, in order
+    std::vector<std::pair<octomap::OcTreeKey, FrameVoxel>> runs;
+    std::size_t inserted = 0, invalid = 0, unknown = 0;
+  };
+  constexpr std::size_t kChunk = 16384;
+  std::vector<Chunk> chunks((points.size + kChunk - 1) / kChunk);
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(chunks.size()); ++cc) {
+    Chunk& ch = chunks[static_cast<std::size_t>(cc)];
+    const std::size_t begin = static_cast<std::size_t>(cc) * kChunk;
+    const std::size_t end = std::min(points.size, begin + kChunk);
+    octomap::OcTreeKey last_key;  // a default key is a real voxel: hence have_last
+    bool have_last = false, last_hit = false;
+    FrameVoxel run;
+    const auto flush = [&] {
+      if (run.n_nontrav + run.n_trav > 0) ch.runs.emplace_back(last_key, run);
+      run = FrameVoxel{};
+    };
+    for (std::size_t i = begin; i < end; ++i) {
+      const float x = points.x[i], y = points.y[i], z = points.z[i];
+      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+        ++ch.invalid;
+        continue;
+      }
+      ++ch.inserted;
+      const octomap::point3d p(x, y, z);
+      octomap::OcTreeKey key;
+      const bool in_tree = tree.coordToKeyChecked(p, key);
+      if (!params.discretize) ch.ray_ends.push_back(p);
+      if (in_tree && !(have_last && key == last_key)) {
+        flush();
+        last_key = key;
+        have_last = true;
+        if (params.discretize) {
+          ch.voxels.push_back(key);
+          last_hit = marksHit(tree.keyToCoord(key));
+        }
+      }
+      const Label label = points.label[i];
+      if (label != Label::Traversable && label != Label::NonTraversable) {
+        ++ch.unknown;
+        continue;
+      }
+      if (!in_tree || !(params.discretize ? last_hit : marksHit(p))) continue;
+      if (label == Label::NonTraversable) {
+        ++run.n_nontrav;
+      } else {
+        ++run.n_trav;
+      }
+      if (points.zeta != nullptr && std::isfinite(points.zeta[i])) {
+        run.zeta_min = std::fmin(run.zeta_min, points.zeta[i]);
+      }
+      if (points.cost != nullptr && std::isfinite(points.cost[i])) {
+        run.cost_sum += points.cost[i];
+        ++run.n_cost;
       }
     }
-    const Label label = points.label[i];
-    if (label != Label::Traversable && label != Label::NonTraversable) {
-      ++stats.points_unknown;
-      continue;
-    }
-    if (!in_tree || !(params.discretize ? last_hit : marksHit(p))) continue;
-    if (label == Label::NonTraversable) {
-      ++run.n_nontrav;
-    } else {
-      ++run.n_trav;
-    }
-    if (points.zeta != nullptr && std::isfinite(points.zeta[i])) {
-      run.zeta_min = std::fmin(run.zeta_min, points.zeta[i]);
-    }
-    if (points.cost != nullptr && std::isfinite(points.cost[i])) {
-      run.cost_sum += points.cost[i];
-      ++run.n_cost;
-    }
+    flush();
   }
-  flush();
+  // 2. The chunks in order: the rays (one per distinct end voxel with discretize) and the
+  // per-voxel sums of the frame.
+  octomap::Pointcloud cloud;
+  octomap::KeySet ends;
+  std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash> frame;
+  std::size_t n_ends = 0;
+  for (const Chunk& ch : chunks)
+    n_ends += params.discretize ? ch.voxels.size() : ch.ray_ends.size();
+  cloud.reserve(n_ends);
+  for (const Chunk& ch : chunks) {
+    stats.points_inserted += ch.inserted;
+    stats.points_invalid += ch.invalid;
+    stats.points_unknown += ch.unknown;
+    for (const octomap::point3d& p : ch.ray_ends) cloud.push_back(p);
+    for (const octomap::OcTreeKey& key : ch.voxels) {
+      if (ends.insert(key).second) cloud.push_back(tree.keyToCoord(key));
+    }
+    for (const auto& [key, run] : ch.runs) frame[key].add(run);
+  }
 
   tree.insertPointCloud(cloud, origin, max_range, /*lazy_eval=*/true);
   for (const auto& [key, v] : frame) {
