@@ -64,22 +64,36 @@ PointCloud dropNonFinite(const PointCloud& in) {
   return selectPoints(unorganized, keep);
 }
 
+namespace {
+// The test of cropRange for a finite point q: within the range of the sensor origin and inside
+// the box, each when enabled.
+class RangeBoxTest {
+ public:
+  RangeBoxTest(const PreprocessParams& p, const Eigen::Vector3f& sensor_origin)
+      : p_(p),
+        origin_(sensor_origin),
+        rmin2_(p.range_min_m * p.range_min_m),
+        rmax2_(p.range_max_m * p.range_max_m) {}
+  bool keeps(const Eigen::Vector3f& q) const {
+    if (p_.range_enabled) {
+      const double d2 = (q - origin_).cast<double>().squaredNorm();
+      if (!(d2 >= rmin2_ && d2 <= rmax2_)) return false;
+    }
+    return !p_.box_enabled ||
+           ((q.array() >= p_.box_min_m.array()).all() && (q.array() <= p_.box_max_m.array()).all());
+  }
+
+ private:
+  const PreprocessParams& p_;
+  Eigen::Vector3f origin_;
+  double rmin2_, rmax2_;
+};
+}  // namespace
+
 PointCloud cropRange(const PointCloud& in, const PreprocessParams& p) {
   std::vector<char> keep(in.size(), 0);
-  const double rmin2 = p.range_min_m * p.range_min_m, rmax2 = p.range_max_m * p.range_max_m;
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    if (!in.isFinite(i)) continue;
-    const Eigen::Vector3f q = in.point(i);
-    bool ok = true;
-    if (p.range_enabled) {
-      const double d2 = (q - in.sensor_origin).cast<double>().squaredNorm();
-      ok = d2 >= rmin2 && d2 <= rmax2;
-    }
-    if (ok && p.box_enabled) {
-      ok = (q.array() >= p.box_min_m.array()).all() && (q.array() <= p.box_max_m.array()).all();
-    }
-    keep[i] = ok;
-  }
+  const RangeBoxTest test(p, in.sensor_origin);
+  for (std::size_t i = 0; i < in.size(); ++i) keep[i] = in.isFinite(i) && test.keeps(in.point(i));
   return selectPoints(in, keep);
 }
 
@@ -220,7 +234,7 @@ namespace {
 // non-finite ones, become NaN (the same tests, in the same precision). Returns the finite points
 // left. In the static shares of the other frame stages.
 std::size_t cropOrganizedInPlace(PointCloud& c, const PreprocessParams& p) {
-  const double rmin2 = p.range_min_m * p.range_min_m, rmax2 = p.range_max_m * p.range_max_m;
+  const RangeBoxTest test(p, c.sensor_origin);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const std::size_t n = c.size();
   float *x = c.x.data(), *y = c.y.data(), *z = c.z.data();
@@ -229,19 +243,8 @@ std::size_t cropOrganizedInPlace(PointCloud& c, const PreprocessParams& p) {
   for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
     const auto i = static_cast<std::size_t>(ii);
     const Eigen::Vector3f q(x[i], y[i], z[i]);
-    bool ok = q.allFinite();  // a non-finite point becomes NaN, as in cropRange
-    if (!ok) {
-      x[i] = y[i] = z[i] = nan;
-      continue;
-    }
-    if (p.range_enabled) {
-      const double d2 = (q - c.sensor_origin).cast<double>().squaredNorm();
-      ok = d2 >= rmin2 && d2 <= rmax2;
-    }
-    if (ok && p.box_enabled) {
-      ok = (q.array() >= p.box_min_m.array()).all() && (q.array() <= p.box_max_m.array()).all();
-    }
-    if (ok) {
+    // A non-finite point becomes NaN too, as in cropRange.
+    if (q.allFinite() && test.keeps(q)) {
       ++kept;
     } else {
       x[i] = y[i] = z[i] = nan;
