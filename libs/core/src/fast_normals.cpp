@@ -10,12 +10,9 @@
 #include <string>
 #include <vector>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "fast_cell_map.h"
 #include "fast_simd.h"
+#include "upd/core/openmp.h"
 
 namespace upd {
 
@@ -254,11 +251,7 @@ std::vector<float> pitchProfile(const PointCloud& cloud, const float* range, boo
   // other core writes next frame made that write twice as slow.)
 #pragma omp parallel
   {
-#ifdef _OPENMP
-    const int team = omp_get_num_threads(), me = omp_get_thread_num();
-#else
-    const int team = 1, me = 0;
-#endif
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
     const std::size_t k0 = along_u ? sampled * me / team : 0,
                       k1 = along_u ? sampled * (me + 1) / team : sampled;
     const std::size_t t0 = along_u ? 0 : pairs * me / team,
@@ -565,22 +558,13 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   // per-thread lists and are scanned after the rows, shared out dynamically: they cluster at
   // depth edges, and a static share of them left one thread with most of the work.
   std::size_t invalid = 0;
-#ifdef _OPENMP
-  const int max_team = omp_get_max_threads();
-#else
-  const int max_team = 1;
-#endif
-  std::vector<std::vector<std::uint32_t>> own_scan(static_cast<std::size_t>(max_team));
+  std::vector<std::vector<std::uint32_t>> own_scan(static_cast<std::size_t>(openmp::maxThreads()));
   std::vector<std::uint32_t> to_scan;
 #pragma omp parallel reduction(+ : invalid)
   {
     std::vector<std::uint8_t> taken(W);
     std::vector<float> spread(5 * W);
-#ifdef _OPENMP
-    std::vector<std::uint32_t>& my_scan = own_scan[static_cast<std::size_t>(omp_get_thread_num())];
-#else
-    std::vector<std::uint32_t>& my_scan = own_scan[0];
-#endif
+    std::vector<std::uint32_t>& my_scan = own_scan[static_cast<std::size_t>(openmp::threadIndex())];
 #pragma omp for schedule(static)
     for (std::ptrdiff_t bv = 0; bv < BH; ++bv) {
       for (std::size_t u = 0; u < W; ++u) {

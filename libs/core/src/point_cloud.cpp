@@ -3,9 +3,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "upd/core/openmp.h"
 
 namespace upd {
 
@@ -38,11 +36,7 @@ void copyColour(const PointCloud& in, PointCloud& out) {
   }
 #pragma omp parallel if (n > 65536)
   {
-#ifdef _OPENMP
-    const int team = omp_get_num_threads(), me = omp_get_thread_num();
-#else
-    const int team = 1, me = 0;
-#endif
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
     const std::size_t begin = n * me / team, len = n * (me + 1) / team - begin;
     std::memcpy(out.r.data() + begin, in.r.data() + begin, len);
     std::memcpy(out.g.data() + begin, in.g.data() + begin, len);

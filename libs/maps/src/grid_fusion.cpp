@@ -1,5 +1,6 @@
 #include "upd/maps/grid_fusion.h"
 
+#include "upd/core/openmp.h"
 #include "upd/core/vector_clones.h"
 
 #include <algorithm>
@@ -8,11 +9,6 @@
 #include <cstring>
 #include <limits>
 #include <vector>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 
 namespace upd::maps {
 
@@ -225,11 +221,7 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
   const GridCellIndexer ix = grid.indexer();
   const Window window{ix.inv_cell, ix.i0, ix.i0 + ix.size_x, ix.j0, ix.j0 + ix.size_y,
                       static_cast<std::uint32_t>(size_x)};
-#ifdef _OPENMP
-  const int max_team = omp_get_max_threads();
-#else
-  const int max_team = 1;
-#endif
+  const int max_team = openmp::maxThreads();
   // Buffers shared by the team: the calling thread's, taken before the parallel region.
   static thread_local std::vector<std::uint32_t> point_cell, slot_of_cell, row_span_of;
   static thread_local std::vector<std::size_t> run_begin_of, run_count_of;
@@ -266,11 +258,7 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
   std::size_t invalid = 0, unknown = 0, used = 0, updated = 0, hit = 0, sparse = 0;
 #pragma omp parallel reduction(+ : invalid, unknown, used, updated, hit, sparse)
   {
-#ifdef _OPENMP
-    const int team = omp_get_num_threads(), me = omp_get_thread_num();
-#else
-    const int team = 1, me = 0;
-#endif
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
     // 1. Each thread takes a chunk of the points: the cell of every point (or why it has none),
     // and where the runs of points sharing a cell start.
     const std::size_t chunk_begin = points.size * me / team,
@@ -313,20 +301,20 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
     // use) points each touched cell to its FrameCell; per row, the span of touched columns.
     std::size_t total_runs = 0;
     for (int c = 0; c < team; ++c) total_runs += run_count[c];
-    const std::size_t share_lo = total_runs * me / team, share_hi = total_runs * (me + 1) / team;
-    std::uint32_t row_lo = static_cast<std::uint32_t>(size_y), row_hi = row_lo;
-    std::size_t before = 0;  // runs in the rows before
-    for (std::uint32_t row = 0; row < static_cast<std::uint32_t>(size_y); ++row) {
-      if (before >= share_lo && row_lo == static_cast<std::uint32_t>(size_y)) row_lo = row;
-      if (before >= share_hi) {
-        row_hi = row;
-        break;
+    // The first row with at least `share` runs in the rows before it.
+    const auto rowAfter = [&](std::size_t share) {
+      std::size_t before = 0;
+      for (int row = 0; row < size_y; ++row) {
+        if (before >= share) return static_cast<std::uint32_t>(row);
+        for (int c = 0; c < team; ++c) {
+          before += runs_per_row[static_cast<std::size_t>(c) * size_y + row];
+        }
       }
-      for (int c = 0; c < team; ++c)
-        before += runs_per_row[static_cast<std::size_t>(c) * size_y + row];
-    }
-    if (me == 0) row_lo = 0;
-    if (me == team - 1) row_hi = static_cast<std::uint32_t>(size_y);
+      return static_cast<std::uint32_t>(size_y);
+    };
+    const std::uint32_t row_lo = me == 0 ? 0 : rowAfter(total_runs * me / team);
+    const std::uint32_t row_hi = me == team - 1 ? static_cast<std::uint32_t>(size_y)
+                                                : rowAfter(total_runs * (me + 1) / team);
     static thread_local std::vector<FrameCell> frame;  // this thread's own
     frame.clear();
     for (int c = 0; c < team; ++c) {
