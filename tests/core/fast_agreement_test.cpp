@@ -152,17 +152,24 @@ TEST(FastNormals, OrganizedScansFindTheExactNeighbourhoods) {
   EXPECT_LE(validity_differs, c.size() / 1000);
 }
 
+// A generated scene on a 0.02 m grid with 2 mm of noise, and its exact normals (r = 0.05 m).
+Scene noisyScene(const std::string& name) {
+  SceneParams sp;
+  sp.spacing_m = 0.02;
+  sp.noise_m = 0.002;
+  return makeScene(name, sp);
+}
+Normals exactNormals(const Scene& s) {
+  NormalParams np;
+  np.radius_m = 0.05;
+  return computeNormals(s.cloud, KdTree(s.cloud), np, s.up);
+}
+
 TEST(FastUpd, AgreesWithTheExactPathOnGeneratedScenes) {
   for (const std::string name : {"corner", "ramp", "step", "stairs", "ditch", "rocks"}) {
     SCOPED_TRACE(name);
-    SceneParams sp;
-    sp.spacing_m = 0.02;
-    sp.noise_m = 0.002;
-    const Scene s = makeScene(name, sp);
-    NormalParams np;
-    np.radius_m = 0.05;
-    const KdTree tree(s.cloud);
-    const Normals normals = computeNormals(s.cloud, tree, np, s.up);
+    const Scene s = noisyScene(name);
+    const Normals normals = exactNormals(s);
     UpdParams defaults;
     defaults.radius_m = 0.5;
     const Agreement d = agreeWithExact(s.cloud, normals, computeUpdFast(s.cloud, normals, defaults),
@@ -178,6 +185,100 @@ TEST(FastUpd, AgreesWithTheExactPathOnGeneratedScenes) {
     EXPECT_LE(a.mean_abs_dzeta, 0.005);
     EXPECT_GE(a.sameLabelFraction(), 0.995);
     EXPECT_LE(a.validity_differs, a.compared / 200);
+  }
+}
+
+// Brute-force eq. 6 at point i over the finite points within d_m (distances in double), and
+// how many points lie so close to the sphere (1e-6 d_m) that float rounding may put them on
+// either side: the exact sums are equal up to those.
+struct BruteSums {
+  Eigen::Vector3d r = Eigen::Vector3d::Zero();
+  std::uint32_t k = 0, ambiguous = 0;
+};
+BruteSums bruteSums(const PointCloud& c, const Normals& n, std::size_t i, double d_m) {
+  BruteSums b;
+  for (std::size_t j = 0; j < c.size(); ++j) {
+    if (!c.isFinite(j) || !n.isValid(j)) continue;
+    const double d = (c.point(j).cast<double>() - c.point(i).cast<double>()).norm();
+    if (std::abs(d - d_m) < 1e-6 * d_m) ++b.ambiguous;
+    if (d > d_m) continue;
+    b.r += n.normal(j).cast<double>();
+    ++b.k;
+  }
+  return b;
+}
+
+// fast_exact_band: the points whose interpolated zeta lies within the band of the label
+// threshold get the exact path's sums (the same normals in, the same r and k out), every other
+// point keeps its interpolated values, and the labels then agree on >= 99.5 % of the points.
+TEST(FastUpd, PointsNearTheLabelThresholdGetTheExactSums) {
+  for (const std::string name : {"corner", "step", "rocks"}) {
+    SCOPED_TRACE(name);
+    const Scene s = noisyScene(name);
+    const Normals normals = exactNormals(s);
+    UpdParams p;
+    p.radius_m = 0.5;
+    const UpdResult interpolated = computeUpdFast(s.cloud, normals, p);
+    const double threshold = ClassifyParams{}.zeta_min;
+    p.fast_exact_band = 0.02;
+    FastUpdStats st;
+    const UpdResult banded = computeUpdFast(s.cloud, normals, p, &st, threshold);
+    std::size_t in_band = 0;
+    for (std::size_t i = 0; i < s.cloud.size(); ++i) {
+      const float z = interpolated.zeta[i];
+      if (!(std::abs(z - threshold) < p.fast_exact_band)) {
+        // Outside the band (or unscored): the interpolated values, bit for bit.
+        ASSERT_EQ(banded.isValid(i), interpolated.isValid(i)) << "point " << i;
+        if (!banded.isValid(i)) continue;
+        ASSERT_EQ(banded.zeta[i], interpolated.zeta[i]) << "point " << i;
+        ASSERT_EQ(banded.rx[i], interpolated.rx[i]) << "point " << i;
+        continue;
+      }
+      ++in_band;
+      ASSERT_TRUE(banded.isValid(i)) << "point " << i;
+      const BruteSums b = bruteSums(s.cloud, normals, i, p.radius_m);
+      EXPECT_LE(std::abs(static_cast<double>(banded.k[i]) - b.k), b.ambiguous) << "point " << i;
+      EXPECT_LE((banded.r(i).cast<double>() - b.r).norm(), 1e-5 * b.k + b.ambiguous)
+          << "point " << i;
+      EXPECT_NEAR(banded.zeta[i], b.r.norm() / b.k, 2e-5 + 2.0 * b.ambiguous / b.k)
+          << "point " << i;
+    }
+    EXPECT_GT(in_band, 50u);
+    EXPECT_EQ(st.exact_points, in_band);
+    EXPECT_EQ(banded.invalid, interpolated.invalid);
+    const Agreement a = agreeWithExact(s.cloud, normals, banded, p, s.up, 3);
+    EXPECT_GE(a.sameLabelFraction(), 0.995);
+    // Without a threshold there is no band.
+    const UpdResult no_threshold = computeUpdFast(s.cloud, normals, p);
+    EXPECT_EQ(no_threshold.zeta, interpolated.zeta);
+  }
+}
+
+// The pipeline passes the classifier's zeta_min as the threshold of the band.
+TEST(FastPipeline, ExactBandFollowsTheClassifierThreshold) {
+  SceneParams sp;
+  sp.spacing_m = 0.02;
+  const Scene s = makeScene("step", sp);
+  PipelineParams p;
+  p.up = s.up;
+  p.preprocess.disableAll();
+  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  p.upd.fast_exact_band = 0.02;
+  for (const double zeta_min : {0.9, 0.95}) {
+    p.classify.zeta_min = zeta_min;
+    p.classify.zeta_caution = std::max(zeta_min, p.classify.zeta_caution);
+    const PipelineResult r = runPipeline(s.cloud, p);
+    PipelineParams off = p;
+    off.upd.fast_exact_band = 0;
+    const PipelineResult o = runPipeline(s.cloud, off);
+    std::size_t in_band = 0;
+    for (std::size_t i = 0; i < r.cloud.size(); i += 3) {
+      if (!(std::abs(o.upd.zeta[i] - zeta_min) < 0.02)) continue;
+      ++in_band;
+      const BruteSums b = bruteSums(r.cloud, r.normals, i, p.upd.radius_m);
+      EXPECT_NEAR(r.upd.zeta[i], b.r.norm() / b.k, 2e-5 + 2.0 * b.ambiguous / b.k) << "point " << i;
+    }
+    EXPECT_GT(in_band, 20u) << "zeta_min " << zeta_min;
   }
 }
 

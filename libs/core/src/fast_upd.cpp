@@ -135,6 +135,18 @@ struct Candidates {
 // fraction moves with X at rate u / (2 sqrt(3) sigma): the gradient of the cut cells' share.
 constexpr float kMaxFracSlope = 4.f;
 
+// Squared nearest and farthest distance from a point to a unit cell whose lower corner lies at
+// (ax, ay, az) from it. (Written as selects: GCC keeps the loops that call it branch-free and
+// vectorizes them.)
+inline void boxDistances2(float ax, float ay, float az, float& near2, float& far2) {
+  const float bx = ax + 1.f, by = ay + 1.f, bz = az + 1.f;
+  const float qx = ax > 0.f ? ax : (bx < 0.f ? -bx : 0.f);
+  const float qy = ay > 0.f ? ay : (by < 0.f ? -by : 0.f);
+  const float qz = az > 0.f ? az : (bz < 0.f ? -bz : 0.f);
+  near2 = qx * qx + qy * qy + qz * qz;
+  far2 = std::max(ax * ax, bx * bx) + std::max(ay * ay, by * by) + std::max(az * az, bz * bz);
+}
+
 UPD_VECTOR_CLONES
 void sumAtNode(const Candidates& c, float X, float Y, float Z, float m, NodeSums& out) {
   float acc[16][kLanes] = {};
@@ -160,16 +172,8 @@ void sumAtNode(const Candidates& c, float X, float Y, float Z, float m, NodeSums
   for (std::size_t j0 = 0; j0 < n; j0 += kLanes) {
     for (int l = 0; l < kLanes; ++l) {
       const std::size_t j = j0 + l;
-      // Nearest and farthest distance from X to the cell's box. (Written as selects and
-      // products of 0/1 floats: GCC keeps such a loop branch-free and vectorizes it.)
-      const float ax = lx[j] - X, ay = ly[j] - Y, az = lz[j] - Z;
-      const float bx = ax + 1.f, by = ay + 1.f, bz = az + 1.f;
-      const float qx = ax > 0.f ? ax : (bx < 0.f ? -bx : 0.f);
-      const float qy = ay > 0.f ? ay : (by < 0.f ? -by : 0.f);
-      const float qz = az > 0.f ? az : (bz < 0.f ? -bz : 0.f);
-      const float near2 = qx * qx + qy * qy + qz * qz;
-      const float far2 =
-          std::max(ax * ax, bx * bx) + std::max(ay * ay, by * by) + std::max(az * az, bz * bz);
+      float near2, far2;
+      boxDistances2(lx[j] - X, ly[j] - Y, lz[j] - Z, near2, far2);
       // The cut fraction from the centroid.
       const float vx = mx[j] - X, vy = my[j] - Y, vz = mz[j] - Z;
       const float d2 = vx * vx + vy * vy + vz * vz + 1e-12f;
@@ -455,17 +459,123 @@ void zetaFromCounts(const float* __restrict rx, const float* __restrict ry,
   }
 }
 
+// --- Exact sums near the label threshold (UpdParams::fast_exact_band) ---
+
+// The points with a valid normal grouped by cell (counting sort; point order within a cell),
+// positions relative to the lattice origin (as in Lattice: the differences stay exact where
+// the input floats allow it, so a cloud far from the origin loses nothing): what the exact
+// sums over a cut cell read.
+struct CellPoints {
+  std::vector<std::uint32_t> start;  // n_cells + 1
+  std::vector<float> x, y, z, nx, ny, nz;
+};
+
+// The cells within reach of a ball around any point of one cell, structure of arrays padded
+// with empty far-away cells to a multiple of kLanes: lower corner relative to that cell (cell
+// units), valid-normal count and normal sum, and the cell's index.
+struct ExactCandidates {
+  std::vector<float> lx, ly, lz, count, nx, ny, nz;
+  std::vector<std::uint32_t> cell;
+  void clear() {
+    for (auto* v : {&lx, &ly, &lz, &count, &nx, &ny, &nz}) v->clear();
+    cell.clear();
+  }
+  void append(float x, float y, float z, const CellSums& s, std::uint32_t c) {
+    lx.push_back(x), ly.push_back(y), lz.push_back(z);
+    count.push_back(s.count), nx.push_back(s.nx), ny.push_back(s.ny), nz.push_back(s.nz);
+    cell.push_back(c);
+  }
+  void pad() {
+    while (lx.size() % kLanes != 0) append(1e6f, 1e6f, 1e6f, CellSums{}, kNoIndex);
+  }
+  std::size_t size() const { return lx.size(); }
+};
+
+// Sums (r, k) over the candidate cells wholly inside the ball of radius m cells around X (cell
+// units, relative to the candidates' origin) into acc, and marks in cut the cells the sphere
+// cuts (their points are summed one by one). in2 and out2 bracket m^2 by a rounding margin, so
+// that a cell is taken whole or skipped only when every point of it certainly is in or out.
+UPD_VECTOR_CLONES
+void sumWholeCells(const ExactCandidates& c, float X, float Y, float Z, float in2, float out2,
+                   float (&acc)[4], float* __restrict cut) {
+  float a[4][kLanes] = {};
+  const std::size_t n = c.size();
+  const float* __restrict lx = c.lx.data();
+  const float* __restrict ly = c.ly.data();
+  const float* __restrict lz = c.lz.data();
+  const float* __restrict cnt = c.count.data();
+  const float* __restrict nx = c.nx.data();
+  const float* __restrict ny = c.ny.data();
+  const float* __restrict nz = c.nz.data();
+  for (std::size_t j0 = 0; j0 < n; j0 += kLanes) {
+    for (int l = 0; l < kLanes; ++l) {
+      const std::size_t j = j0 + l;
+      float near2, far2;
+      boxDistances2(lx[j] - X, ly[j] - Y, lz[j] - Z, near2, far2);
+      const float inside = far2 <= in2 ? 1.f : 0.f;
+      cut[j] = (1.f - inside) * (near2 <= out2 ? 1.f : 0.f) * (cnt[j] > 0.f ? 1.f : 0.f);
+      a[0][l] += inside * nx[j];
+      a[1][l] += inside * ny[j];
+      a[2][l] += inside * nz[j];
+      a[3][l] += inside * cnt[j];
+    }
+  }
+  for (int v = 0; v < 4; ++v) {
+    float s = 0.f;
+    for (int l = 0; l < kLanes; ++l) s += a[v][l];
+    acc[v] += s;
+  }
+}
+
+// Adds the normals of the points of cells [0, n) (their ranges [begin[c], end[c]) in p) within
+// distance^2 r2 of (X, Y, Z) and their count to acc: the exact path's test, |p - q|^2 <= r^2.
+// (Float rounding may put a point within ~1e-7 r of the sphere on the other side than the k-d
+// tree does.) A range is read a vector of points at a time, lanes past its end masked off (p is
+// padded by kLanes): the lanes are reduced once, not once per cell.
+UPD_VECTOR_CLONES
+void sumPointsWithin(const CellPoints& p, const std::uint32_t* begin, const std::uint32_t* end,
+                     std::size_t n, float X, float Y, float Z, float r2, float (&acc)[4]) {
+  float a[4][kLanes] = {};
+  const float* __restrict x = p.x.data();
+  const float* __restrict y = p.y.data();
+  const float* __restrict z = p.z.data();
+  const float* __restrict nx = p.nx.data();
+  const float* __restrict ny = p.ny.data();
+  const float* __restrict nz = p.nz.data();
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::size_t b = begin[c], e = end[c];
+    for (std::size_t j0 = b; j0 < e; j0 += kLanes) {
+      // Lanes l < e - j0 are in the range.
+      const auto valid = static_cast<std::ptrdiff_t>(e - j0);
+      for (int l = 0; l < kLanes; ++l) {
+        const std::size_t j = j0 + static_cast<std::size_t>(l);
+        const float dx = x[j] - X, dy = y[j] - Y, dz = z[j] - Z;
+        const float w = (dx * dx + dy * dy + dz * dz <= r2) & (l < valid) ? 1.f : 0.f;
+        a[0][l] += w * nx[j];
+        a[1][l] += w * ny[j];
+        a[2][l] += w * nz[j];
+        a[3][l] += w;
+      }
+    }
+  }
+  for (int v = 0; v < 4; ++v) {
+    float s = 0.f;
+    for (int l = 0; l < kLanes; ++l) s += a[v][l];
+    acc[v] += s;
+  }
+}
+
 }  // namespace
 
 UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdParams& params,
-                         FastUpdStats* stats) {
+                         FastUpdStats* stats, double zeta_threshold) {
   UpdResult out;
-  computeUpdFast(cloud, normals, params, out, stats);
+  computeUpdFast(cloud, normals, params, out, stats, zeta_threshold);
   return out;
 }
 
 void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdParams& params,
-                    UpdResult& out, FastUpdStats* stats) {
+                    UpdResult& out, FastUpdStats* stats, double zeta_threshold) {
   params.validate();
   requireParam(params.knn == 0, "UpdParams", "knn", params.knn,
                "the fast path sums over the radius d_m: it needs knn = 0");
@@ -804,8 +914,151 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
       }
     }
   }
+  // 7. Exact sums for the points whose zeta lies within fast_exact_band of the label threshold:
+  // their label is then the exact path's. A cell wholly inside the ball adds its sums, one
+  // wholly outside nothing, and the points of a cell the sphere cuts are tested one by one.
+  std::size_t exact_points = 0;
+  if (params.fast_exact_band > 0 && std::isfinite(zeta_threshold)) {
+    const auto lo = static_cast<float>(zeta_threshold - params.fast_exact_band);
+    const auto hi = static_cast<float>(zeta_threshold + params.fast_exact_band);
+    // The points to sum exactly (per chunk, in point order) and the valid-normal points per
+    // chunk and cell (for the counting sort below), in the binning's shares.
+    std::vector<std::vector<std::uint32_t>> chosen(n_blocks_pts);
+    std::vector<std::uint32_t> chunk_count(n_blocks_pts * n_cells, 0);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_blocks_pts); ++c) {
+      const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
+      const std::size_t end = std::min(n_pts, begin + kChunk);
+      std::uint32_t* count = &chunk_count[static_cast<std::size_t>(c) * n_cells];
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t cell = cell_of[i];
+        if (cell == kNoIndex) continue;
+        if (out.zeta[i] > lo && out.zeta[i] < hi) {
+          chosen[c].push_back(static_cast<std::uint32_t>(i));
+        }
+        if (normals.isValid(i)) ++count[cell];
+      }
+    }
+    for (const auto& v : chosen) exact_points += v.size();
+    if (exact_points > 0) {
+      // Counting sort of the valid-normal points by cell, chunk by chunk: the same order for
+      // any number of threads.
+      static thread_local CellPoints points_buffer;
+      CellPoints& pts = points_buffer;
+      pts.start.assign(n_cells + 1, 0);
+      for (std::size_t cell = 0; cell < n_cells; ++cell) {
+        std::uint32_t at = pts.start[cell];
+        for (std::size_t c = 0; c < n_blocks_pts; ++c) {
+          const std::uint32_t k = chunk_count[c * n_cells + cell];
+          chunk_count[c * n_cells + cell] = at;  // now the chunk's first slot in the cell
+          at += k;
+        }
+        pts.start[cell + 1] = at;
+      }
+      const std::size_t n_valid = pts.start[n_cells];
+      // (kLanes more: sumPointsWithin reads whole vectors, masking the lanes past a range.)
+      for (auto* v : {&pts.x, &pts.y, &pts.z, &pts.nx, &pts.ny, &pts.nz}) {
+        v->assign(n_valid + kLanes, 0.f);
+      }
+#pragma omp parallel for schedule(static)
+      for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_blocks_pts); ++c) {
+        const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
+        const std::size_t end = std::min(n_pts, begin + kChunk);
+        std::uint32_t* slot = &chunk_count[static_cast<std::size_t>(c) * n_cells];
+        for (std::size_t i = begin; i < end; ++i) {
+          const std::uint32_t cell = cell_of[i];
+          if (cell == kNoIndex || !normals.isValid(i)) continue;
+          const std::uint32_t j = slot[cell]++;
+          pts.x[j] = cloud.x[i] - lat.rx, pts.y[j] = cloud.y[i] - lat.ry;
+          pts.z[j] = cloud.z[i] - lat.rz;
+          pts.nx[j] = normals.nx[i], pts.ny[j] = normals.ny[i], pts.nz[j] = normals.nz[i];
+        }
+      }
+      // The chosen points grouped by cell: each cell's candidates are gathered once.
+      std::vector<std::uint32_t> chosen_start(n_cells + 1, 0), chosen_order(exact_points);
+      for (const auto& v : chosen) {
+        for (const std::uint32_t i : v) ++chosen_start[cell_of[i] + 1];
+      }
+      for (std::size_t cell = 0; cell < n_cells; ++cell) {
+        chosen_start[cell + 1] += chosen_start[cell];
+      }
+      {
+        std::vector<std::uint32_t> fill(chosen_start.begin(), chosen_start.end() - 1);
+        for (const auto& v : chosen) {
+          for (const std::uint32_t i : v) chosen_order[fill[cell_of[i]]++] = i;
+        }
+      }
+      const float m2 = mf * mf;
+      const float in2 = m2 * (1.f - 1e-4f), out2 = m2 * (1.f + 1e-4f);
+      const auto radius = static_cast<float>(params.radius_m);
+      const float r2 = radius * radius;
+      const auto min_k = static_cast<std::uint32_t>(params.min_neighbors);
+      std::size_t newly_invalid = 0;
+#pragma omp parallel reduction(+ : newly_invalid)
+      {
+        ExactCandidates cand;
+        std::vector<std::uint32_t> cells, cut_begin, cut_end;
+        std::vector<float> cut;
+#pragma omp for schedule(dynamic, 2)
+        for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
+          const auto c = static_cast<std::size_t>(cc);
+          if (chosen_start[c] == chosen_start[c + 1]) continue;
+          // The cells within m cells (box to box) of cell c: every cell a ball around one of
+          // its points can reach.
+          around(cell_block[c], cells);
+          cand.clear();
+          const std::int32_t* own = &cell_xyz[3 * c];
+          for (const std::uint32_t j : cells) {
+            std::int32_t d[3], gap2 = 0;
+            for (int a = 0; a < 3; ++a) {
+              d[a] = cell_xyz[3 * j + a] - own[a];
+              const std::int32_t gap = std::max(0, std::abs(d[a]) - 1);
+              gap2 += gap * gap;
+            }
+            if (gap2 > m * m) continue;
+            cand.append(static_cast<float>(d[0]), static_cast<float>(d[1]),
+                        static_cast<float>(d[2]), sums[j], j);
+          }
+          cand.pad();
+          cut.resize(cand.size());
+          cut_begin.resize(cand.size()), cut_end.resize(cand.size());
+          for (std::uint32_t q = chosen_start[c]; q < chosen_start[c + 1]; ++q) {
+            const std::uint32_t i = chosen_order[q];
+            float acc[4] = {0.f, 0.f, 0.f, 0.f};
+            sumWholeCells(cand, lat.gx(cloud.x[i]) - static_cast<float>(own[0]),
+                          lat.gy(cloud.y[i]) - static_cast<float>(own[1]),
+                          lat.gz(cloud.z[i]) - static_cast<float>(own[2]), in2, out2, acc,
+                          cut.data());
+            const float X = cloud.x[i] - lat.rx, Y = cloud.y[i] - lat.ry, Z = cloud.z[i] - lat.rz;
+            // The cut cells' point ranges, listed without a branch per candidate.
+            std::size_t n_cut = 0;
+            for (std::size_t j = 0; j < cand.size(); ++j) {
+              const std::uint32_t cell = cand.cell[j];
+              cut_begin[n_cut] = cell == kNoIndex ? 0 : pts.start[cell];
+              cut_end[n_cut] = cell == kNoIndex ? 0 : pts.start[cell + 1];
+              n_cut += cut[j] != 0.f ? 1 : 0;
+            }
+            sumPointsWithin(pts, cut_begin.data(), cut_end.data(), n_cut, X, Y, Z, r2, acc);
+            const auto k = static_cast<std::uint32_t>(acc[3] + 0.5f);
+            if (k < min_k) {
+              setUnscored(out, i);
+              ++newly_invalid;
+              continue;
+            }
+            out.rx[i] = acc[0], out.ry[i] = acc[1], out.rz[i] = acc[2];
+            const double r_norm = std::sqrt(double(acc[0]) * acc[0] + double(acc[1]) * acc[1] +
+                                            double(acc[2]) * acc[2]);
+            out.zeta[i] = static_cast<float>(r_norm / k);
+            out.k[i] = k;
+          }
+        }
+      }
+      invalid += newly_invalid;
+    }
+  }
   out.invalid = invalid;
   if (stats) {
+    stats->exact_points = exact_points;
     stats->cells = n_cells;
     stats->nodes = n_nodes;
     stats->blocks = n_blocks;

@@ -68,7 +68,7 @@ void runPipeline(const PointCloud& input, const PipelineParams& params, Pipeline
       res.normals = computeNormalsGrid(res.cloud, params.normals, up);
     }
     res.timings.normals_ms = lap.lapMs();
-    computeUpdFast(res.cloud, res.normals, params.upd, res.upd);
+    computeUpdFast(res.cloud, res.normals, params.upd, res.upd, nullptr, params.classify.zeta_min);
     res.timings.upd_ms = lap.lapMs();
   } else {
     res.organized_normals = false;

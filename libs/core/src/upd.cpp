@@ -19,6 +19,8 @@ void UpdParams::validate() const {
                "fast_cells_per_radius", fast_cells_per_radius, "must be in [2, 16]");
   requireParam(std::isfinite(fast_refine_spread) && fast_refine_spread >= 0, "UpdParams",
                "fast_refine_spread", fast_refine_spread, "must be >= 0");
+  requireParam(std::isfinite(fast_exact_band) && fast_exact_band >= 0, "UpdParams",
+               "fast_exact_band", fast_exact_band, "must be >= 0");
 }
 
 UpdResult computeUpd(const PointCloud& cloud, const KdTree& tree, const Normals& normals,

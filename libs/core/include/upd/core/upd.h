@@ -35,6 +35,10 @@ struct UpdParams {
   /// Fast path: a cell whose lattice nodes' zeta spread by more than this is not interpolated;
   /// its points get the lattice sums at their own position (fast_upd.h). 0 turns this off.
   double fast_refine_spread = 0.0;
+  /// Fast path: points whose zeta lies within this of the classifier's zeta_min are summed
+  /// exactly over their neighbourhood (fast_upd.h), so their label is the exact path's.
+  /// 0 turns this off.
+  double fast_exact_band = 0.0;
 
   void validate() const;
   template <class V>
@@ -51,6 +55,9 @@ struct UpdParams {
     v("fast_refine_spread", fast_refine_spread,
       "fast path: cells whose nodes' zeta spread by more than this are summed per point, "
       "not interpolated (0 = never)");
+    v("fast_exact_band", fast_exact_band,
+      "fast path: points whose zeta lies within this of [ClassifyParams] zeta_min are summed "
+      "exactly over their neighbourhood, so their label is the exact path's (0 = never)");
   }
 };
 
