@@ -6,7 +6,10 @@
 #include <limits>
 #include <stdexcept>
 
+#include "synthetic.h"
+#include "upd/core/kdtree.h"
 #include "upd/core/preprocess.h"
+#include "upd/core/scenes.h"
 
 namespace upd {
 namespace {
@@ -95,6 +98,55 @@ TEST(Preprocess, StatisticalOutliersAreIsolatedPoints) {
   const PointCloud kept = removeStatisticalOutliers(c, 8, 1.0);
   ASSERT_EQ(kept.size(), 2500u);
   for (std::size_t i = 0; i < kept.size(); ++i) EXPECT_EQ(kept.z[i], 0.f);
+}
+
+// The outlier filter's mean neighbour distances from the grid equal the k-d tree's: on a
+// voxelized scene, a random volume, a cloud with lone points far off, duplicates, and clouds
+// with fewer points than k + 1.
+TEST(Preprocess, MeanNeighbourDistancesEqualTheKdTrees) {
+  const auto kdTreeMeans = [](const PointCloud& c, int k) {
+    std::vector<double> m(c.size(), std::numeric_limits<double>::quiet_NaN());
+    const KdTree tree(c);
+    std::vector<std::uint32_t> nb;
+    std::vector<float> d2;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      if (!c.isFinite(i)) continue;
+      tree.knnSearch(c.point(i), k + 1, nb, &d2);
+      if (nb.size() < 2) continue;
+      double s = 0;
+      for (std::size_t j = 1; j < d2.size(); ++j) s += std::sqrt(static_cast<double>(d2[j]));
+      m[i] = s / static_cast<double>(d2.size() - 1);
+    }
+    return m;
+  };
+  std::vector<std::pair<std::string, PointCloud>> clouds;
+  clouds.emplace_back("rocks voxelized", voxelDownsample(makeScene("rocks").cloud, 0.02));
+  clouds.emplace_back("random volume", test::makeRandomCloud(3000, 3, 1.f));
+  PointCloud lone = makeScene("step").cloud;
+  lone.push_back(5.f, 5.f, 5.f);
+  lone.push_back(-3.f, 0.f, 2.f);
+  lone.push_back(kNan, 0.f, 0.f);
+  for (int i = 0; i < 40; ++i) lone.push_back(lone.x[7], lone.y[7], lone.z[7]);  // duplicates
+  clouds.emplace_back("lone points and duplicates", lone);
+  PointCloud few;
+  for (int i = 0; i < 5; ++i) few.push_back(0.1f * static_cast<float>(i), 0.f, 0.f);
+  clouds.emplace_back("5 points", few);
+  PointCloud one;
+  one.push_back(1.f, 2.f, 3.f);
+  clouds.emplace_back("1 point", one);
+  for (const auto& [name, c] : clouds) {
+    for (const int k : {1, 8, 16}) {
+      SCOPED_TRACE(name + ", k " + std::to_string(k));
+      const std::vector<double> grid = meanNeighbourDistances(c, k);
+      const std::vector<double> tree = kdTreeMeans(c, k);
+      ASSERT_EQ(grid.size(), c.size());
+      for (std::size_t i = 0; i < c.size(); ++i) {
+        ASSERT_EQ(std::isnan(grid[i]), std::isnan(tree[i])) << "point " << i;
+        if (std::isnan(tree[i])) continue;
+        ASSERT_NEAR(grid[i], tree[i], 1e-6 * (1.0 + tree[i])) << "point " << i;
+      }
+    }
+  }
 }
 
 TEST(Preprocess, WithEveryStepOffTheInputComesBackUnchanged) {

@@ -6,6 +6,7 @@
 #include "fast_simd.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -164,25 +165,285 @@ PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
   return out;
 }
 
-PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul) {
+namespace {
+
+// The finite points binned into cubic cells of edge h (anchored at the first finite point, as
+// the fast UPD's lattice): cell ids from a flat hash map, and the points' coordinates relative
+// to the anchor sorted by cell (counting sort), with their cloud indices.
+struct PointGrid {
+  double h = 1, inv_h = 1;
+  float ox = 0, oy = 0, oz = 0;  // anchor
+  detail::CellMap map;
+  std::vector<std::int32_t> cell_xyz;  // 3 per cell
+  std::vector<std::uint32_t> start;    // n_cells + 1
+  std::vector<float> x, y, z;          // by cell
+  std::vector<std::uint32_t> index;    // by cell: the cloud's index
+  std::vector<std::uint32_t> cell_of;  // per cloud point; kNoIndex if not finite
+
+  std::int32_t cellCoord(float v, float o) const {
+    return static_cast<std::int32_t>(std::floor(static_cast<double>(v - o) * inv_h));
+  }
+  // Squared distance from (qx, qy, qz) to the box of cell c (0 inside).
+  float boxDistance2(std::uint32_t c, float qx, float qy, float qz) const {
+    const float q[3] = {qx, qy, qz};
+    float d2 = 0.f;
+    for (int a = 0; a < 3; ++a) {
+      const auto lo = static_cast<float>(cell_xyz[3 * c + a] * h);
+      const auto hi = static_cast<float>((cell_xyz[3 * c + a] + 1) * h);
+      const float d = q[a] < lo ? lo - q[a] : (q[a] > hi ? q[a] - hi : 0.f);
+      d2 += d * d;
+    }
+    // (Shrunk by a rounding margin: a cell is skipped only when it is certainly farther.)
+    return d2 * (1.f - 1e-5f);
+  }
+  std::uint32_t find(std::int32_t cx, std::int32_t cy, std::int32_t cz) const {
+    return detail::keyFits(cx, cy, cz) ? map.find(detail::packKey(cx, cy, cz)) : detail::kNoIndex;
+  }
+};
+
+// Bins the finite points at edge h; false when a point lies beyond the keys' range.
+bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, double h,
+               PointGrid& g) {
+  g.h = h, g.inv_h = 1.0 / h;
+  const std::uint32_t f0 = finite.front();
+  g.ox = in.x[f0], g.oy = in.y[f0], g.oz = in.z[f0];
+  g.map = detail::CellMap(finite.size() / 4 + 64);
+  g.cell_xyz.clear();
+  g.cell_of.assign(in.size(), detail::kNoIndex);
+  std::vector<std::uint32_t> count;
+  for (const std::uint32_t i : finite) {
+    const std::int32_t cx = g.cellCoord(in.x[i], g.ox), cy = g.cellCoord(in.y[i], g.oy),
+                       cz = g.cellCoord(in.z[i], g.oz);
+    if (!detail::keyFits(cx, cy, cz)) return false;
+    bool inserted = false;
+    const std::uint32_t c = g.map.findOrInsert(detail::packKey(cx, cy, cz), inserted);
+    if (inserted) {
+      g.cell_xyz.insert(g.cell_xyz.end(), {cx, cy, cz});
+      count.push_back(0);
+    }
+    ++count[c];
+    g.cell_of[i] = c;
+  }
+  const std::size_t n_cells = count.size();
+  g.start.assign(n_cells + 1, 0);
+  for (std::size_t c = 0; c < n_cells; ++c) g.start[c + 1] = g.start[c] + count[c];
+  std::vector<std::uint32_t> fill(g.start.begin(), g.start.end() - 1);
+  g.x.resize(finite.size()), g.y.resize(finite.size()), g.z.resize(finite.size());
+  g.index.resize(finite.size());
+  for (const std::uint32_t i : finite) {
+    const std::uint32_t j = fill[g.cell_of[i]]++;
+    g.x[j] = in.x[i] - g.ox, g.y[j] = in.y[i] - g.oy, g.z[j] = in.z[i] - g.oz;
+    g.index[j] = i;
+  }
+  return true;
+}
+
+// The k smallest squared distances seen so far, ascending.
+class NearestK {
+ public:
+  explicit NearestK(std::size_t k) : k_(k) { d_.reserve(k + 1); }
+  void clear() { d_.clear(); }
+  void offer(float d2) {
+    if (d_.size() == k_ && !(d2 < d_.back())) return;
+    if (d_.size() < k_) d_.push_back(d2);
+    std::size_t pos = d_.size() - 1;
+    for (; pos > 0 && d2 < d_[pos - 1]; --pos) d_[pos] = d_[pos - 1];
+    d_[pos] = d2;
+  }
+  bool full() const { return d_.size() == k_; }
+  float worst() const { return d_.back(); }
+  // Mean of the square roots of all but the smallest (the query point itself, or a duplicate
+  // of it at the same distance 0: the k-d tree's answer, whichever of the two it lists first).
+  double meanWithoutFirst() const {
+    double s = 0;
+    for (std::size_t j = 1; j < d_.size(); ++j) s += std::sqrt(static_cast<double>(d_[j]));
+    return s / static_cast<double>(d_.size() - 1);
+  }
+  std::size_t size() const { return d_.size(); }
+
+ private:
+  std::size_t k_;
+  std::vector<float> d_;
+};
+
+// Distance from q (grid coordinates relative to the anchor) to the outside of the block of
+// cells within Chebyshev distance ring of its cell (cx, cy, cz): no point outside that block
+// is nearer.
+double blockMargin(const PointGrid& g, double qx, double qy, double qz, std::int32_t cx,
+                   std::int32_t cy, std::int32_t cz, int ring) {
+  double m = std::numeric_limits<double>::infinity();
+  const double q[3] = {qx, qy, qz};
+  const std::int32_t c[3] = {cx, cy, cz};
+  for (int a = 0; a < 3; ++a) {
+    const double lo = static_cast<double>(c[a] - ring) * g.h;
+    const double hi = static_cast<double>(c[a] + ring + 1) * g.h;
+    m = std::min({m, q[a] - lo, hi - q[a]});
+  }
+  return m;
+}
+
+// The cell offsets at Chebyshev distance ring (0 .. 3), sorted by their distance.
+const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
+  static const auto table = [] {
+    std::array<std::vector<std::array<std::int32_t, 3>>, 4> t;
+    for (std::int32_t r = 0; r < 4; ++r) {
+      for (std::int32_t dz = -r; dz <= r; ++dz) {
+        for (std::int32_t dy = -r; dy <= r; ++dy) {
+          for (std::int32_t dx = -r; dx <= r; ++dx) {
+            if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) == r) {
+              t[static_cast<std::size_t>(r)].push_back({dx, dy, dz});
+            }
+          }
+        }
+      }
+      std::stable_sort(t[static_cast<std::size_t>(r)].begin(), t[static_cast<std::size_t>(r)].end(),
+                       [](const auto& a, const auto& b) {
+                         return a[0] * a[0] + a[1] * a[1] + a[2] * a[2] <
+                                b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+                       });
+    }
+    return t;
+  }();
+  return table[static_cast<std::size_t>(ring)];
+}
+
+// Squared distances from (qx, qy, qz) to points [begin, end) of the grid.
+UPD_VECTOR_CLONES
+void distances2(const PointGrid& g, std::size_t begin, std::size_t end, float qx, float qy,
+                float qz, float* __restrict out) {
+  const float* __restrict x = g.x.data();
+  const float* __restrict y = g.y.data();
+  const float* __restrict z = g.z.data();
+  for (std::size_t j = begin; j < end; ++j) {
+    const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
+    out[j - begin] = dx * dx + dy * dy + dz * dz;
+  }
+}
+
+// How many points per occupied cell the grid aims at: the k + 1 nearest of a point on a
+// surface then lie within about half a cell, inside the 3 x 3 x 3 block around its cell.
+double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const std::uint32_t i : finite) {
+    const Eigen::Vector3d p = in.point(i).cast<double>();
+    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  }
+  const Eigen::Vector3d ext = (hi - lo).cwiseMax(1e-3);
+  // First guess: the points filling the bounding box; then one correction from the measured
+  // points per occupied cell, as for a surface (count ~ h^2).
+  double h = std::cbrt(ext.prod() / static_cast<double>(finite.size()));
+  PointGrid g;
+  if (!buildGrid(in, finite, h, g)) return h;
+  const double per_cell =
+      static_cast<double>(finite.size()) / static_cast<double>(g.cell_xyz.size() / 3);
+  const double target = static_cast<double>(k + 1);
+  return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
+}
+
+}  // namespace
+
+std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
   requireParam(k >= 1, "PreprocessParams", "outlier_k", k, "must be >= 1");
-  const KdTree tree(in);
   std::vector<double> mean_dist(in.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<std::uint32_t> finite;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (in.isFinite(i)) finite.push_back(static_cast<std::uint32_t>(i));
+  }
+  if (finite.empty()) return mean_dist;
+  const std::size_t want = static_cast<std::size_t>(k) + 1;  // the point itself comes first
+  // The k + 1 nearest by a grid of cells: every point of a cell is compared with the points of
+  // the 27 cells around (gathered once per cell); the answer is exact where the (k + 1)-th
+  // distance is within the block's margin. Where it is not (the edge of the data, a lone
+  // point), the block grows ring by ring up to kMaxRing, then the k-d tree answers.
+  constexpr int kMaxRing = 3;
+  PointGrid g;
+  std::vector<std::uint32_t> rest;  // points left to the k-d tree
+  if (!buildGrid(in, finite, gridCellEdge(in, finite, k), g)) {
+    rest = finite;
+  } else {
+    const std::size_t n_cells = g.start.size() - 1;
 #pragma omp parallel
-  {
-    std::vector<std::uint32_t> nb;
-    std::vector<float> d2;
-#pragma omp for schedule(dynamic, 512)
-    for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(in.size()); ++ii) {
-      const auto i = static_cast<std::size_t>(ii);
-      if (!in.isFinite(i)) continue;
-      tree.knnSearch(in.point(i), k + 1, nb, &d2);  // the point itself comes first
-      if (nb.size() < 2) continue;
-      double s = 0;
-      for (std::size_t j = 1; j < d2.size(); ++j) s += std::sqrt(static_cast<double>(d2[j]));
-      mean_dist[i] = s / static_cast<double>(d2.size() - 1);
+    {
+      NearestK best(want);
+      std::vector<float> d2;
+      std::vector<std::uint32_t> around, ring1;  // cells of a block, of the 3 x 3 x 3 block
+      std::vector<std::uint32_t> my_rest;
+      // The cells at Chebyshev distance `ring` from (cx, cy, cz), nearest first: the nearer
+      // points come first, so that NearestK rejects most later ones with one comparison.
+      const auto shell = [&](std::int32_t cx, std::int32_t cy, std::int32_t cz, int ring) {
+        around.clear();
+        for (const auto& d : shellOffsets(ring)) {
+          const std::uint32_t c = g.find(cx + d[0], cy + d[1], cz + d[2]);
+          if (c != detail::kNoIndex) around.push_back(c);
+        }
+      };
+#pragma omp for schedule(dynamic, 16)
+      for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
+        const auto c = static_cast<std::size_t>(cc);
+        const std::int32_t cx = g.cell_xyz[3 * c], cy = g.cell_xyz[3 * c + 1],
+                           cz = g.cell_xyz[3 * c + 2];
+        shell(cx, cy, cz, 0);
+        ring1 = around;
+        shell(cx, cy, cz, 1);
+        ring1.insert(ring1.end(), around.begin(), around.end());
+        for (std::uint32_t q = g.start[c]; q < g.start[c + 1]; ++q) {
+          const float qx = g.x[q], qy = g.y[q], qz = g.z[q];
+          best.clear();
+          const auto scan = [&](const std::vector<std::uint32_t>& cells) {
+            for (const std::uint32_t b : cells) {
+              // A cell whose box lies beyond the k-th distance so far holds none of the k.
+              if (best.full() && g.boxDistance2(b, qx, qy, qz) > best.worst()) continue;
+              const std::size_t n = g.start[b + 1] - g.start[b];
+              d2.resize(std::max(d2.size(), n));
+              distances2(g, g.start[b], g.start[b + 1], qx, qy, qz, d2.data());
+              for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
+            }
+          };
+          scan(ring1);
+          int ring = 1;
+          while (true) {
+            const double margin = blockMargin(g, qx, qy, qz, cx, cy, cz, ring);
+            if (best.full() && static_cast<double>(best.worst()) <= margin * margin) break;
+            if (++ring > kMaxRing) break;
+            shell(cx, cy, cz, ring);
+            scan(around);
+          }
+          if (ring > kMaxRing) {
+            my_rest.push_back(g.index[q]);
+            continue;
+          }
+          mean_dist[g.index[q]] = best.meanWithoutFirst();
+        }
+      }
+#pragma omp critical(upd_outlier_rest)
+      rest.insert(rest.end(), my_rest.begin(), my_rest.end());
     }
   }
+  if (!rest.empty()) {
+    // (The order of rest depends on the threads; each point's answer does not.)
+    const KdTree tree(in);
+#pragma omp parallel
+    {
+      std::vector<std::uint32_t> nb;
+      std::vector<float> d2;
+#pragma omp for schedule(dynamic, 64)
+      for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(rest.size()); ++r) {
+        const std::uint32_t i = rest[static_cast<std::size_t>(r)];
+        tree.knnSearch(in.point(i), k + 1, nb, &d2);
+        if (nb.size() < 2) continue;
+        double s = 0;
+        for (std::size_t j = 1; j < d2.size(); ++j) s += std::sqrt(static_cast<double>(d2[j]));
+        mean_dist[i] = s / static_cast<double>(d2.size() - 1);
+      }
+    }
+  }
+  return mean_dist;
+}
+
+PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul) {
+  requireParam(k >= 1, "PreprocessParams", "outlier_k", k, "must be >= 1");
+  const std::vector<double> mean_dist = meanNeighbourDistances(in, k);
   double s = 0, s2 = 0;
   std::size_t n = 0;
   for (const double d : mean_dist) {

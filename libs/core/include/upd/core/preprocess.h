@@ -10,6 +10,8 @@
 #include "upd/core/params.h"
 #include "upd/core/point_cloud.h"
 
+#include <vector>
+
 namespace upd {
 
 struct PreprocessParams {
@@ -60,6 +62,13 @@ PointCloud dropNonFinite(const PointCloud& in);
 PointCloud cropRange(const PointCloud& in, const PreprocessParams& p);
 PointCloud voxelDownsample(const PointCloud& in, double voxel_m);
 PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul);
+
+/// What the outlier filter thresholds: every finite point's mean distance to its k nearest
+/// other points (NaN for a point that is not finite or has no other point). The neighbours
+/// come from a grid of cells sized for about k + 1 points each (the cells around a point's
+/// own, ring by ring until the k-th distance is certain), and from a k-d tree for the few
+/// points whose neighbours lie beyond 3 rings: the k-d tree's answer, up to float rounding.
+std::vector<double> meanNeighbourDistances(const PointCloud& in, int k);
 
 /// The whole chain. With every step disabled the input is returned unchanged (organized, NaNs
 /// kept), so invalid points are scored as NaN and counted instead of silently dropped.
