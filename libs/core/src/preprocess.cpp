@@ -238,33 +238,71 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   return true;
 }
 
-// The k smallest squared distances seen so far, ascending.
+// The k smallest squared distances seen so far, ascending (k <= kMax: the outlier filter's k
+// is a few dozen at most; larger k is refused by the caller).
 class NearestK {
  public:
-  explicit NearestK(std::size_t k) : k_(k) { d_.reserve(k + 1); }
-  void clear() { d_.clear(); }
+  static constexpr std::size_t kMax = 128;
+  explicit NearestK(std::size_t k) : k_(k) {}
+  void clear() { n_ = 0; }
   void offer(float d2) {
-    if (d_.size() == k_ && !(d2 < d_.back())) return;
-    if (d_.size() < k_) d_.push_back(d2);
-    std::size_t pos = d_.size() - 1;
+    if (n_ == k_) {
+      if (!(d2 < d_[n_ - 1])) return;
+    } else {
+      ++n_;
+    }
+    std::size_t pos = n_ - 1;
     for (; pos > 0 && d2 < d_[pos - 1]; --pos) d_[pos] = d_[pos - 1];
     d_[pos] = d2;
   }
-  bool full() const { return d_.size() == k_; }
-  float worst() const { return d_.back(); }
+  bool full() const { return n_ == k_; }
+  float worst() const { return d_[n_ - 1]; }
   // Mean of the square roots of all but the smallest (the query point itself, or a duplicate
   // of it at the same distance 0: the k-d tree's answer, whichever of the two it lists first).
   double meanWithoutFirst() const {
     double s = 0;
-    for (std::size_t j = 1; j < d_.size(); ++j) s += std::sqrt(static_cast<double>(d_[j]));
-    return s / static_cast<double>(d_.size() - 1);
+    for (std::size_t j = 1; j < n_; ++j) s += std::sqrt(static_cast<double>(d_[j]));
+    return s / static_cast<double>(n_ - 1);
   }
-  std::size_t size() const { return d_.size(); }
 
  private:
-  std::size_t k_;
-  std::vector<float> d_;
+  std::size_t k_, n_ = 0;
+  float d_[kMax];
 };
+
+// The points of a block of cells as one structure of arrays, padded to a multiple of 16 with
+// far-away points (their distances are huge and never kept).
+struct BlockPoints {
+  std::vector<float> x, y, z;
+  std::size_t n = 0;
+  void fill(const PointGrid& g, const std::vector<std::uint32_t>& cells) {
+    n = 0;
+    for (const std::uint32_t c : cells) n += g.start[c + 1] - g.start[c];
+    const std::size_t cap = (n + 15) / 16 * 16;
+    x.assign(cap, 1e18f), y.assign(cap, 1e18f), z.assign(cap, 1e18f);
+    std::size_t j = 0;
+    for (const std::uint32_t c : cells) {
+      const std::uint32_t b = g.start[c], e = g.start[c + 1];
+      std::copy(&g.x[b], &g.x[b] + (e - b), &x[j]);
+      std::copy(&g.y[b], &g.y[b] + (e - b), &y[j]);
+      std::copy(&g.z[b], &g.z[b] + (e - b), &z[j]);
+      j += e - b;
+    }
+  }
+};
+
+// Squared distances from (qx, qy, qz) to every point of b, padding included.
+UPD_VECTOR_CLONES
+void blockDistances2(const BlockPoints& b, float qx, float qy, float qz, float* __restrict d2) {
+  const float* __restrict x = b.x.data();
+  const float* __restrict y = b.y.data();
+  const float* __restrict z = b.z.data();
+  const std::size_t cap = b.x.size();
+  for (std::size_t j = 0; j < cap; ++j) {
+    const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
+    d2[j] = dx * dx + dy * dy + dz * dz;
+  }
+}
 
 // Distance from q (grid coordinates relative to the anchor) to the outside of the block of
 // cells within Chebyshev distance ring of its cell (cx, cy, cz): no point outside that block
@@ -359,7 +397,8 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
   constexpr int kMaxRing = 3;
   PointGrid g;
   std::vector<std::uint32_t> rest;  // points left to the k-d tree
-  if (!buildGrid(in, finite, gridCellEdge(in, finite, k), g)) {
+  // (A k beyond NearestK's capacity, or a cloud beyond the keys' range: the k-d tree alone.)
+  if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k), g)) {
     rest = finite;
   } else {
     const std::size_t n_cells = g.start.size() - 1;
@@ -368,6 +407,8 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
       NearestK best(want);
       std::vector<float> d2;
       std::vector<std::uint32_t> around, ring1;  // cells of a block, of the 3 x 3 x 3 block
+      BlockPoints block;                         // the points of ring1, nearest cells first
+      std::vector<float> bd2;
       std::vector<std::uint32_t> my_rest;
       // The cells at Chebyshev distance `ring` from (cx, cy, cz), nearest first: the nearer
       // points come first, so that NearestK rejects most later ones with one comparison.
@@ -387,9 +428,14 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
         ring1 = around;
         shell(cx, cy, cz, 1);
         ring1.insert(ring1.end(), around.begin(), around.end());
+        block.fill(g, ring1);
+        bd2.resize(block.x.size());
         for (std::uint32_t q = g.start[c]; q < g.start[c + 1]; ++q) {
           const float qx = g.x[q], qy = g.y[q], qz = g.z[q];
           best.clear();
+          // The 3 x 3 x 3 block: its distances in one vector pass, then the nearest kept.
+          blockDistances2(block, qx, qy, qz, bd2.data());
+          for (std::size_t j = 0; j < block.n; ++j) best.offer(bd2[j]);
           const auto scan = [&](const std::vector<std::uint32_t>& cells) {
             for (const std::uint32_t b : cells) {
               // A cell whose box lies beyond the k-th distance so far holds none of the k.
@@ -400,7 +446,6 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
               for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
             }
           };
-          scan(ring1);
           int ring = 1;
           while (true) {
             const double margin = blockMargin(g, qx, qy, qz, cx, cy, cz, ring);
