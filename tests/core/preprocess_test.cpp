@@ -135,7 +135,7 @@ TEST(Preprocess, MeanNeighbourDistancesEqualTheKdTrees) {
   one.push_back(1.f, 2.f, 3.f);
   clouds.emplace_back("1 point", one);
   for (const auto& [name, c] : clouds) {
-    for (const int k : {1, 8, 16}) {
+    for (const int k : {1, 8, 16, 130}) {  // (130: beyond the grid's array, the k-d tree)
       SCOPED_TRACE(name + ", k " + std::to_string(k));
       const std::vector<double> grid = meanNeighbourDistances(c, k);
       const std::vector<double> tree = kdTreeMeans(c, k);
