@@ -167,6 +167,15 @@ PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
 
 namespace {
 
+// The cell (x, y, z) of point i in cells of edge 1 / inv_h anchored at point f0, as 64-bit
+// integers (detail::keyFits says whether they fit a key).
+inline void cellOf(const PointCloud& in, std::uint32_t i, std::uint32_t f0, double inv_h,
+                   std::int64_t (&c)[3]) {
+  c[0] = detail::floorToInt(static_cast<double>(in.x[i] - in.x[f0]) * inv_h);
+  c[1] = detail::floorToInt(static_cast<double>(in.y[i] - in.y[f0]) * inv_h);
+  c[2] = detail::floorToInt(static_cast<double>(in.z[i] - in.z[f0]) * inv_h);
+}
+
 // The finite points binned into cubic cells of edge h (anchored at the first finite point, as
 // the fast UPD's lattice): cell ids from a flat hash map, and the points' coordinates relative
 // to the anchor sorted by cell (counting sort), with their cloud indices.
@@ -178,11 +187,7 @@ struct PointGrid {
   std::vector<std::uint32_t> start;    // n_cells + 1
   std::vector<float> x, y, z;          // by cell
   std::vector<std::uint32_t> index;    // by cell: the cloud's index
-  std::vector<std::uint32_t> cell_of;  // per cloud point; kNoIndex if not finite
 
-  std::int32_t cellCoord(float v, float o) const {
-    return static_cast<std::int32_t>(std::floor(static_cast<double>(v - o) * inv_h));
-  }
   // Squared distance from (qx, qy, qz) to the box of cell c (0 inside).
   float boxDistance2(std::uint32_t c, float qx, float qy, float qz) const {
     const float q[3] = {qx, qy, qz};
@@ -196,7 +201,7 @@ struct PointGrid {
     // (Shrunk by a rounding margin: a cell is skipped only when it is certainly farther.)
     return d2 * (1.f - 1e-5f);
   }
-  std::uint32_t find(std::int32_t cx, std::int32_t cy, std::int32_t cz) const {
+  std::uint32_t find(std::int64_t cx, std::int64_t cy, std::int64_t cz) const {
     return detail::keyFits(cx, cy, cz) ? map.find(detail::packKey(cx, cy, cz)) : detail::kNoIndex;
   }
 };
@@ -209,20 +214,22 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   g.ox = in.x[f0], g.oy = in.y[f0], g.oz = in.z[f0];
   g.map = detail::CellMap(finite.size() / 4 + 64);
   g.cell_xyz.clear();
-  g.cell_of.assign(in.size(), detail::kNoIndex);
-  std::vector<std::uint32_t> count;
-  for (const std::uint32_t i : finite) {
-    const std::int32_t cx = g.cellCoord(in.x[i], g.ox), cy = g.cellCoord(in.y[i], g.oy),
-                       cz = g.cellCoord(in.z[i], g.oz);
-    if (!detail::keyFits(cx, cy, cz)) return false;
+  std::vector<std::uint32_t> count, cell_of(finite.size());
+  for (std::size_t f = 0; f < finite.size(); ++f) {
+    const std::uint32_t i = finite[f];
+    std::int64_t k[3];
+    cellOf(in, i, f0, g.inv_h, k);
+    if (!detail::keyFits(k[0], k[1], k[2])) return false;
     bool inserted = false;
-    const std::uint32_t c = g.map.findOrInsert(detail::packKey(cx, cy, cz), inserted);
+    const std::uint32_t c = g.map.findOrInsert(detail::packKey(k[0], k[1], k[2]), inserted);
     if (inserted) {
-      g.cell_xyz.insert(g.cell_xyz.end(), {cx, cy, cz});
+      g.cell_xyz.insert(g.cell_xyz.end(),
+                        {static_cast<std::int32_t>(k[0]), static_cast<std::int32_t>(k[1]),
+                         static_cast<std::int32_t>(k[2])});
       count.push_back(0);
     }
     ++count[c];
-    g.cell_of[i] = c;
+    cell_of[f] = c;
   }
   const std::size_t n_cells = count.size();
   g.start.assign(n_cells + 1, 0);
@@ -230,8 +237,9 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   std::vector<std::uint32_t> fill(g.start.begin(), g.start.end() - 1);
   g.x.resize(finite.size()), g.y.resize(finite.size()), g.z.resize(finite.size());
   g.index.resize(finite.size());
-  for (const std::uint32_t i : finite) {
-    const std::uint32_t j = fill[g.cell_of[i]]++;
+  for (std::size_t f = 0; f < finite.size(); ++f) {
+    const std::uint32_t i = finite[f];
+    const std::uint32_t j = fill[cell_of[f]]++;
     g.x[j] = in.x[i] - g.ox, g.y[j] = in.y[i] - g.oy, g.z[j] = in.z[i] - g.oz;
     g.index[j] = i;
   }
@@ -239,7 +247,7 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
 }
 
 // The k smallest squared distances seen so far, ascending (k <= kMax: the outlier filter's k
-// is a few dozen at most; larger k is refused by the caller).
+// is a few dozen at most; with a larger one the caller asks the k-d tree instead).
 class NearestK {
  public:
   static constexpr std::size_t kMax = 128;
@@ -371,10 +379,17 @@ double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& fini
   // First guess: the points filling the bounding box; then one correction from the measured
   // points per occupied cell, as for a surface (count ~ h^2).
   double h = std::cbrt(ext.prod() / static_cast<double>(finite.size()));
-  PointGrid g;
-  if (!buildGrid(in, finite, h, g)) return h;
-  const double per_cell =
-      static_cast<double>(finite.size()) / static_cast<double>(g.cell_xyz.size() / 3);
+  const std::uint32_t f0 = finite.front();
+  const double inv_h = 1.0 / h;
+  detail::CellMap cells(finite.size() / 4 + 64);
+  for (const std::uint32_t i : finite) {
+    std::int64_t c[3];
+    cellOf(in, i, f0, inv_h, c);
+    if (!detail::keyFits(c[0], c[1], c[2])) return h;  // (buildGrid refuses it too: k-d tree)
+    bool inserted = false;
+    cells.findOrInsert(detail::packKey(c[0], c[1], c[2]), inserted);
+  }
+  const double per_cell = static_cast<double>(finite.size()) / static_cast<double>(cells.size());
   const double target = static_cast<double>(k + 1);
   return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
 }
