@@ -489,6 +489,24 @@ struct ExactCandidates {
     while (lx.size() % kLanes != 0) append(1e6f, 1e6f, 1e6f, CellSums{}, kNoIndex);
   }
   std::size_t size() const { return lx.size(); }
+  // The cells of `cells` within m cells (box to box) of cell `own` (cell_xyz[3 * own]), padded:
+  // every cell that a ball of radius m around one of own's points can reach.
+  void gather(const std::vector<std::uint32_t>& cells, std::size_t own, std::int32_t m,
+              const std::int32_t* cell_xyz, const CellSums* sums) {
+    clear();
+    for (const std::uint32_t j : cells) {
+      std::int32_t d[3], gap2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        d[a] = cell_xyz[3 * j + a] - cell_xyz[3 * own + a];
+        const std::int32_t gap = std::max(0, std::abs(d[a]) - 1);
+        gap2 += gap * gap;
+      }
+      if (gap2 > m * m) continue;
+      append(static_cast<float>(d[0]), static_cast<float>(d[1]), static_cast<float>(d[2]), sums[j],
+             j);
+    }
+    pad();
+  }
 };
 
 // Sums (r, k) over the candidate cells wholly inside the ball of radius m cells around X (cell
@@ -563,6 +581,34 @@ void sumPointsWithin(const CellPoints& p, const std::uint32_t* begin, const std:
     for (int l = 0; l < kLanes; ++l) s += a[v][l];
     acc[v] += s;
   }
+}
+
+// Scratch of exactBallSums, kept by each thread across its queries.
+struct ExactScratch {
+  std::vector<float> cut;
+  std::vector<std::uint32_t> cut_begin, cut_end;
+};
+
+// Eq. 6 and k at a point over its true neighbourhood: the candidate cells wholly inside the
+// ball add their sums, the points of the cells the sphere cuts are tested one by one. q_cell is
+// the point in cell units relative to the candidates' origin, q its position relative to the
+// lattice origin (world units); in2 and out2 bracket m^2 (sumWholeCells), r2 = d_m^2.
+void exactBallSums(const ExactCandidates& cand, const CellPoints& pts, const float (&q_cell)[3],
+                   const float (&q)[3], float in2, float out2, float r2, ExactScratch& s,
+                   float (&acc)[4]) {
+  s.cut.resize(cand.size());
+  s.cut_begin.resize(cand.size()), s.cut_end.resize(cand.size());
+  acc[0] = acc[1] = acc[2] = acc[3] = 0.f;
+  sumWholeCells(cand, q_cell[0], q_cell[1], q_cell[2], in2, out2, acc, s.cut.data());
+  // The cut cells' point ranges, listed without a branch per candidate.
+  std::size_t n_cut = 0;
+  for (std::size_t j = 0; j < cand.size(); ++j) {
+    const std::uint32_t cell = cand.cell[j];
+    s.cut_begin[n_cut] = cell == kNoIndex ? 0 : pts.start[cell];
+    s.cut_end[n_cut] = cell == kNoIndex ? 0 : pts.start[cell + 1];
+    n_cut += s.cut[j] != 0.f ? 1 : 0;
+  }
+  sumPointsWithin(pts, s.cut_begin.data(), s.cut_end.data(), n_cut, q[0], q[1], q[2], r2, acc);
 }
 
 }  // namespace
@@ -997,48 +1043,24 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
 #pragma omp parallel reduction(+ : newly_invalid)
       {
         ExactCandidates cand;
-        std::vector<std::uint32_t> cells, cut_begin, cut_end;
-        std::vector<float> cut;
+        std::vector<std::uint32_t> cells;
+        ExactScratch scratch;
 #pragma omp for schedule(dynamic, 2)
         for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
           const auto c = static_cast<std::size_t>(cc);
           if (chosen_start[c] == chosen_start[c + 1]) continue;
-          // The cells within m cells (box to box) of cell c: every cell a ball around one of
-          // its points can reach.
           around(cell_block[c], cells);
-          cand.clear();
+          cand.gather(cells, c, m, cell_xyz.data(), sums.data());
           const std::int32_t* own = &cell_xyz[3 * c];
-          for (const std::uint32_t j : cells) {
-            std::int32_t d[3], gap2 = 0;
-            for (int a = 0; a < 3; ++a) {
-              d[a] = cell_xyz[3 * j + a] - own[a];
-              const std::int32_t gap = std::max(0, std::abs(d[a]) - 1);
-              gap2 += gap * gap;
-            }
-            if (gap2 > m * m) continue;
-            cand.append(static_cast<float>(d[0]), static_cast<float>(d[1]),
-                        static_cast<float>(d[2]), sums[j], j);
-          }
-          cand.pad();
-          cut.resize(cand.size());
-          cut_begin.resize(cand.size()), cut_end.resize(cand.size());
           for (std::uint32_t q = chosen_start[c]; q < chosen_start[c + 1]; ++q) {
             const std::uint32_t i = chosen_order[q];
-            float acc[4] = {0.f, 0.f, 0.f, 0.f};
-            sumWholeCells(cand, lat.gx(cloud.x[i]) - static_cast<float>(own[0]),
-                          lat.gy(cloud.y[i]) - static_cast<float>(own[1]),
-                          lat.gz(cloud.z[i]) - static_cast<float>(own[2]), in2, out2, acc,
-                          cut.data());
-            const float X = cloud.x[i] - lat.rx, Y = cloud.y[i] - lat.ry, Z = cloud.z[i] - lat.rz;
-            // The cut cells' point ranges, listed without a branch per candidate.
-            std::size_t n_cut = 0;
-            for (std::size_t j = 0; j < cand.size(); ++j) {
-              const std::uint32_t cell = cand.cell[j];
-              cut_begin[n_cut] = cell == kNoIndex ? 0 : pts.start[cell];
-              cut_end[n_cut] = cell == kNoIndex ? 0 : pts.start[cell + 1];
-              n_cut += cut[j] != 0.f ? 1 : 0;
-            }
-            sumPointsWithin(pts, cut_begin.data(), cut_end.data(), n_cut, X, Y, Z, r2, acc);
+            const float q_cell[3] = {lat.gx(cloud.x[i]) - static_cast<float>(own[0]),
+                                     lat.gy(cloud.y[i]) - static_cast<float>(own[1]),
+                                     lat.gz(cloud.z[i]) - static_cast<float>(own[2])};
+            const float q_world[3] = {cloud.x[i] - lat.rx, cloud.y[i] - lat.ry,
+                                      cloud.z[i] - lat.rz};
+            float acc[4];
+            exactBallSums(cand, pts, q_cell, q_world, in2, out2, r2, scratch, acc);
             const auto k = static_cast<std::uint32_t>(acc[3] + 0.5f);
             if (k < min_k) {
               setUnscored(out, i);
