@@ -519,11 +519,15 @@ ObservationCloud toCloud(const mrpt::obs::CObservation& obs, const SourceParams&
 void toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params,
              ObservationCloud& out) {
   params.validate();
-  // Emptied, its buffers kept: a sensor loop's range images convert without allocating.
+  // Emptied, its buffers kept: a sensor loop's range images convert without allocating (and a
+  // skipped observation, below, leaves them for the next frame too).
   PointCloud& c = out.cloud_in_robot;
-  c.x.clear(), c.y.clear(), c.z.clear(), c.r.clear(), c.g.clear(), c.b.clear();
-  c.width = 0, c.height = 1;
-  c.sensor_origin.setZero();
+  const auto empty = [&c] {
+    c.x.clear(), c.y.clear(), c.z.clear(), c.r.clear(), c.g.clear(), c.b.clear();
+    c.width = 0, c.height = 1;
+    c.sensor_origin.setZero();
+  };
+  empty();
   out.skipped_reason.clear();
   out.source_class = detail::shortClassName(obs);
   out.sensor_pose_on_robot = sensorPoseOnRobot(obs);
@@ -542,7 +546,7 @@ void toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params,
   } else {
     out.skipped_reason = out.source_class + " carries no 3D points";
   }
-  if (!out.ok()) out.cloud_in_robot = PointCloud();
+  if (!out.ok()) empty();
 }
 
 }  // namespace upd::mrptbridge
