@@ -815,6 +815,25 @@ int run(const Options& o) {
         "%.3f%% (exact normals %.0f ms, exact UPD of the sample %.0f ms, 2 threads)\n",
         frames[f].name.c_str(), a.compared, a.finite, a.mean_abs_dzeta, a.max_abs_dzeta,
         100 * a.same_label, a.exact_normals_ms, a.exact_upd_ms);
+    // What the labels' agreement costs at full resolution (not a target: the trade-off
+    // docs/PERFORMANCE.md discusses): normals per 3 x 3 pixels and exact sums within 0.004 of
+    // zeta_min.
+    PipelineParams accurate = p;
+    accurate.normals.fast_block_px = 3;
+    accurate.upd.fast_exact_band = 0.004;
+    omp_set_num_threads(1);
+    PipelineResult ar;
+    const FrameTiming at = timeFramePipeline(frames[f], accurate, std::max(3, o.repeats / 3), &ar);
+    omp_set_num_threads(2);
+    const Agreement aa = agreement(ref, ar.upd, accurate);
+    frame_cases[f]["accuracy_settings"] = {{"fast_block_px", 3},
+                                           {"fast_exact_band", 0.004},
+                                           {"one_core_ms", num(at.total_ms)},
+                                           {"agreement", aa.toJson()}};
+    std::printf(
+        "%-30s   with 3 x 3 px normals and exact sums within 0.004 of zeta_min: one core "
+        "%.2f ms, mean |dzeta| %.5f, same label %.3f%%\n",
+        "", at.total_ms, aa.mean_abs_dzeta, 100 * aa.same_label);
     std::fflush(stdout);
   }
 
