@@ -427,6 +427,8 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
       std::vector<std::uint32_t> my_rest;
       // The cells at Chebyshev distance `ring` from (cx, cy, cz), nearest first: the nearer
       // points come first, so that NearestK rejects most later ones with one comparison.
+      // Ring 0 and 1 make a cell's block (copied once per cell); the outer rings are scanned
+      // only for the few points whose k-th distance the block's margin does not settle.
       const auto shell = [&](std::int32_t cx, std::int32_t cy, std::int32_t cz, int ring) {
         around.clear();
         for (const auto& d : shellOffsets(ring)) {
@@ -451,8 +453,13 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
           // The 3 x 3 x 3 block: its distances in one vector pass, then the nearest kept.
           blockDistances2(block, qx, qy, qz, bd2.data());
           for (std::size_t j = 0; j < block.n; ++j) best.offer(bd2[j]);
-          const auto scan = [&](const std::vector<std::uint32_t>& cells) {
-            for (const std::uint32_t b : cells) {
+          int ring = 1;
+          while (true) {
+            const double margin = blockMargin(g, qx, qy, qz, cx, cy, cz, ring);
+            if (best.full() && static_cast<double>(best.worst()) <= margin * margin) break;
+            if (++ring > kMaxRing) break;
+            shell(cx, cy, cz, ring);
+            for (const std::uint32_t b : around) {
               // A cell whose box lies beyond the k-th distance so far holds none of the k.
               if (best.full() && g.boxDistance2(b, qx, qy, qz) > best.worst()) continue;
               const std::size_t n = g.start[b + 1] - g.start[b];
@@ -460,14 +467,6 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
               distances2(g, g.start[b], g.start[b + 1], qx, qy, qz, d2.data());
               for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
             }
-          };
-          int ring = 1;
-          while (true) {
-            const double margin = blockMargin(g, qx, qy, qz, cx, cy, cz, ring);
-            if (best.full() && static_cast<double>(best.worst()) <= margin * margin) break;
-            if (++ring > kMaxRing) break;
-            shell(cx, cy, cz, ring);
-            scan(around);
           }
           if (ring > kMaxRing) {
             my_rest.push_back(g.index[q]);
