@@ -220,10 +220,22 @@ TEST(JsonIo, SummaryOfARealPipelineRun) {
   // An unorganized cloud with the defaults (method auto, radius neighbourhoods): the fast path.
   EXPECT_EQ(j["method"], "fast");
   EXPECT_EQ(j["normals_method"], "hash grid");
+  EXPECT_EQ(j["exact_band"]["points"], 0u);  // off by default
+  // With the band, the points near zeta_min that got the exact sums are counted.
+  upd::PipelineParams banded = p;
+  banded.upd.fast_exact_band = 0.05;
+  const upd::PipelineResult rb = upd::runPipeline(cloud, banded);
+  const json jb = upd::io::summaryJson(rb, banded, cloud.size());
+  std::size_t near = 0;
+  for (const float z : r.upd.zeta) near += std::abs(z - banded.classify.zeta_min) < 0.05 ? 1 : 0;
+  EXPECT_GT(near, 0u);
+  EXPECT_EQ(jb["exact_band"]["points"], near);
+  EXPECT_EQ(jb["exact_band"]["band"], 0.05);
   p.upd.method = static_cast<int>(upd::UpdMethod::Exact);
   const json exact = upd::io::summaryJson(upd::runPipeline(cloud, p), p, cloud.size());
   EXPECT_EQ(exact["method"], "exact");
   EXPECT_EQ(exact["normals_method"], "exact (k-d tree)");
+  EXPECT_FALSE(exact.contains("exact_band"));
 
   TempDir dir;
   const std::string f = dir.file("summary.json");

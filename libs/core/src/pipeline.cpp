@@ -68,10 +68,13 @@ void runPipeline(const PointCloud& input, const PipelineParams& params, Pipeline
       res.normals = computeNormalsGrid(res.cloud, params.normals, up);
     }
     res.timings.normals_ms = lap.lapMs();
-    computeUpdFast(res.cloud, res.normals, params.upd, res.upd, nullptr, params.classify.zeta_min);
+    FastUpdStats stats;
+    computeUpdFast(res.cloud, res.normals, params.upd, res.upd, &stats, params.classify.zeta_min);
+    res.exact_band_points = stats.exact_points;
     res.timings.upd_ms = lap.lapMs();
   } else {
     res.organized_normals = false;
+    res.exact_band_points = 0;
     const KdTree tree(res.cloud);
     res.timings.index_ms = lap.lapMs();
     res.normals = computeNormals(res.cloud, tree, params.normals, up);

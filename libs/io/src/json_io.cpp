@@ -147,6 +147,12 @@ json summaryJson(const PipelineResult& result, const PipelineParams& params,
   j["normals_method"] = result.method == UpdMethod::Exact ? "exact (k-d tree)"
                         : result.organized_normals        ? "organized window scans"
                                                           : "hash grid";
+  if (result.method == UpdMethod::Fast) {
+    // The points near zeta_min that got the exact sums (UpdParams::fast_exact_band).
+    j["exact_band"] = {{"band", doubleValue(params.upd.fast_exact_band)},
+                       {"zeta_min", doubleValue(params.classify.zeta_min)},
+                       {"points", result.exact_band_points}};
+  }
   j["zeta"] = z;
   j["labels"] = {{"traversable", traversable},
                  {"non_traversable", non_traversable},

@@ -55,6 +55,9 @@ struct PipelineResult {
   StageTimings timings;
   UpdMethod method = UpdMethod::Exact;  ///< exact or fast, as resolveMethod chose
   bool organized_normals = false;        ///< fast path: normals from image-window scans
+  /// Fast path: the points whose zeta lay within UpdParams::fast_exact_band of the classifier's
+  /// zeta_min and were summed exactly (0 with the band off).
+  std::size_t exact_band_points = 0;
 };
 
 /// Runs the chain; throws std::invalid_argument for bad parameters. An empty input (or one
