@@ -246,6 +246,25 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   return true;
 }
 
+// Squared distances from (qx, qy, qz) to the n points (x, y, z)[j], into out.
+UPD_VECTOR_CLONES
+void distances2(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                std::size_t n, float qx, float qy, float qz, float* __restrict out) {
+  for (std::size_t j = 0; j < n; ++j) {
+    const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
+    out[j] = dx * dx + dy * dy + dz * dz;
+  }
+}
+
+// Mean of the square roots of d2[1, n): the k nearest's mean distance, leaving out the first
+// (the query point itself, or a duplicate of it at the same distance 0: the k-d tree's answer,
+// whichever of the two it lists first).
+double meanRootWithoutFirst(const float* d2, std::size_t n) {
+  double s = 0;
+  for (std::size_t j = 1; j < n; ++j) s += std::sqrt(static_cast<double>(d2[j]));
+  return s / static_cast<double>(n - 1);
+}
+
 // The k smallest squared distances seen so far, ascending (k <= kMax: the outlier filter's k
 // is a few dozen at most; with a larger one the caller asks the k-d tree instead).
 class NearestK {
@@ -265,13 +284,7 @@ class NearestK {
   }
   bool full() const { return n_ == k_; }
   float worst() const { return d_[n_ - 1]; }
-  // Mean of the square roots of all but the smallest (the query point itself, or a duplicate
-  // of it at the same distance 0: the k-d tree's answer, whichever of the two it lists first).
-  double meanWithoutFirst() const {
-    double s = 0;
-    for (std::size_t j = 1; j < n_; ++j) s += std::sqrt(static_cast<double>(d_[j]));
-    return s / static_cast<double>(n_ - 1);
-  }
+  double meanWithoutFirst() const { return meanRootWithoutFirst(d_, n_); }
 
  private:
   std::size_t k_, n_ = 0;
@@ -298,19 +311,6 @@ struct BlockPoints {
     }
   }
 };
-
-// Squared distances from (qx, qy, qz) to every point of b, padding included.
-UPD_VECTOR_CLONES
-void blockDistances2(const BlockPoints& b, float qx, float qy, float qz, float* __restrict d2) {
-  const float* __restrict x = b.x.data();
-  const float* __restrict y = b.y.data();
-  const float* __restrict z = b.z.data();
-  const std::size_t cap = b.x.size();
-  for (std::size_t j = 0; j < cap; ++j) {
-    const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
-    d2[j] = dx * dx + dy * dy + dz * dz;
-  }
-}
 
 // Distance from q (grid coordinates relative to the anchor) to the outside of the block of
 // cells within Chebyshev distance ring of its cell (cx, cy, cz): no point outside that block
@@ -351,19 +351,6 @@ const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
     return t;
   }();
   return table[static_cast<std::size_t>(ring)];
-}
-
-// Squared distances from (qx, qy, qz) to points [begin, end) of the grid.
-UPD_VECTOR_CLONES
-void distances2(const PointGrid& g, std::size_t begin, std::size_t end, float qx, float qy,
-                float qz, float* __restrict out) {
-  const float* __restrict x = g.x.data();
-  const float* __restrict y = g.y.data();
-  const float* __restrict z = g.z.data();
-  for (std::size_t j = begin; j < end; ++j) {
-    const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
-    out[j - begin] = dx * dx + dy * dy + dz * dz;
-  }
 }
 
 // How many points per occupied cell the grid aims at: the k + 1 nearest of a point on a
@@ -451,7 +438,8 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
           const float qx = g.x[q], qy = g.y[q], qz = g.z[q];
           best.clear();
           // The 3 x 3 x 3 block: its distances in one vector pass, then the nearest kept.
-          blockDistances2(block, qx, qy, qz, bd2.data());
+          distances2(block.x.data(), block.y.data(), block.z.data(), block.x.size(), qx, qy, qz,
+                     bd2.data());
           for (std::size_t j = 0; j < block.n; ++j) best.offer(bd2[j]);
           int ring = 1;
           while (true) {
@@ -464,7 +452,8 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
               if (best.full() && g.boxDistance2(b, qx, qy, qz) > best.worst()) continue;
               const std::size_t n = g.start[b + 1] - g.start[b];
               d2.resize(std::max(d2.size(), n));
-              distances2(g, g.start[b], g.start[b + 1], qx, qy, qz, d2.data());
+              distances2(&g.x[g.start[b]], &g.y[g.start[b]], &g.z[g.start[b]], n, qx, qy, qz,
+                         d2.data());
               for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
             }
           }
@@ -491,9 +480,7 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
         const std::uint32_t i = rest[static_cast<std::size_t>(r)];
         tree.knnSearch(in.point(i), k + 1, nb, &d2);
         if (nb.size() < 2) continue;
-        double s = 0;
-        for (std::size_t j = 1; j < d2.size(); ++j) s += std::sqrt(static_cast<double>(d2[j]));
-        mean_dist[i] = s / static_cast<double>(d2.size() - 1);
+        mean_dist[i] = meanRootWithoutFirst(d2.data(), d2.size());
       }
     }
   }
