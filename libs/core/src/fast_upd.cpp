@@ -509,6 +509,15 @@ struct ExactCandidates {
   }
 };
 
+// Adds the lane sums of the four accumulators (r_x, r_y, r_z, k) to acc.
+inline void addLanes(const float (&a)[4][kLanes], float (&acc)[4]) {
+  for (int v = 0; v < 4; ++v) {
+    float s = 0.f;
+    for (int l = 0; l < kLanes; ++l) s += a[v][l];
+    acc[v] += s;
+  }
+}
+
 // Sums (r, k) over the candidate cells wholly inside the ball of radius m cells around X (cell
 // units, relative to the candidates' origin) into acc, and marks in cut the cells the sphere
 // cuts (their points are summed one by one). in2 and out2 bracket m^2 by a rounding margin, so
@@ -538,11 +547,7 @@ void sumWholeCells(const ExactCandidates& c, float X, float Y, float Z, float in
       a[3][l] += inside * cnt[j];
     }
   }
-  for (int v = 0; v < 4; ++v) {
-    float s = 0.f;
-    for (int l = 0; l < kLanes; ++l) s += a[v][l];
-    acc[v] += s;
-  }
+  addLanes(a, acc);
 }
 
 // Adds the normals of the points of cells [0, n) (their ranges [begin[c], end[c]) in p) within
@@ -576,11 +581,7 @@ void sumPointsWithin(const CellPoints& p, const std::uint32_t* begin, const std:
       }
     }
   }
-  for (int v = 0; v < 4; ++v) {
-    float s = 0.f;
-    for (int l = 0; l < kLanes; ++l) s += a[v][l];
-    acc[v] += s;
-  }
+  addLanes(a, acc);
 }
 
 // Scratch of exactBallSums, kept by each thread across its queries.
