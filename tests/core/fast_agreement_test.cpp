@@ -126,6 +126,7 @@ TEST(FastNormals, OrganizedScansFindTheExactNeighbourhoods) {
   NormalParams p;
   p.radius_m = 0.05;
   p.fast_block_px = 1;  // a normal per pixel: the scans alone
+  p.fast_scan_px = 24;  // wider than the ball beyond ~1.3 m in this quarter-resolution frame
   const KdTree tree(c);
   const Normals exact = computeNormals(c, tree, p, rs.scene.up);
   const Normals fast = computeNormalsOrganized(c, p, rs.scene.up);
@@ -355,12 +356,57 @@ TEST(FastUpd, CostDoesNotDependOnTheRadiusButTheLatticeSizeDoes) {
   for (const double d_m : {0.25, 0.5, 1.0, 2.0}) {
     UpdParams p;
     p.radius_m = d_m;
+    p.fast_cells_per_point = 0;  // a fixed number of cells per d_m (see the next test)
     FastUpdStats st;
     const UpdResult r = computeUpdFast(s.cloud, n, p, &st);
     EXPECT_EQ(r.size(), s.cloud.size());
     EXPECT_LT(st.nodes, previous_nodes) << "d_m " << d_m;
     previous_nodes = st.nodes;
   }
+}
+
+TEST(FastUpd, FinerLatticeKeepsItsCellsWithinTheBudget) {
+  // The largest m up to 2 x 4 whose estimated cells (cells at 4 times (m / 4)^2) fit.
+  EXPECT_EQ(finerCellsPerRadius(4, 3115, 254345, 0.015), 4);  // 3115 * 1.5625 > 3815
+  EXPECT_EQ(finerCellsPerRadius(4, 1000, 150000, 0.015), 6);  // 1000 * 2.25 <= 2250 < 1000 * 3.06
+  EXPECT_EQ(finerCellsPerRadius(4, 757, 259845, 0.015), 8);   // 3028 <= 3898: the cap, 2 x 4
+  EXPECT_EQ(finerCellsPerRadius(10, 10, 1e6, 0.015), 16);     // never beyond 16
+  EXPECT_EQ(finerCellsPerRadius(4, 100, 0, 0.015), 4);        // no valid normal: as given
+}
+
+TEST(FastUpd, DenseCloudsGetAFinerLatticeAndCloserSums) {
+  // Rocks sampled every 1 cm (~100 points per occupied 12.5 cm cell) under a budget of 0.03
+  // cells per point: a finer lattice, and sums closer to exact. Sampled every 2 cm (~25 points
+  // per cell), they keep 4 cells per d_m. (Not every scene improves at every step: an
+  // axis-aligned step's error depends on where the cell faces fall, and at 5 or 6 cells per
+  // d_m it is larger than at 4; from 7 on it is smaller. Rocks and ramps improve steadily.)
+  SceneParams sp;
+  sp.spacing_m = 0.01;
+  sp.noise_m = 0.002;
+  const Scene dense = makeScene("rocks", sp);
+  const Normals normals = exactNormals(dense);
+  UpdParams fixed;
+  fixed.radius_m = 0.5;
+  fixed.fast_cells_per_point = 0;
+  UpdParams budget = fixed;
+  budget.fast_cells_per_point = 0.03;
+  FastUpdStats fs, bs;
+  const UpdResult f = computeUpdFast(dense.cloud, normals, fixed, &fs);
+  const UpdResult b = computeUpdFast(dense.cloud, normals, budget, &bs);
+  EXPECT_EQ(fs.cells_per_radius, 4);
+  EXPECT_GT(bs.cells_per_radius, 4);
+  const double valid = static_cast<double>(dense.cloud.size() - normals.invalid);
+  EXPECT_EQ(bs.cells_per_radius, finerCellsPerRadius(4, fs.cells, valid, 0.03));
+  const std::size_t stride = dense.cloud.size() / 3000;
+  const Agreement af = agreeWithExact(dense.cloud, normals, f, fixed, dense.up, stride);
+  const Agreement ab = agreeWithExact(dense.cloud, normals, b, budget, dense.up, stride);
+  EXPECT_LT(ab.mean_abs_dzeta, 0.8 * af.mean_abs_dzeta);
+  EXPECT_GE(ab.same_label, af.same_label);
+
+  const Scene sparse = noisyScene("rocks");
+  FastUpdStats ss;
+  computeUpdFast(sparse.cloud, exactNormals(sparse), budget, &ss);
+  EXPECT_EQ(ss.cells_per_radius, 4);
 }
 
 TEST(FastPaths, DegenerateInputsGiveNaNAndCounts) {

@@ -221,6 +221,8 @@ TEST(JsonIo, SummaryOfARealPipelineRun) {
   EXPECT_EQ(j["method"], "fast");
   EXPECT_EQ(j["normals_method"], "hash grid");
   EXPECT_EQ(j["exact_band"]["points"], 0u);  // off by default
+  EXPECT_EQ(j["lattice_cells_per_radius"], r.fast_cells_per_radius);
+  EXPECT_GE(r.fast_cells_per_radius, p.upd.fast_cells_per_radius);
   // With the band, the points near zeta_min that got the exact sums are counted.
   upd::PipelineParams banded = p;
   banded.upd.fast_exact_band = 0.05;
@@ -236,6 +238,7 @@ TEST(JsonIo, SummaryOfARealPipelineRun) {
   EXPECT_EQ(exact["method"], "exact");
   EXPECT_EQ(exact["normals_method"], "exact (k-d tree)");
   EXPECT_FALSE(exact.contains("exact_band"));
+  EXPECT_FALSE(exact.contains("lattice_cells_per_radius"));
 
   TempDir dir;
   const std::string f = dir.file("summary.json");

@@ -283,10 +283,9 @@ std::vector<float> pitchProfile(const PointCloud& cloud, const float* range, boo
   return lowest;
 }
 
-// Largest half-width of a scanned window [pixels]; wider windows than kScanSide + 1 pixels are
-// sampled every 2nd or 4th row and column (at most 16 x 16 points at full rate).
+// Largest half-width of a scanned window [pixels]; windows wider than
+// NormalParams::fast_scan_px are sampled every 2nd or 4th row and column.
 constexpr std::ptrdiff_t kMaxHalf = 96;
-constexpr std::ptrdiff_t kScanSide = 23;
 
 // kScanLanes floats as one GCC vector: the compiler emits AVX-512, AVX2 or SSE code for it in the
 // respective UPD_VECTOR_CLONES version of a function (no intrinsics, no -march).
@@ -417,7 +416,7 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   // The calling thread's buffers, kept for the next frame and shared by the team (their
   // pointers are taken here, outside the parallel regions).
   static thread_local std::vector<float> buffer, range_buffer;
-  const std::size_t image_len = N + kMaxHalf + kScanLanes * kScanSide;
+  const std::size_t image_len = N + kMaxHalf + kScanLanes;
   buffer.resize(3 * image_len);
   range_buffer.resize(N);
   float* const X = buffer.data();
@@ -468,9 +467,11 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   // The ball of radius r around a point at range rho subtends asin(r / rho) each way: its
   // pixels lie within that angle over the pitch of their column and row, plus one. Those
   // windows are scanned and the points within r in 3D kept: the neighbours of the exact path.
-  // A window wider than kScanSide + 1 pixels (a near point) is scanned every 2nd or 4th row
-  // and column: a regular sample of its ball, still hundreds of points.
+  // A window wider than fast_scan_px pixels (a near point) is scanned every 2nd row and column,
+  // one wider than twice that every 4th: a regular sample of its ball, still hundreds of
+  // points.
   const double radius = params.radius_m;
+  const std::ptrdiff_t scan_px = params.fast_scan_px;
   const auto radius2 = static_cast<float>(radius * radius);
   const auto scanMoments = [&](std::ptrdiff_t u, std::ptrdiff_t v, std::size_t i) {
     const double angle = std::asin(std::min(1.0, radius / range[i]));
@@ -478,10 +479,10 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
         kMaxHalf, static_cast<std::ptrdiff_t>(angle / pitch_u[static_cast<std::size_t>(u)]) + 1);
     const auto ev = std::min<std::ptrdiff_t>(
         kMaxHalf, static_cast<std::ptrdiff_t>(angle / pitch_v[static_cast<std::size_t>(v)]) + 1);
-    // Every stride-th row and column (1, 2 or 4) so that at most kScanSide + 1 of each: the
+    // Every stride-th row and column (1, 2 or 4) so that at most fast_scan_px of each: the
     // columns of the sparse images, the window's first one rounded down to them.
     const std::ptrdiff_t side = 2 * std::max(eu, ev) + 1;
-    const std::ptrdiff_t stride = side <= kScanSide + 1 ? 1 : side <= 2 * (kScanSide + 1) ? 2 : 4;
+    const std::ptrdiff_t stride = side <= scan_px ? 1 : side <= 2 * scan_px ? 2 : 4;
     const std::ptrdiff_t v0 = std::max<std::ptrdiff_t>(0, v - ev);
     const std::ptrdiff_t v1 = std::min<std::ptrdiff_t>(Hi - 1, v + ev);
     const std::ptrdiff_t a0 = std::max<std::ptrdiff_t>(0, u - eu) / stride;

@@ -612,7 +612,69 @@ void exactBallSums(const ExactCandidates& cand, const CellPoints& pts, const flo
   sumPointsWithin(pts, s.cut_begin.data(), s.cut_end.data(), n_cut, q[0], q[1], q[2], r2, acc);
 }
 
+// Bins points [first, cloud.size()) in chunks of chunk points (binRange), then merges the
+// chunks' cells in chunk order; cell_of[i] is then point i's cell in the result.
+Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+               std::size_t first, std::size_t chunk, double radius_m, std::uint32_t* cell_of) {
+  const std::size_t n_pts = cloud.size();
+  const std::size_t n_chunks = (n_pts - first + chunk - 1) / chunk;
+  std::vector<Bins> chunk_bins(n_chunks);
+  int all_fit = 1;
+  // Static schedules here and below: every stage of a frame deals the points out to the threads
+  // in the same contiguous shares, so that a point's data stay in one core's cache (see
+  // copyCloud). Dynamic schedules scattered them, and on a two-vCPU VM a line the other core
+  // has read costs twice as much to write again.
+#pragma omp parallel for schedule(static) reduction(& : all_fit)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
+    const std::size_t begin = first + static_cast<std::size_t>(c) * chunk;
+    all_fit &=
+        binRange(cloud, normals, lat, begin, std::min(n_pts, begin + chunk), chunk_bins[c], cell_of)
+            ? 1
+            : 0;
+  }
+  if (!all_fit) {
+    throw std::invalid_argument(
+        "UpdParams.radius_m = " + std::to_string(radius_m) +
+        ": the cloud spans more than 2^20 fast-path lattice cells along an axis; use a "
+        "range cut-off, a larger radius or fewer fast_cells_per_radius");
+  }
+  Bins bins = std::move(chunk_bins[0]);
+  std::vector<std::vector<std::uint32_t>> remap(n_chunks);
+  for (std::size_t c = 1; c < n_chunks; ++c) {
+    const Bins& cb = chunk_bins[c];
+    remap[c].resize(cb.sums.size());
+    for (std::size_t j = 0; j < cb.sums.size(); ++j) {
+      const std::uint32_t id = bins.cellOf(cb.xyz[3 * j], cb.xyz[3 * j + 1], cb.xyz[3 * j + 2]);
+      bins.sums[id].add(cb.sums[j]);
+      remap[c][j] = id;
+    }
+  }
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
+    if (c == 0) continue;  // (from 0: the same shares as the binning)
+    const std::size_t begin = first + static_cast<std::size_t>(c) * chunk;
+    const std::size_t end = std::min(n_pts, begin + chunk);
+    for (std::size_t i = begin; i < end; ++i) {
+      if (cell_of[i] != kNoIndex) cell_of[i] = remap[c][cell_of[i]];
+    }
+  }
+  return bins;
+}
+
 }  // namespace
+
+int finerCellsPerRadius(int cells_per_radius, std::size_t cells, double valid_points,
+                        double cells_per_point) {
+  const int top = std::min(2 * cells_per_radius, 16);
+  int m = cells_per_radius;
+  // On a surface the occupied cells grow as the square of the cells per d_m.
+  while (m < top) {
+    const double ratio = static_cast<double>(m + 1) / cells_per_radius;
+    if (static_cast<double>(cells) * ratio * ratio > cells_per_point * valid_points) break;
+    ++m;
+  }
+  return m;
+}
 
 UpdResult computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdParams& params,
                          FastUpdStats* stats, double zeta_threshold) {
@@ -638,7 +700,7 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   out.invalid = 0;
   if (stats) *stats = FastUpdStats{};
 
-  const int m = params.fast_cells_per_radius;
+  int m = params.fast_cells_per_radius;  // or finer, below
   Lattice lat;
   lat.inv_cell = static_cast<float>(m / params.radius_m);
   std::size_t first = 0;
@@ -663,47 +725,19 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   // equal share.
   const std::size_t n_chunks = (n_pts - first + (std::size_t(1) << 15) - 1) >> 15;
   const std::size_t kChunk = ((n_pts - first + n_chunks - 1) / n_chunks + 255) / 256 * 256;
-  std::vector<Bins> chunk_bins(n_chunks);
-  int all_fit = 1;
-  // Static schedules here and below: every stage of a frame deals the points out to the threads
-  // in the same contiguous shares, so that a point's data stay in one core's cache (see
-  // copyCloud). Dynamic schedules scattered them, and on a two-vCPU VM a line the other core
-  // has read costs twice as much to write again.
-#pragma omp parallel for schedule(static) reduction(& : all_fit)
-  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
-    const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
-    all_fit &= binRange(cloud, normals, lat, begin, std::min(n_pts, begin + kChunk),
-                        chunk_bins[c], cell_of)
-                   ? 1
-                   : 0;
-  }
-  if (!all_fit) {
-    throw std::invalid_argument(
-        "UpdParams.radius_m = " + std::to_string(params.radius_m) +
-        ": the cloud spans more than 2^20 fast-path lattice cells along an axis; use a "
-        "range cut-off, a larger radius or fewer fast_cells_per_radius");
-  }
-  Bins bins = std::move(chunk_bins[0]);
-  std::vector<std::vector<std::uint32_t>> remap(n_chunks);
-  for (std::size_t c = 1; c < n_chunks; ++c) {
-    const Bins& cb = chunk_bins[c];
-    remap[c].resize(cb.sums.size());
-    for (std::size_t j = 0; j < cb.sums.size(); ++j) {
-      const std::uint32_t id = bins.cellOf(cb.xyz[3 * j], cb.xyz[3 * j + 1], cb.xyz[3 * j + 2]);
-      bins.sums[id].add(cb.sums[j]);
-      remap[c][j] = id;
+  Bins bins = binPoints(cloud, normals, lat, first, kChunk, params.radius_m, cell_of);
+  // A finer lattice where the points are dense (fast_cells_per_point): the node work grows
+  // with the cells, so it stays a fixed share of the per-point work.
+  if (params.fast_cells_per_point > 0) {
+    double valid = 0;
+    for (const CellSums& cs : bins.sums) valid += cs.count;
+    const int finer = finerCellsPerRadius(m, bins.sums.size(), valid, params.fast_cells_per_point);
+    if (finer > m) {
+      m = finer;
+      lat.inv_cell = static_cast<float>(m / params.radius_m);
+      bins = binPoints(cloud, normals, lat, first, kChunk, params.radius_m, cell_of);
     }
   }
-#pragma omp parallel for schedule(static)
-  for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
-    if (c == 0) continue;  // (from 0: the same shares as the binning)
-    const std::size_t begin = first + static_cast<std::size_t>(c) * kChunk;
-    const std::size_t end = std::min(n_pts, begin + kChunk);
-    for (std::size_t i = begin; i < end; ++i) {
-      if (cell_of[i] != kNoIndex) cell_of[i] = remap[c][cell_of[i]];
-    }
-  }
-  chunk_bins.clear();
   const std::vector<std::int32_t>& cell_xyz = bins.xyz;
   const std::vector<CellSums>& sums = bins.sums;
   const std::size_t n_cells = sums.size();
@@ -1086,6 +1120,7 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
     stats->nodes = n_nodes;
     stats->blocks = n_blocks;
     stats->refined_points = refined_points;
+    stats->cells_per_radius = m;
   }
 }
 

@@ -17,6 +17,8 @@ void NormalParams::validate() const {
                "vertical_band_deg", vertical_band_rad * kRadToDeg, "must be in [0, 90)");
   requireParam(fast_block_px >= 1 && fast_block_px <= 16, "NormalParams", "fast_block_px",
                fast_block_px, "must be in [1, 16]");
+  requireParam(fast_scan_px >= 1 && fast_scan_px <= 193, "NormalParams", "fast_scan_px",
+               fast_scan_px, "must be in [1, 193]");
   requireParam(std::isfinite(max_depth_jump_ratio) && max_depth_jump_ratio > 0, "NormalParams",
                "max_depth_jump_ratio", max_depth_jump_ratio, "must be > 0");
 }

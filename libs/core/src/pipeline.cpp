@@ -71,10 +71,12 @@ void runPipeline(const PointCloud& input, const PipelineParams& params, Pipeline
     FastUpdStats stats;
     computeUpdFast(res.cloud, res.normals, params.upd, res.upd, &stats, params.classify.zeta_min);
     res.exact_band_points = stats.exact_points;
+    res.fast_cells_per_radius = stats.cells_per_radius;
     res.timings.upd_ms = lap.lapMs();
   } else {
     res.organized_normals = false;
     res.exact_band_points = 0;
+    res.fast_cells_per_radius = 0;
     const KdTree tree(res.cloud);
     res.timings.index_ms = lap.lapMs();
     res.normals = computeNormals(res.cloud, tree, params.normals, up);

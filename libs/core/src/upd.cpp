@@ -17,6 +17,8 @@ void UpdParams::validate() const {
                method, "the fast path (2) sums over the radius d_m: it needs knn = 0");
   requireParam(fast_cells_per_radius >= 2 && fast_cells_per_radius <= 16, "UpdParams",
                "fast_cells_per_radius", fast_cells_per_radius, "must be in [2, 16]");
+  requireParam(std::isfinite(fast_cells_per_point) && fast_cells_per_point >= 0, "UpdParams",
+               "fast_cells_per_point", fast_cells_per_point, "must be >= 0");
   requireParam(std::isfinite(fast_refine_spread) && fast_refine_spread >= 0, "UpdParams",
                "fast_refine_spread", fast_refine_spread, "must be >= 0");
   requireParam(std::isfinite(fast_exact_band) && fast_exact_band >= 0, "UpdParams",

@@ -152,6 +152,8 @@ json summaryJson(const PipelineResult& result, const PipelineParams& params,
     j["exact_band"] = {{"band", doubleValue(params.upd.fast_exact_band)},
                        {"zeta_min", doubleValue(params.classify.zeta_min)},
                        {"points", result.exact_band_points}};
+    // The lattice used: fast_cells_per_radius, or finer on a dense cloud (fast_cells_per_point).
+    j["lattice_cells_per_radius"] = result.fast_cells_per_radius;
   }
   j["zeta"] = z;
   j["labels"] = {{"traversable", traversable},

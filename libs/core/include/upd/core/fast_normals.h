@@ -8,9 +8,9 @@
 // from the cloud's own rays: no intrinsics needed). The window is scanned, a vector of pixels
 // at a time, and the points within r in 3D are kept: the same neighbourhood as a k-d tree
 // radius search, without building or walking a tree. Near the sensor, where a ball spans more
-// than 24 pixels, every 2nd or 4th row and column is scanned (a regular sample of hundreds of
-// its points). One normal is computed per block of fast_block_px x fast_block_px pixels, at
-// its centre. A pixel takes the normal of the nearest block centre on its surface (range
+// than fast_scan_px pixels (48), every 2nd or 4th row and column is scanned (a regular sample
+// of hundreds of its points). One normal is computed per block of fast_block_px x fast_block_px
+// pixels, at its centre. A pixel takes the normal of the nearest block centre on its surface (range
 // within max_depth_jump_ratio of the pixel's): its own block's, else the closest in range of
 // the 8 blocks around it. A pixel with none (a depth edge, a thin object) computes its own.
 // The UPD sums thousands of normals per point, so sharing changes zeta by about 1e-3 while

@@ -37,6 +37,17 @@
 // normal is equal, so r = k n exactly and zeta = 1 at any slope. UpdResult::k is the
 // interpolated count rounded to an integer.
 //
+// A finer lattice where the points are dense (fast_cells_per_point, default 0.015): the points
+// are binned at fast_cells_per_radius first; if the occupied cells number well below
+// fast_cells_per_point per point with a valid normal, the lattice is rebinned at the largest
+// number of cells per d_m, up to twice fast_cells_per_radius, whose cells (estimated as a
+// surface's: growing as its square) stay within that budget. The node work, which follows the
+// cells, then stays a fixed share of the per-point work, so the cost per point still does not
+// grow with d_m; what grows is the accuracy where a frame is dense. A full-resolution Kinect frame
+// of a near scene (region_growing: ~350 points per 12.5 cm cell) gets 8 cells per d_m, and its
+// labels agree with the exact path on 99.6 % of the points instead of 98.9 %; a far, wide one
+// (office1) keeps 4; a cloud voxelized at 2 cm (a few dozen points per cell) keeps 4.
+//
 // Exact near the label threshold (fast_exact_band > 0, given the classifier's zeta_min): the
 // points whose interpolated zeta lies within the band of zeta_min are summed exactly, over the
 // same lattice: a cell wholly inside the ball adds its sums, and the points of a cell the
@@ -65,7 +76,15 @@ struct FastUpdStats {
   std::size_t blocks = 0;  ///< groups of (fast_cells_per_radius + 1)^3 cells, the work units
   std::size_t refined_points = 0;  ///< points summed at their own position, not interpolated
   std::size_t exact_points = 0;    ///< points summed exactly (near the label threshold)
+  int cells_per_radius = 0;        ///< lattice cells per d_m used (fast_cells_per_point)
 };
+
+/// The lattice's cells per d_m for UpdParams::fast_cells_per_point: the largest m from
+/// cells_per_radius up to min(2 cells_per_radius, 16) whose occupied cells, estimated as
+/// cells (m / cells_per_radius)^2 (a surface), number at most cells_per_point * valid_points.
+/// cells: the occupied cells at cells_per_radius; valid_points: the points with a valid normal.
+int finerCellsPerRadius(int cells_per_radius, std::size_t cells, double valid_points,
+                        double cells_per_point);
 
 /// UPD of every point of cloud from its normals by the lattice of voxel moments described in
 /// the header comment. params.knn must be 0 (std::invalid_argument otherwise). The cloud may

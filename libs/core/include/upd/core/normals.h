@@ -33,6 +33,11 @@ struct NormalParams {
   /// fast_block_px x fast_block_px pixels (at its centre) and shared by the pixels on its
   /// surface in the block and the 8 blocks around it (each takes the nearest in range).
   int fast_block_px = 4;
+  /// Fast path on organized clouds: the ball's pixel window is scanned at every pixel up to
+  /// this many pixels across, every 2nd row and column up to twice that, every 4th beyond
+  /// (near points, whose balls span many pixels). Sampling every 2nd pixel on a quantized Kinect
+  /// depth staircase tilts the normals enough to flip labels (docs/PERFORMANCE.md).
+  int fast_scan_px = 48;
   /// Fast path on organized clouds: a pixel shares a block centre's normal only when their
   /// ranges differ by at most this fraction of the range [-] (PCL's depth-change factor is 0.02).
   double max_depth_jump_ratio = 0.02;
@@ -48,6 +53,9 @@ struct NormalParams {
     v("fast_block_px", fast_block_px,
       "fast path, organized clouds: one normal per block of this many pixels squared, shared "
       "by the pixels on the same surface nearby (1 = a normal per pixel)");
+    v("fast_scan_px", fast_scan_px,
+      "fast path, organized clouds: windows up to this many pixels across are scanned at "
+      "every pixel, up to twice that every 2nd row and column, wider ones every 4th");
     v("max_depth_jump_ratio", max_depth_jump_ratio,
       "fast path, organized clouds: a pixel shares a block centre's normal only if their "
       "ranges differ by at most this fraction of the range");

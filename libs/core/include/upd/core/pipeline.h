@@ -58,6 +58,9 @@ struct PipelineResult {
   /// Fast path: the points whose zeta lay within UpdParams::fast_exact_band of the classifier's
   /// zeta_min and were summed exactly (0 with the band off).
   std::size_t exact_band_points = 0;
+  /// Fast path: the lattice's cells per d_m (UpdParams::fast_cells_per_radius, or finer under
+  /// fast_cells_per_point); 0 on the exact path.
+  int fast_cells_per_radius = 0;
 };
 
 /// Runs the chain; throws std::invalid_argument for bad parameters. An empty input (or one

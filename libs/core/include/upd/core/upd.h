@@ -32,6 +32,11 @@ struct UpdParams {
   /// Fast path: lattice cells per d_m (fast_upd.h). The node work grows as its 4th power; the
   /// error falls with it (4: mean |delta zeta| ~2e-3; 8: ~7e-4 on the generated scenes).
   int fast_cells_per_radius = 4;
+  /// Fast path: where the points are dense (a full-resolution frame), a finer lattice, up to
+  /// twice fast_cells_per_radius, while its occupied cells number at most this many per point
+  /// with a valid normal: the node work then stays a fixed share of the per-point work, and a
+  /// voxelized or sparse cloud keeps fast_cells_per_radius (fast_upd.h). 0 turns this off.
+  double fast_cells_per_point = 0.015;
   /// Fast path: a cell whose lattice nodes' zeta spread by more than this is not interpolated;
   /// its points get the lattice sums at their own position (fast_upd.h). 0 turns this off.
   double fast_refine_spread = 0.0;
@@ -52,6 +57,9 @@ struct UpdParams {
       "voxel-moment lattice for the UPD)");
     v("fast_cells_per_radius", fast_cells_per_radius,
       "fast path: lattice cells per d_m (2 .. 16); more is slower and closer to exact");
+    v("fast_cells_per_point", fast_cells_per_point,
+      "fast path: dense clouds get a finer lattice (up to 2 x fast_cells_per_radius) while its "
+      "occupied cells number at most this many per point (0 = never)");
     v("fast_refine_spread", fast_refine_spread,
       "fast path: cells whose nodes' zeta spread by more than this are summed per point, "
       "not interpolated (0 = never)");
