@@ -766,6 +766,8 @@ int run(const Options& o) {
     c["two_core_stages"] = t2.stages;
     c["two_core_speedup"] = num(t1.total_ms / t2.total_ms);
     c["normals_method"] = frame_results[f].organized_normals ? "image-window scans" : "hash grid";
+    // UpdParams::fast_cells_per_point: the lattice's cells per d_m on this frame.
+    c["lattice_cells_per_radius"] = frame_results[f].fast_cells_per_radius;
     report.target(fr.name + ": frame pipeline, one core (median)", t1.total_ms, kFrameBudgetMs,
                   true, "ms");
     report.target(fr.name + ": second core speedup", t1.total_ms / t2.total_ms, kMinTwoCoreSpeedup,
@@ -812,9 +814,11 @@ int run(const Options& o) {
                   false, "");
     std::printf(
         "%-30s %6zu of %6zu points compared: mean |dzeta| %.5f, max %.4f, same label "
-        "%.3f%% (exact normals %.0f ms, exact UPD of the sample %.0f ms, 2 threads)\n",
+        "%.3f%% (%d lattice cells per d_m; exact normals %.0f ms, exact UPD of the sample %.0f "
+        "ms, 2 threads)\n",
         frames[f].name.c_str(), a.compared, a.finite, a.mean_abs_dzeta, a.max_abs_dzeta,
-        100 * a.same_label, a.exact_normals_ms, a.exact_upd_ms);
+        100 * a.same_label, frame_results[f].fast_cells_per_radius, a.exact_normals_ms,
+        a.exact_upd_ms);
     // What the labels' agreement costs at full resolution (not a target: the trade-off
     // docs/PERFORMANCE.md discusses): normals per 3 x 3 pixels and exact sums within 0.004 of
     // zeta_min.

@@ -27,8 +27,8 @@
 // numbers as at the origin.
 //
 // How far from exact (measured by tests/core/fast_agreement_test.cpp and bench/upd_bench,
-// docs/PERFORMANCE.md), with the defaults (4 cells per d_m, no refinement): mean |delta zeta|
-// 1e-3 to 5e-3 on Kinect frames, a LiDAR scan and generated scenes, labels equal on 99.0-99.97 %
+// docs/PERFORMANCE.md), at 4 cells per d_m and no refinement: mean |delta zeta|
+// 1e-3 to 5e-3 on Kinect frames, a LiDAR scan and generated scenes, labels equal on 98.9-99.97 %
 // of the points; the differences gather where zeta crosses zeta_min within a few cm of a sharp
 // step. Their number is about the density of points per unit of zeta at zeta_min times the
 // mean error there: a cluttered frame with a fifth of its points within 0.01 of zeta_min
