@@ -479,8 +479,9 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
         kMaxHalf, static_cast<std::ptrdiff_t>(angle / pitch_u[static_cast<std::size_t>(u)]) + 1);
     const auto ev = std::min<std::ptrdiff_t>(
         kMaxHalf, static_cast<std::ptrdiff_t>(angle / pitch_v[static_cast<std::size_t>(v)]) + 1);
-    // Every stride-th row and column (1, 2 or 4) so that at most fast_scan_px of each: the
-    // columns of the sparse images, the window's first one rounded down to them.
+    // Every stride-th row and column: every one up to fast_scan_px pixels across, every 2nd up
+    // to twice that, every 4th beyond; the columns of the sparse images, the window's first one
+    // rounded down to them.
     const std::ptrdiff_t side = 2 * std::max(eu, ev) + 1;
     const std::ptrdiff_t stride = side <= scan_px ? 1 : side <= 2 * scan_px ? 2 : 4;
     const std::ptrdiff_t v0 = std::max<std::ptrdiff_t>(0, v - ev);

@@ -620,10 +620,10 @@ Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& l
   const std::size_t n_chunks = (n_pts - first + chunk - 1) / chunk;
   std::vector<Bins> chunk_bins(n_chunks);
   int all_fit = 1;
-  // Static schedules here and below: every stage of a frame deals the points out to the threads
-  // in the same contiguous shares, so that a point's data stay in one core's cache (see
-  // copyCloud). Dynamic schedules scattered them, and on a two-vCPU VM a line the other core
-  // has read costs twice as much to write again.
+  // Static schedules here and in computeUpdFast's stages: every stage of a frame deals the
+  // points out to the threads in the same contiguous shares, so that a point's data stay in one
+  // core's cache (see copyCloud). Dynamic schedules scattered them, and on a two-vCPU VM a line
+  // the other core has read costs twice as much to write again.
 #pragma omp parallel for schedule(static) reduction(& : all_fit)
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(n_chunks); ++c) {
     const std::size_t begin = first + static_cast<std::size_t>(c) * chunk;
