@@ -185,7 +185,7 @@ void Navigator::followWaypoints(const std::vector<Eigen::Vector2d>& waypoints_wo
     seq.waypoints.emplace_back(w.x(), w.y(),
                                last ? impl_->setup.params.target_allowed_distance_m
                                     : impl_->setup.params.waypoint_allowed_distance_m,
-                               /*allow_skip=*/false);
+                               /*allow_skip=*/impl_->setup.params.skip_waypoints);
   }
   impl_->nav.navigateWaypoints(seq);
 }

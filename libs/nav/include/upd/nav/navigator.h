@@ -32,6 +32,10 @@ struct NavigatorParams {
   /// closer to the target; overrides the PTG file's alarm_seems_not_approaching_target_timeout.
   double no_progress_timeout_s = 30.0;
   double waypoint_allowed_distance_m = 0.6;  ///< an intermediate waypoint is reached within [m]
+  /// The navigator may skip an intermediate waypoint when a later one is directly reachable
+  /// (MRPT's allow_skip): a waypoint next to an obstacle mapped after the route was planned
+  /// then cannot hold the robot until no_progress_timeout_s ends the run.
+  bool skip_waypoints = true;
 
   void validate() const;
   template <class V>
@@ -42,6 +46,8 @@ struct NavigatorParams {
       "end with an error after this long without getting closer to the goal [s]");
     v("waypoint_allowed_distance_m", waypoint_allowed_distance_m,
       "an intermediate waypoint of a route is reached within this distance [m]");
+    v("skip_waypoints", skip_waypoints,
+      "the navigator may skip an intermediate waypoint when a later one is directly reachable");
   }
 };
 
