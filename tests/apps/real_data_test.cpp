@@ -1,8 +1,8 @@
 // The UPD on real Kinect frames from ../shared/data: every organized PCD loads and is scored,
 // and on two indoor frames the open floor is traversable while floor-wall and floor-obstacle
 // borders are not. Regions are found geometrically (elevation along up), not hand-labelled.
+#include "exact_agreement.h"
 #include "test_data.h"
-#include "upd/core/classify.h"
 #include "upd/core/kdtree.h"
 #include "upd/core/normals.h"
 #include "upd/core/pipeline.h"
@@ -152,7 +152,7 @@ TEST(RealData, EveryOrganizedPcdLoadsAndIsScored) {
 
 // The frame pipeline's default fast path on a whole 640 x 480 frame (every pixel, normals of
 // 5 cm, d_m = 0.5 m: the benchmark's frame settings) against the exact path: exact normals for
-// every pixel, the exact UPD (eq. 6 over a k-d tree radius search) at every 23rd finite pixel.
+// every pixel, the exact UPD (eq. 6 over a k-d tree radius search) at every 23rd pixel.
 // region_growing is the frame whose zeta crowds the label threshold most (docs/PERFORMANCE.md):
 // its labels agreed on 98.9 % at 4 lattice cells per d_m, 99.6 % since the lattice refines on
 // dense frames (fast_cells_per_point) and the normals scan whole windows up to 48 px.
@@ -167,47 +167,14 @@ TEST(RealData, FullResolutionFrameAgreesWithTheExactPath) {
   const PipelineResult fast = runPipeline(cloud, p);
   ASSERT_EQ(fast.method, UpdMethod::Fast);
   EXPECT_EQ(fast.fast_cells_per_radius, 8);  // a dense frame: twice fast_cells_per_radius
-  const KdTree tree(fast.cloud);
-  const Normals normals = computeNormals(fast.cloud, tree, p.normals, p.unitUp());
-  UpdResult exact, sampled;
-  std::vector<std::uint32_t> nb;
-  for (std::size_t i = 0, n = 0; i < fast.cloud.size(); ++i) {
-    if (!fast.cloud.isFinite(i) || n++ % 23 != 0) continue;
-    tree.radiusSearch(fast.cloud.point(i), static_cast<float>(p.upd.radius_m), nb);
-    Eigen::Vector3d r = Eigen::Vector3d::Zero();
-    std::uint32_t k = 0;
-    for (const std::uint32_t j : nb) {
-      if (!normals.isValid(j)) continue;
-      r += normals.normal(j).cast<double>();
-      ++k;
-    }
-    const float nan = std::numeric_limits<float>::quiet_NaN();
-    const bool scored = k >= static_cast<std::uint32_t>(p.upd.min_neighbors);
-    exact.rx.push_back(scored ? static_cast<float>(r.x()) : nan);
-    exact.ry.push_back(scored ? static_cast<float>(r.y()) : nan);
-    exact.rz.push_back(scored ? static_cast<float>(r.z()) : nan);
-    exact.zeta.push_back(scored ? static_cast<float>(r.norm() / k) : nan);
-    exact.k.push_back(scored ? k : 0);
-    sampled.rx.push_back(fast.upd.rx[i]), sampled.ry.push_back(fast.upd.ry[i]);
-    sampled.rz.push_back(fast.upd.rz[i]), sampled.zeta.push_back(fast.upd.zeta[i]);
-    sampled.k.push_back(fast.upd.k[i]);
-  }
-  const Classification ce = classify(exact, p.unitUp(), p.classify);
-  const Classification cf = classify(sampled, p.unitUp(), p.classify);
-  std::size_t same = 0, both = 0;
-  double sum = 0;
-  for (std::size_t q = 0; q < exact.size(); ++q) {
-    same += ce.label[q] == cf.label[q] ? 1 : 0;
-    if (!exact.isValid(q) || !sampled.isValid(q)) continue;
-    sum += std::abs(static_cast<double>(exact.zeta[q]) - sampled.zeta[q]);
-    ++both;
-  }
-  ASSERT_GT(both, 10000u);
-  const double same_fraction = static_cast<double>(same) / static_cast<double>(exact.size());
-  std::printf("region_growing, %zu samples: mean |dzeta| %.5f, same label %.3f %%\n", exact.size(),
-              sum / static_cast<double>(both), 100 * same_fraction);
-  EXPECT_LE(sum / static_cast<double>(both), 0.005);
-  EXPECT_GE(same_fraction, 0.995);
+  const Normals normals = computeNormals(fast.cloud, KdTree(fast.cloud), p.normals, p.unitUp());
+  const test::Agreement a =
+      test::agreeWithExact(fast.cloud, normals, fast.upd, p.upd, p.unitUp(), 23);
+  ASSERT_GT(a.both_valid, 10000u);
+  std::printf("region_growing, %zu samples: mean |dzeta| %.5f, same label %.3f %%\n", a.compared,
+              a.mean_abs_dzeta, 100 * a.sameLabelFraction());
+  EXPECT_LE(a.mean_abs_dzeta, 0.005);
+  EXPECT_GE(a.sameLabelFraction(), 0.995);
 }
 
 }  // namespace
