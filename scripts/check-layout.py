@@ -35,7 +35,7 @@ stack stdexcept streambuf string string_view system_error thread tuple type_trai
 typeinfo unordered_map unordered_set utility valarray variant vector version
 """.split())
 
-# Includes a library may not have: (folder, description, predicate on the included path).
+# What libs/core may not include: every third-party library but Eigen.
 FORBIDDEN_IN_CORE = re.compile(r"^(mrpt/|octomap/|opencv|pcl/|pcl_|OpenNI|openni|ni2?/)",
                                re.IGNORECASE)
 
@@ -74,7 +74,7 @@ def long_functions(src, max_lines):
                 kind = "fn"
             else:
                 kind = "other"
-            stack.append((kind, line, header[-100:]))
+            stack.append((kind, line, header))
             last = i + 1
         elif ch == "}":
             if stack:
@@ -88,6 +88,13 @@ def long_functions(src, max_lines):
     return out
 
 
+def function_name(header):
+    """The name of the function a block header declares, e.g. `Terrain::raycast()`."""
+    paren = header.find("(")
+    words = header[:paren].split() if paren > 0 else []
+    return (words[-1] + "()") if words else "function: " + header
+
+
 def source_files(root, folder):
     base = os.path.join(root, folder)
     for dirpath, dirnames, filenames in os.walk(base):
@@ -98,8 +105,11 @@ def source_files(root, folder):
 
 
 def includes(path):
+    """(line, delimiter, included path) of every #include of the file."""
     with open(path, errors="replace") as f:
-        return [(m.group(1), m.group(2).strip()) for m in INCLUDE_RE.finditer(f.read())]
+        src = f.read()
+    return [(src.count("\n", 0, m.start()) + 1, m.group(1), m.group(2).strip())
+            for m in INCLUDE_RE.finditer(src)]
 
 
 def sim_include_allowed(path, delim, inc):
@@ -122,17 +132,17 @@ def check(root, max_fn, max_file):
             if n > max_file:
                 problems.append(f"{rel(path)}: file has {n} lines (> {max_file})")
             for length, start, header in long_functions(src, max_fn):
-                problems.append(
-                    f"{rel(path)}:{start}: function of {length} lines (> {max_fn}): {header}")
+                problems.append(f"{rel(path)}:{start}: {function_name(header)} has {length} "
+                                f"lines (> {max_fn})")
     for path in source_files(root, "libs/core"):
-        for _, inc in includes(path):
+        for line, _, inc in includes(path):
             if FORBIDDEN_IN_CORE.match(inc):
-                problems.append(f"{rel(path)}: libs/core includes {inc} (Eigen only)")
+                problems.append(f"{rel(path)}:{line}: libs/core includes {inc} (Eigen only)")
     for path in source_files(root, "libs/sim"):
-        for delim, inc in includes(path):
+        for line, delim, inc in includes(path):
             if not sim_include_allowed(path, delim, inc):
-                problems.append(
-                    f"{rel(path)}: libs/sim includes {inc} (Eigen, std, upd/core, upd/sim only)")
+                problems.append(f"{rel(path)}:{line}: libs/sim includes {inc} "
+                                "(Eigen, std, upd/core, upd/sim only)")
     return problems
 
 
