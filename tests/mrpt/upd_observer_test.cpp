@@ -47,7 +47,8 @@ void expectConsistentSizes(const ObserverResult& r) {
   EXPECT_EQ(r.scored.classes.label.size(), n);
   EXPECT_EQ(r.scored.classes.cost.size(), n);
   EXPECT_EQ(r.scored.classes.slope_rad.size(), n);
-  EXPECT_EQ(r.scored.classes.traversable + r.scored.classes.non_traversable + r.scored.classes.unknown, n);
+  const upd::Classification& c = r.scored.classes;
+  EXPECT_EQ(c.traversable + c.non_traversable + c.unknown, n);
 }
 
 TEST(UpdObserver, FloorIsTraversableAtTheRobotsWorldPosition) {
@@ -125,7 +126,8 @@ TEST(UpdObserver, ReusedResultEqualsAFreshOne) {
   ASSERT_GT(fresh.size(), 0u);
   EXPECT_EQ(reused.scored.cloud_world.x, fresh.scored.cloud_world.x);
   EXPECT_EQ(reused.scored.cloud_world.z, fresh.scored.cloud_world.z);
-  EXPECT_TRUE(reused.scored.cloud_world.sensor_origin.isApprox(fresh.scored.cloud_world.sensor_origin));
+  EXPECT_TRUE(
+      reused.scored.cloud_world.sensor_origin.isApprox(fresh.scored.cloud_world.sensor_origin));
   const auto same = [](const std::vector<float>& u, const std::vector<float>& v) {
     if (u.size() != v.size()) return false;
     for (std::size_t i = 0; i < u.size(); ++i) {
@@ -155,11 +157,11 @@ TEST(UpdObserver, SlopeIsMeasuredAgainstGravity) {
   const ObserverResult tilted = observer.observe(
       *obs, upd::mrptbridge::toIsometry(mrpt::poses::CPose3D(0, 0, 0, 0, pitch, 0)));
   std::vector<float> sf, st;
-  for (std::size_t i = 0; i < flat.size(); ++i) {
-    if (std::isfinite(flat.scored.classes.slope_rad[i])) sf.push_back(flat.scored.classes.slope_rad[i]);
+  for (const float s : flat.scored.classes.slope_rad) {
+    if (std::isfinite(s)) sf.push_back(s);
   }
-  for (std::size_t i = 0; i < tilted.size(); ++i) {
-    if (std::isfinite(tilted.scored.classes.slope_rad[i])) st.push_back(tilted.scored.classes.slope_rad[i]);
+  for (const float s : tilted.scored.classes.slope_rad) {
+    if (std::isfinite(s)) st.push_back(s);
   }
   ASSERT_FALSE(sf.empty());
   ASSERT_FALSE(st.empty());
