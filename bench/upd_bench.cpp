@@ -27,9 +27,9 @@
 #include "upd/core/fast_upd.h"
 #include "upd/core/kdtree.h"
 #include "upd/core/pipeline.h"
-#include "upd/core/render.h"
-#include "upd/core/scenes.h"
-#include "upd/core/terrain.h"
+#include "upd/sim/render.h"
+#include "upd/sim/scenes.h"
+#include "upd/sim/terrain.h"
 #include "upd/io/cloud_io.h"
 
 #ifdef UPD_BENCH_HAVE_MAPS
@@ -61,6 +61,8 @@
 
 namespace upd::bench {
 namespace {
+
+using namespace upd::sim;  // generated worlds, scenes and the depth renderer
 
 using json = nlohmann::json;
 using Clock = std::chrono::steady_clock;

@@ -9,6 +9,7 @@
 
 #include "upd/io/cloud_io.h"
 #include "upd/io/json_io.h"
+#include "upd/io/ros_map.h"
 #include "upd/maps/grid_export.h"
 #include "upd/maps/grid_fusion.h"
 #include "upd/mrpt/rawlog_reader.h"
@@ -98,14 +99,14 @@ struct Scores {
 // Precision over the map's non-traversable cells, recall over the observed (known) cells that
 // the truth marks non-traversable; a match is within tolerance_m (0: the same cell).
 Scores scoreAgainstTruth(const maps::TraversabilityGrid& grid,
-                         const mrptbridge::TruthGrid& truth, double tolerance_m) {
+                         const io::RosMap& truth, double tolerance_m) {
   const int r = static_cast<int>(std::ceil(tolerance_m / grid.cellSize() - 1e-9));
   const int nx = grid.sizeX(), ny = grid.sizeY();
   std::vector<signed char> map_label(static_cast<std::size_t>(nx) * ny, -1), truth_nt(map_label.size(), 0);
   for (int cy = 0; cy < ny; ++cy) {
     for (int cx = 0; cx < nx; ++cx) {
       const auto c = grid.cellCenter(cx, cy);
-      truth_nt[cy * nx + cx] = truth.labelAt(c.x(), c.y()) == 1;
+      truth_nt[cy * nx + cx] = truth.labelAt(c.x(), c.y()) == Label::NonTraversable;
     }
   }
   maps::forEachKnownCell(grid, [&](int cx, int cy, const maps::GridCell& cell) {
@@ -128,7 +129,7 @@ Scores scoreAgainstTruth(const maps::TraversabilityGrid& grid,
       const int i = cy * nx + cx;
       if (map_label[i] < 0) continue;  // never observed
       const auto c = grid.cellCenter(cx, cy);
-      if (truth.labelAt(c.x(), c.y()) == 2) continue;  // outside the world
+      if (truth.labelAt(c.x(), c.y()) == Label::Unknown) continue;  // outside the world
       if (map_label[i] == 1) {
         ++s.map_non_traversable;
         s.map_non_traversable_matched += anyWithin(cx, cy, [&](int j) { return truth_nt[j] == 1; });
@@ -226,12 +227,12 @@ int runPlayback(const std::vector<std::string>& argv) {
     tracker = mrptbridge::RobotPoseTracker(mrptbridge::TumTrajectory::load(*poses),
                                            config.ground_truth);
   }
-  std::optional<mrptbridge::TruthGrid> truth;
+  std::optional<io::RosMap> truth;
   std::string truth_path = args.str("--truth").value_or("");
   if (truth_path.empty() && fs::exists(mrptbridge::truthMapPath(rawlog))) {
     truth_path = mrptbridge::truthMapPath(rawlog);
   }
-  if (!truth_path.empty()) truth = mrptbridge::readTruthMap(truth_path);
+  if (!truth_path.empty()) truth = io::readRosMap(truth_path);
 
   const fs::path out_dir(*args.str("--output"));
   fs::create_directories(out_dir);
