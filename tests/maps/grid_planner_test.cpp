@@ -144,8 +144,10 @@ TEST(GridPlanner, PathKeepsTheInflationFromBlockedCells) {
       }
     }
   }
-  // Wider than the gap allows: no path.
+  // The gap's middle cell is 0.5 m from both sides: a larger inflation closes it.
   p.inflation_m = 0.5;
+  EXPECT_TRUE(planGridPath(r.view(0.1), {2, 3}, {37, 3}, p).found);
+  p.inflation_m = 0.55;
   EXPECT_FALSE(planGridPath(r.view(0.1), {2, 3}, {37, 3}, p).found);
 }
 
