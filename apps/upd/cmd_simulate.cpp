@@ -14,7 +14,7 @@ namespace upd::app {
 
 const char* const kSimulateUsage =
     "usage: upd simulate --world NAME --output FILE.rawlog [--config FILE.ini] [--frames N]\n"
-    "  Drives a virtual Dune (0.7 x 0.45 m, a Kinect 0.5 m high at its front, pitched down)\n"
+    "  Drives a virtual Dune ([RobotBodyParams], a Kinect on it as [CameraMountParams])\n"
     "  from the world's start to its goal and back, and records a real MRPT rawlog: 640 x 480\n"
     "  CObservation3DRangeScan frames with Kinect noise and odometry with drift. Beside it:\n"
     "  FILE.gt.tum (ground-truth poses, TUM format) and FILE.truth.pgm/.yaml (the world's\n"

@@ -1,4 +1,5 @@
 // The synthetic scenes and worlds: exact sampling, truth regions, noise, named worlds.
+#include "upd/sim/robot.h"
 #include "upd/sim/scenes.h"
 #include "upd/sim/terrain.h"
 
@@ -524,9 +525,10 @@ class Reach {
   std::vector<char> free_;
 };
 
-// The Dune's circumscribed radius (0.7 x 0.45 m): a planner that inflates by it must still
-// find the way in every solvable world.
-constexpr double kRobotRadius_m = 0.42;
+// The Dune's circumscribed radius: a planner that inflates by it must still find the way in
+// every solvable world.
+const double kRobotRadius_m =
+    0.5 * std::hypot(upd::sim::RobotBodyParams{}.length_m, upd::sim::RobotBodyParams{}.width_m);
 
 TEST(Worlds, NamesStartsAndGoals) {
   const std::vector<std::string> names = upd::sim::worldNames();

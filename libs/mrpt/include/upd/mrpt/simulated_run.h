@@ -1,7 +1,7 @@
 // A simulated robot run recorded as a real MRPT rawlog: the embedded default data of UPD-Nav.
 //
-// A virtual robot (sim::RobotBodyParams and sim::CameraMountParams, upd/sim/robot.h: the Dune,
-// 0.7 x 0.45 m, with a Kinect at its front 0.5 m high, pitched down) drives through a generated
+// A virtual robot (sim::RobotBodyParams and sim::CameraMountParams, upd/sim/robot.h: the Dune
+// with a Kinect at its front, pitched down) drives through a generated
 // world (upd/sim/terrain.h): from the world's start to its goal and back, along a route planned
 // on the ground truth with the robot's clearance (the one grid planner, upd/maps/grid_planner.h).
 // Its body follows the terrain (sim::bodyPoseOnTerrain: pitch and roll from the wheel contact

@@ -9,8 +9,8 @@
 // sampleSurface() samples them. Outside the extent the world is the plane z = 0 and its truth
 // is Unknown.
 //
-// Ground truth (truthAt) answers "could a small rover (Dune: 0.7 x 0.45 m, 0.2 m wheels) stand
-// here?" by a local rule, evaluated in this order:
+// Ground truth (truthAt) answers "could a small rover (the Dune, upd/sim/robot.h) stand here?"
+// by a local rule, evaluated in this order:
 //  1. outside the extent: Unknown;
 //  2. NonTraversable inside a ditch or within border_m of it (floor, walls and both rims);
 //  3. NonTraversable on a wall Box (Box::wall) or within border_m of it;
