@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <vector>
 
-#include "upd/core/render.h"
+#include "upd/sim/render.h"
 #include "upd/core/stopwatch.h"
-#include "upd/core/terrain.h"
+#include "upd/sim/terrain.h"
 #include "upd/io/cloud_io.h"
 
 #ifdef UPD_BENCH_HAVE_MAPS
@@ -19,6 +19,9 @@
 #endif
 
 namespace upd::bench {
+
+using namespace upd::sim;  // generated worlds, scenes and the depth renderer
+
 namespace {
 
 // The map update stage: the scored points into the 2.5D traversability grid, world frame.

@@ -6,17 +6,17 @@
 #include "upd/core/fast_normals.h"
 #include "upd/core/fast_upd.h"
 #include "upd/core/kdtree.h"
-#include "upd/core/render.h"
-#include "upd/core/terrain.h"
+#include "upd/sim/render.h"
+#include "upd/sim/terrain.h"
 
 namespace {
 
-const upd::RenderedScene& frame() {
-  static const upd::RenderedScene rs = [] {
-    upd::DepthNoise noise;
+const upd::sim::RenderedScene& frame() {
+  static const upd::sim::RenderedScene rs = [] {
+    upd::sim::DepthNoise noise;
     noise.max_range_m = 5.0;
-    return upd::renderScene(upd::makeWorld("mixed").terrain,
-                            upd::cameraPoseLookingAt({1.0, 0.3, 0.6}, {4.5, -0.4, 0.0}),
+    return upd::sim::renderScene(upd::sim::makeWorld("mixed").terrain,
+                            upd::sim::cameraPoseLookingAt({1.0, 0.3, 0.6}, {4.5, -0.4, 0.0}),
                             upd::CameraIntrinsics{}, noise, 7);
   }();
   return rs;

@@ -8,11 +8,14 @@
 #include "cases.h"
 #include "upd/core/kdtree.h"
 #include "upd/core/preprocess.h"
-#include "upd/core/scenes.h"
+#include "upd/sim/scenes.h"
 #include "upd/core/stopwatch.h"
 #include "upd/io/cloud_io.h"
 
 namespace upd::bench {
+
+using namespace upd::sim;  // generated worlds, scenes and the depth renderer
+
 namespace {
 
 // Our exact path, once, single core like the peer, when its neighbour visits are affordable.

@@ -12,7 +12,7 @@
 #include "upd/nav/live_view.h"
 #include "upd/nav/nav_config.h"
 #include "upd/nav/navigation_loop.h"
-#include "upd/nav/simulation.h"
+#include "upd/sim/robot.h"
 
 #include <atomic>
 #include <chrono>
@@ -97,7 +97,7 @@ int runLive(const std::vector<std::string>& argv) {
   g_stop = false;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
-  const Eigen::Isometry3d camera_on_robot = nav::cameraOnRobot(config.camera);
+  const Eigen::Isometry3d camera_on_robot = sim::cameraOnRobot(config.camera);
   const auto t0 = std::chrono::steady_clock::now();
   auto last = t0, last_report = t0;
   int frames = 0;
@@ -121,9 +121,10 @@ int runLive(const std::vector<std::string>& argv) {
     if (dt > 0) base.advance(dt);
     nav::BaseState s;
     base.readState(s);
-    const PointCloud cloud_world =
-        transformCloud(depthToCloud(frame.depth, frame.K),
-                       nav::bodyPoseFlat(s.pose_world_robot) * camera_on_robot);
+    const Eigen::Vector3d xy_yaw(s.pose_world_robot.x_m, s.pose_world_robot.y_m,
+                                 s.pose_world_robot.yaw_rad);
+    const PointCloud cloud_world = transformCloud(depthToCloud(frame.depth, frame.K),
+                                                  sim::bodyPoseFlat(xy_yaw) * camera_on_robot);
     const nav::FrameEvidence& ev = loop.addFrame(cloud_world, base.timeS());
     score_ms += ev.score_ms;
     ++frames;

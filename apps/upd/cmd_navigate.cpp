@@ -5,9 +5,9 @@
 #include "commands.h"
 #include "run_config.h"
 
-#include "upd/core/terrain.h"
 #include "upd/nav/nav_config.h"
 #include "upd/nav/scenario.h"
+#include "upd/sim/terrain.h"
 
 #include <cmath>
 #include <cstdio>
@@ -57,7 +57,7 @@ int runNavigate(const std::vector<std::string>& argv) {
       throw UsageError(std::string("option --obstacles: ") + e.what());
     }
   }
-  const WorldSpec world = makeWorld(*scenario);  // throws listing the valid names
+  const sim::WorldSpec world = sim::makeWorld(*scenario);  // throws listing the valid names
 
   const auto config_path =
       args.str("--config").value_or(nav::defaultConfigDir() + "/dune-kinect.ini");

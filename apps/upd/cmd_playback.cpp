@@ -11,6 +11,7 @@
 #include "upd/io/atomic_file.h"
 #include "upd/io/cloud_io.h"
 #include "upd/io/json_io.h"
+#include "upd/io/ros_map.h"
 #include "upd/maps/evaluation.h"
 #include "upd/maps/grid_export.h"
 #include "upd/maps/grid_fusion.h"
@@ -118,7 +119,7 @@ PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
 // The ground truth: --truth, else the rawlog's sidecar when present; none without either.
 struct Truth {
   std::string path;
-  std::optional<mrptbridge::TruthGrid> grid;
+  std::optional<io::RosMap> grid;
 };
 
 Truth loadTruth(const PlaybackOptions& o) {
@@ -127,7 +128,7 @@ Truth loadTruth(const PlaybackOptions& o) {
   if (t.path.empty() && fs::exists(mrptbridge::truthMapPath(o.rawlog))) {
     t.path = mrptbridge::truthMapPath(o.rawlog);
   }
-  if (!t.path.empty()) t.grid = mrptbridge::readTruthMap(t.path);
+  if (!t.path.empty()) t.grid = io::readRosMap(t.path);
   return t;
 }
 
@@ -141,13 +142,9 @@ json scoresJson(const maps::MapEvaluation& e) {
 
 // The grid scored against the truth at tolerance_m and cell by cell.
 json truthJson(const maps::TraversabilityGrid& grid, const Truth& truth, double tolerance_m) {
-  const mrptbridge::TruthGrid& raster = *truth.grid;
+  const io::RosMap& raster = *truth.grid;
   const maps::TruthLabelAt label_at = [&raster](double x_m, double y_m) {
-    switch (raster.labelAt(x_m, y_m)) {
-      case 0: return Label::Traversable;
-      case 1: return Label::NonTraversable;
-      default: return Label::Unknown;  // outside the world
-    }
+    return raster.labelAt(x_m, y_m);
   };
   return {{"map", truth.path},
           {"tolerance_m", tolerance_m},

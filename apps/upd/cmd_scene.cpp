@@ -3,8 +3,8 @@
 #include "cli.h"
 #include "commands.h"
 
-#include "upd/core/scenes.h"
 #include "upd/io/cloud_io.h"
+#include "upd/sim/scenes.h"
 
 #include <cstdio>
 
@@ -26,11 +26,11 @@ int runScene(const std::vector<std::string>& argv) {
   if (args.positionals().size() != 1) throw UsageError("expected exactly one scene NAME");
   const auto out = args.str("--output");
   if (!out) throw UsageError("--output FILE.ply is required");
-  SceneParams params;
+  sim::SceneParams params;
   if (const auto v = args.number("--noise-m")) params.noise_m = *v;
   if (const auto v = args.number("--spacing-m")) params.spacing_m = *v;
   if (const auto v = args.integer("--seed")) params.seed = *v;
-  const Scene scene = makeScene(args.positionals()[0], params);
+  const sim::Scene scene = sim::makeScene(args.positionals()[0], params);
   io::writePly(*out, scene.cloud, &scene.truth);
   std::printf("%s: %zu points -> %s\n", scene.name.c_str(), scene.cloud.size(), out->c_str());
   return 0;

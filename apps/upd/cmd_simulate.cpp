@@ -4,17 +4,17 @@
 #include "commands.h"
 #include "run_config.h"
 
-#include "upd/core/terrain.h"
+#include "upd/core/stopwatch.h"
 #include "upd/mrpt/simulated_run.h"
+#include "upd/sim/terrain.h"
 
-#include <chrono>
 #include <cstdio>
 
 namespace upd::app {
 
 const char* const kSimulateUsage =
     "usage: upd simulate --world NAME --output FILE.rawlog [--config FILE.ini] [--frames N]\n"
-    "  Drives a virtual Dune (0.7 x 0.45 m, a Kinect 0.5 m high at its front, pitched down)\n"
+    "  Drives a virtual Dune ([RobotBodyParams], a Kinect on it as [CameraMountParams])\n"
     "  from the world's start to its goal and back, and records a real MRPT rawlog: 640 x 480\n"
     "  CObservation3DRangeScan frames with Kinect noise and odometry with drift. Beside it:\n"
     "  FILE.gt.tum (ground-truth poses, TUM format) and FILE.truth.pgm/.yaml (the world's\n"
@@ -22,7 +22,8 @@ const char* const kSimulateUsage =
     "options:\n"
     "  --world NAME      mixed, rocks, ramp, ditch, corridor, trapped (default mixed)\n"
     "  --output FILE     the rawlog to write (required)\n"
-    "  --config FILE     [SimulationParams] (speed, frame spacing, camera pose, drift, seed)\n"
+    "  --config FILE     [SimulationParams] (speed, frame spacing, drift, seed),\n"
+    "                    [RobotBodyParams] and [CameraMountParams] (the robot and its camera)\n"
     "  --frames N        stop after N frames (default: the whole route)\n";
 
 int runSimulate(const std::vector<std::string>& argv) {
@@ -33,11 +34,10 @@ int runSimulate(const std::vector<std::string>& argv) {
   const RunConfig config = args.has("--config") ? loadRunConfig(*args.str("--config")) : RunConfig{};
   const int frames = args.integer("--frames").value_or(0);
   if (frames < 0) throw UsageError("option --frames = " + std::to_string(frames) + ": must be >= 0");
-  const WorldSpec world = makeWorld(args.str("--world").value_or("mixed"));
-  const auto start = std::chrono::steady_clock::now();
+  const sim::WorldSpec world = sim::makeWorld(args.str("--world").value_or("mixed"));
+  const Stopwatch watch;
   const auto s = mrptbridge::simulateRun(world, config.simulation, *out, frames);
-  const double secs =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double secs = watch.elapsedMs() / 1000.0;
   std::printf("%s: %zu frames over %.1f m (%.0f s of driving) in %.1f s\n  poses: %s\n  truth: %s\n",
               s.rawlog_path.c_str(), s.frames, s.path_length_m, s.duration_s, secs,
               s.poses_path.c_str(), s.truth_yaml_path.c_str());

@@ -76,6 +76,10 @@ void forEachSection(RunConfig& c, F&& f) {
   f("GroundTruthParams", "Ground-truth pose files (TUM) given to `upd playback --poses`.",
     c.ground_truth);
   f("SimulationParams", "The simulated Dune of `upd simulate`.", c.simulation);
+  f("RobotBodyParams", "The simulated robot's body (`upd simulate`; `upd navigate` reads it "
+    "from the navigation config).", c.simulation.body);
+  f("CameraMountParams", "The simulated robot's depth camera (`upd simulate`; `upd navigate` "
+    "reads it from the navigation config).", c.simulation.camera);
   f("EvaluationParams", "Scoring a map against a ground-truth grid.", c.evaluation);
 }
 

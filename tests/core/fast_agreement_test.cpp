@@ -17,12 +17,14 @@
 #include "upd/core/fast_upd.h"
 #include "upd/core/kdtree.h"
 #include "upd/core/pipeline.h"
-#include "upd/core/render.h"
-#include "upd/core/scenes.h"
-#include "upd/core/terrain.h"
+#include "upd/sim/render.h"
+#include "upd/sim/scenes.h"
+#include "upd/sim/terrain.h"
 
 namespace upd {
 namespace {
+
+using namespace upd::sim;  // generated scenes as test inputs
 
 using test::Agreement;
 using test::agreeWithExact;

@@ -5,7 +5,7 @@
 #include "upd/core/classify.h"
 #include "upd/core/normals.h"
 #include "upd/core/pipeline.h"
-#include "upd/core/scenes.h"
+#include "upd/sim/scenes.h"
 #include "upd/core/upd.h"
 
 #include <Eigen/Eigenvalues>
@@ -15,6 +15,8 @@
 
 namespace upd {
 namespace {
+
+using namespace upd::sim;  // generated scenes as test inputs
 
 const Eigen::Vector3f kUp = Eigen::Vector3f::UnitZ();
 

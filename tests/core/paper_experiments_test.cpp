@@ -2,7 +2,7 @@
 // generated scenes: the 90 deg corner and the 20 deg ramp with the roughness-index contrast.
 #include "upd/core/baselines.h"
 #include "upd/core/pipeline.h"
-#include "upd/core/scenes.h"
+#include "upd/sim/scenes.h"
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,8 @@
 
 namespace upd {
 namespace {
+
+using namespace upd::sim;  // generated scenes as test inputs
 
 constexpr double kHalfSqrt2 = 0.70710678118654752;
 // With a 0.01 m grid, a 0.015 m radius takes the 3 x 3 pixel block: the normals' own support is

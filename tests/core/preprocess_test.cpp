@@ -9,10 +9,12 @@
 #include "synthetic.h"
 #include "upd/core/kdtree.h"
 #include "upd/core/preprocess.h"
-#include "upd/core/scenes.h"
+#include "upd/sim/scenes.h"
 
 namespace upd {
 namespace {
+
+using namespace upd::sim;  // generated scenes as test inputs
 
 constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
 

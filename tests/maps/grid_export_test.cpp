@@ -4,6 +4,7 @@
 #include "upd/maps/grid_export.h"
 #include "upd/maps/grid_fusion.h"
 #include "upd/maps/occupancy_grid.h"
+#include "upd/io/ros_map.h"
 
 #include <gtest/gtest.h>
 #include <mrpt/img/CImage.h>
@@ -156,21 +157,21 @@ TEST(RosMap, PgmAndYamlFollowMapServerFormatAndOrientation) {
     const int row = pgm.height - 1 - static_cast<int>(std::floor((y - oy) / 0.1));
     return pgm.at(col, row);
   };
-  EXPECT_EQ(pixelOf(kObsX, kObsY), upd::maps::kRosOccupied);
-  EXPECT_EQ(pixelOf(kFreeX, kFreeY), upd::maps::kRosFree);
+  EXPECT_EQ(pixelOf(kObsX, kObsY), upd::io::kRosOccupied);
+  EXPECT_EQ(pixelOf(kFreeX, kFreeY), upd::io::kRosFree);
   int occupied = 0, free = 0, unknown = 0;
   for (unsigned char v : pgm.pixels) {
-    occupied += v == upd::maps::kRosOccupied;
-    free += v == upd::maps::kRosFree;
-    unknown += v == upd::maps::kRosUnknown;
+    occupied += v == upd::io::kRosOccupied;
+    free += v == upd::io::kRosFree;
+    unknown += v == upd::io::kRosUnknown;
   }
   EXPECT_EQ(occupied, 1);
   EXPECT_EQ(free, 1);
   EXPECT_EQ(unknown, 80 * 80 - 2);
   // The obstacle is in the upper half of the image (it is north of the window centre) and
   // the free cell in the lower half: the image is not flipped.
-  EXPECT_EQ(pgm.at(53, 32), upd::maps::kRosOccupied);  // col (2.35 + 3) / 0.1, row 79 - 47
-  EXPECT_EQ(pgm.at(35, 50), upd::maps::kRosFree);      // col (0.55 + 3) / 0.1, row 79 - 29
+  EXPECT_EQ(pgm.at(53, 32), upd::io::kRosOccupied);  // col (2.35 + 3) / 0.1, row 79 - 47
+  EXPECT_EQ(pgm.at(35, 50), upd::io::kRosFree);      // col (0.55 + 3) / 0.1, row 79 - 29
 }
 
 TEST(ColourPng, ReadableWithColoursAndLegend) {
@@ -282,6 +283,6 @@ TEST(GridExport, RewritingReplacesTheFileAtomically) {
   const std::string second = slurp(dir.file("m.pgm"));
   EXPECT_EQ(first.size(), second.size());
   EXPECT_NE(first, second);
-  EXPECT_EQ(second.find(static_cast<char>(upd::maps::kRosOccupied), 10), std::string::npos);
+  EXPECT_EQ(second.find(static_cast<char>(upd::io::kRosOccupied), 10), std::string::npos);
   EXPECT_EQ(dir.listing().size(), 2u);
 }

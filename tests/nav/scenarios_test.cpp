@@ -28,7 +28,7 @@ class NavScenario : public ::testing::Test {
   void TearDown() override { fs::remove_all(cache_); }
 
   ScenarioResult run(const std::string& name, ObstacleDetector d = ObstacleDetector::Upd) {
-    const ScenarioResult r = runScenario(makeWorld(name), name, config_, d);
+    const ScenarioResult r = runScenario(sim::makeWorld(name), name, config_, d);
     RecordProperty("sim_time_s", std::to_string(r.sim_time_s));
     RecordProperty("min_clearance_m", std::to_string(r.min_clearance_m));
     return r;

@@ -1,6 +1,7 @@
 #include "upd/maps/grid_export.h"
 
 #include "upd/io/atomic_file.h"
+#include "upd/io/ros_map.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -137,40 +138,19 @@ ColourPngLayout writeColourPng(const TraversabilityGrid& grid, const std::string
 }
 
 void writeRosMap(const TraversabilityGrid& grid, const std::string& path_without_ext) {
-  const std::string pgm_path = path_without_ext + ".pgm";
-  const std::string yaml_path = path_without_ext + ".yaml";
-  const int w = grid.sizeX(), h = grid.sizeY();
-
-  std::ostringstream pgm;
-  pgm << "P5\n" << w << " " << h << "\n255\n";
-  std::string pixels(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), '\0');
-  for (int row = 0; row < h; ++row) {
-    const int cy = h - 1 - row;  // image row 0 is the top: y max
-    for (int cx = 0; cx < w; ++cx) {
-      std::uint8_t v = kRosUnknown;
-      switch (labelOf(grid.at(cx, cy), grid.params())) {
-        case Label::NonTraversable: v = kRosOccupied; break;
-        case Label::Traversable: v = kRosFree; break;
-        case Label::Unknown: v = kRosUnknown; break;
-      }
-      pixels[static_cast<std::size_t>(row) * w + cx] = static_cast<char>(v);
+  io::RosMap map;
+  map.resolution_m = grid.cellSize();
+  map.origin_xy = {grid.xMin(), grid.yMin()};
+  map.width = grid.sizeX();
+  map.height = grid.sizeY();
+  map.labels.resize(static_cast<std::size_t>(map.width) * static_cast<std::size_t>(map.height));
+  for (int cy = 0; cy < map.height; ++cy) {
+    for (int cx = 0; cx < map.width; ++cx) {
+      map.labels[static_cast<std::size_t>(cy) * map.width + cx] =
+          labelOf(grid.at(cx, cy), grid.params());
     }
   }
-  pgm << pixels;
-  const std::string pgm_bytes = pgm.str();
-  writeBytes(pgm_path, pgm_bytes.data(), pgm_bytes.size());
-
-  std::ostringstream yaml;
-  yaml << std::setprecision(12);
-  yaml << "image: " << std::filesystem::path(pgm_path).filename().string() << "\n"
-       << "resolution: " << grid.cellSize() << "\n"
-       << "origin: [" << grid.xMin() << ", " << grid.yMin() << ", 0.0]\n"
-       << "negate: 0\n"
-       << "occupied_thresh: 0.65\n"
-       << "free_thresh: 0.196\n"
-       << "mode: trinary\n";
-  const std::string yaml_bytes = yaml.str();
-  writeBytes(yaml_path, yaml_bytes.data(), yaml_bytes.size());
+  io::writeRosMap(map, path_without_ext + ".yaml");
 }
 
 }  // namespace upd::maps

@@ -27,10 +27,10 @@ struct LiveView::Impl {
   mrpt::gui::CDisplayWindow3D::Ptr window;
   mrpt::opengl::CPointCloudColoured::Ptr cloud, map;
   mrpt::opengl::CSetOfLines::Ptr robot, route;
-  RobotBodyParams body;
+  sim::RobotBodyParams body;
 };
 
-LiveView::LiveView(const std::string& title, const RobotBodyParams& body)
+LiveView::LiveView(const std::string& title, const sim::RobotBodyParams& body)
     : impl_(std::make_unique<Impl>()) {
   if (!displayAvailable()) {
     throw std::runtime_error("--view needs a display (neither DISPLAY nor WAYLAND_DISPLAY is set)");

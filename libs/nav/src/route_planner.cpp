@@ -1,11 +1,10 @@
 #include "upd/nav/route_planner.h"
 
+#include "upd/maps/grid_planner.h"
 #include "upd/maps/traversability_grid.h"
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <queue>
 #include <stdexcept>
 
 namespace upd::nav {
@@ -29,8 +28,6 @@ void RoutePlannerParams::validate() const {
 }
 
 namespace {
-
-constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // Waypoints every spacing along the polyline, ending exactly at goal.
 std::vector<Eigen::Vector2d> sampleWaypoints(const std::vector<Eigen::Vector2d>& path,
@@ -58,6 +55,59 @@ std::vector<Eigen::Vector2d> sampleWaypoints(const std::vector<Eigen::Vector2d>&
 
 }  // namespace
 
+namespace {
+
+// The planner's raster over the grid's window: hard obstacles (NonTraversable cells and fixed
+// points), the cells around the start exempt from inflation, and the extra cost of Unknown cells.
+struct RouteRaster {
+  std::vector<std::uint8_t> blocked, exempt;
+  std::vector<double> extra_cost;
+  maps::PlannerGridView view;
+};
+
+RouteRaster rasterize(const maps::TraversabilityGrid& grid,
+                      const std::vector<Eigen::Vector2d>& fixed_obstacles_world,
+                      const Eigen::Vector2d& start_world, const RoutePlannerParams& params) {
+  const int nx = grid.sizeX(), ny = grid.sizeY();
+  const std::size_t n = static_cast<std::size_t>(nx) * ny;
+  RouteRaster r;
+  r.blocked.assign(n, 0);
+  r.exempt.assign(n, 0);
+  r.extra_cost.assign(n, 0.0);
+  const double start_free2 = params.start_free_radius_m * params.start_free_radius_m;
+  for (int cy = 0; cy < ny; ++cy) {
+    for (int cx = 0; cx < nx; ++cx) {
+      const std::size_t i = static_cast<std::size_t>(cy) * nx + cx;
+      const Label l = maps::labelOf(grid.at(cx, cy), grid.params());
+      r.blocked[i] = l == Label::NonTraversable;
+      if (l == Label::Unknown) r.extra_cost[i] = params.unknown_cost;
+      r.exempt[i] = (grid.cellCenter(cx, cy) - start_world).squaredNorm() <= start_free2;
+    }
+  }
+  for (const auto& p : fixed_obstacles_world) {
+    int cx, cy;
+    if (grid.cellIndex(p.x(), p.y(), cx, cy)) r.blocked[static_cast<std::size_t>(cy) * nx + cx] = 1;
+  }
+  r.view.width = nx;
+  r.view.height = ny;
+  r.view.cell_m = grid.cellSize();
+  r.view.blocked = r.blocked.data();
+  r.view.inflation_exempt = r.exempt.data();
+  r.view.extra_cost = r.extra_cost.data();
+  return r;
+}
+
+// The cell of p, clamped into the grid's window; false when the grid has no cells.
+bool clampedCell(const maps::TraversabilityGrid& grid, const Eigen::Vector2d& p,
+                 Eigen::Vector2i& cell) {
+  const double half = 0.5 * grid.cellSize();
+  const double x = std::clamp(p.x(), grid.xMin() + half, grid.xMax() - half);
+  const double y = std::clamp(p.y(), grid.yMin() + half, grid.yMax() - half);
+  return grid.cellIndex(x, y, cell.x(), cell.y());
+}
+
+}  // namespace
+
 Route planRoute(const maps::TraversabilityGrid& grid,
                 const std::vector<Eigen::Vector2d>& fixed_obstacles_world,
                 const Eigen::Vector2d& start_world, const Eigen::Vector2d& goal_world,
@@ -66,118 +116,22 @@ Route planRoute(const maps::TraversabilityGrid& grid,
   if (!start_world.allFinite() || !goal_world.allFinite()) {
     throw std::invalid_argument("planRoute: start and goal must be finite");
   }
-  const int nx = grid.sizeX(), ny = grid.sizeY();
-  const double cell = grid.cellSize();
-  const auto idx = [nx](int cx, int cy) { return static_cast<std::size_t>(cy) * nx + cx; };
-  const std::size_t n = static_cast<std::size_t>(nx) * ny;
-
-  // Hard obstacles: NonTraversable cells and fixed points.
-  std::vector<std::uint8_t> hard(n, 0), unknown(n, 0);
-  for (int cy = 0; cy < ny; ++cy) {
-    for (int cx = 0; cx < nx; ++cx) {
-      const Label l = maps::labelOf(grid.at(cx, cy), grid.params());
-      hard[idx(cx, cy)] = l == Label::NonTraversable;
-      unknown[idx(cx, cy)] = l == Label::Unknown;
-    }
-  }
-  for (const auto& p : fixed_obstacles_world) {
-    int cx, cy;
-    if (grid.cellIndex(p.x(), p.y(), cx, cy)) hard[idx(cx, cy)] = 1;
-  }
-
-  // Distance from each cell centre to the nearest hard cell centre, up to the larger of the
-  // inflation and clearance radii (stamped discs; farther cells stay at +inf).
-  const double reach_m = std::max(params.inflation_m, params.clearance_m);
-  const int r_cells = static_cast<int>(std::ceil(reach_m / cell));
-  std::vector<float> dist(n, kInf);
-  for (int cy = 0; cy < ny; ++cy) {
-    for (int cx = 0; cx < nx; ++cx) {
-      if (!hard[idx(cx, cy)]) continue;
-      for (int dy = -r_cells; dy <= r_cells; ++dy) {
-        const int y = cy + dy;
-        if (y < 0 || y >= ny) continue;
-        for (int dx = -r_cells; dx <= r_cells; ++dx) {
-          const int x = cx + dx;
-          if (x < 0 || x >= nx) continue;
-          const float d = static_cast<float>(cell * std::sqrt(double(dx * dx + dy * dy)));
-          float& cur = dist[idx(x, y)];
-          cur = std::min(cur, d);
-        }
-      }
-    }
-  }
-
-  const auto clampCell = [&](const Eigen::Vector2d& p, int& cx, int& cy) {
-    const double x = std::clamp(p.x(), grid.xMin() + 0.5 * cell, grid.xMax() - 0.5 * cell);
-    const double y = std::clamp(p.y(), grid.yMin() + 0.5 * cell, grid.yMax() - 0.5 * cell);
-    return grid.cellIndex(x, y, cx, cy);
-  };
-  int sx, sy, gx, gy;
   Route route;
-  if (!clampCell(start_world, sx, sy) || !clampCell(goal_world, gx, gy)) return route;
-
-  const double start_free2 = params.start_free_radius_m * params.start_free_radius_m;
-  const auto passable = [&](int cx, int cy) {
-    const std::size_t i = idx(cx, cy);
-    if (hard[i]) return false;
-    if (dist[i] >= params.inflation_m) return true;
-    const Eigen::Vector2d c = grid.cellCenter(cx, cy);
-    return (c - start_world).squaredNorm() <= start_free2;
-  };
-  const auto cellCost = [&](std::size_t i) {
-    double c = 1.0;
-    if (params.clearance_m > 0 && dist[i] < params.clearance_m) {
-      const double t = 1.0 - dist[i] / params.clearance_m;
-      c += params.clearance_weight * t * t;
-    }
-    if (unknown[i]) c += params.unknown_cost;
-    return c;
-  };
-  if (!passable(gx, gy)) return route;
-
-  // A* with the Euclidean distance (in cells) as the admissible heuristic (every cost >= 1).
-  std::vector<double> g(n, std::numeric_limits<double>::infinity());
-  std::vector<std::int32_t> parent(n, -1);
-  std::vector<std::uint8_t> closed(n, 0);
-  using Entry = std::pair<double, std::int32_t>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
-  const auto h = [&](int cx, int cy) { return std::hypot(double(cx - gx), double(cy - gy)); };
-  const std::size_t s = idx(sx, sy), goal_i = idx(gx, gy);
-  g[s] = 0.0;
-  open.emplace(h(sx, sy), static_cast<std::int32_t>(s));
-  static const int kDx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
-  static const int kDy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
-  while (!open.empty()) {
-    const auto [f, ci] = open.top();
-    open.pop();
-    const auto cur = static_cast<std::size_t>(ci);
-    if (closed[cur]) continue;
-    closed[cur] = 1;
-    if (cur == goal_i) break;
-    const int cx = static_cast<int>(cur % nx), cy = static_cast<int>(cur / nx);
-    for (int k = 0; k < 8; ++k) {
-      const int x = cx + kDx[k], y = cy + kDy[k];
-      if (x < 0 || y < 0 || x >= nx || y >= ny || !passable(x, y)) continue;
-      // No corner cutting between two blocked cells.
-      if (k >= 4 && (!passable(cx + kDx[k], cy) || !passable(cx, cy + kDy[k]))) continue;
-      const std::size_t ni = idx(x, y);
-      if (closed[ni]) continue;
-      const double step = (k >= 4 ? std::sqrt(2.0) : 1.0) * 0.5 * (cellCost(cur) + cellCost(ni));
-      if (g[cur] + step < g[ni]) {
-        g[ni] = g[cur] + step;
-        parent[ni] = static_cast<std::int32_t>(cur);
-        open.emplace(g[ni] + h(x, y), static_cast<std::int32_t>(ni));
-      }
-    }
+  Eigen::Vector2i start_cell, goal_cell;
+  if (!clampedCell(grid, start_world, start_cell) || !clampedCell(grid, goal_world, goal_cell)) {
+    return route;
   }
-  if (!closed[goal_i]) return route;
+  const RouteRaster raster = rasterize(grid, fixed_obstacles_world, start_world, params);
+  maps::GridPlannerParams gp;
+  gp.inflation_m = params.inflation_m;
+  gp.clearance_m = params.clearance_m;
+  gp.clearance_weight = params.clearance_weight;
+  const maps::GridPlan plan = maps::planGridPath(raster.view, start_cell, goal_cell, gp);
+  if (!plan.found) return route;
 
-  for (std::int64_t i = static_cast<std::int64_t>(goal_i); i >= 0; i = parent[i]) {
-    const int cx = static_cast<int>(i % nx), cy = static_cast<int>(i / nx);
-    route.path_world.push_back(grid.cellCenter(cx, cy));
-    if (static_cast<std::size_t>(i) == s) break;
+  for (const Eigen::Vector2i& c : plan.cells) {
+    route.path_world.push_back(grid.cellCenter(c.x(), c.y()));
   }
-  std::reverse(route.path_world.begin(), route.path_world.end());
   route.path_world.front() = start_world;
   route.path_world.push_back(goal_world);
   for (std::size_t i = 1; i < route.path_world.size(); ++i) {

@@ -1,10 +1,12 @@
 #include "upd/nav/scenario.h"
 
+#include "upd/core/stopwatch.h"
 #include "upd/io/atomic_file.h"
 #include "upd/io/json_io.h"
 #include "upd/maps/grid_export.h"
 #include "upd/nav/navigation_loop.h"
-#include "upd/nav/simulation.h"
+#include "upd/sim/robot.h"
+#include "upd/sim/truth_raster.h"
 
 #include <mrpt/core/Clock.h>
 #include <opencv2/core.hpp>
@@ -13,7 +15,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -61,58 +62,118 @@ class SimulatedClock {
 
 }  // namespace
 
-ScenarioResult runScenario(const WorldSpec& world, const std::string& name, const NavConfig& config,
-                           ObstacleDetector detector, const std::string& navlog_path,
-                           const StepCallback& on_step) {
-  config.validate();
-  const auto wall0 = std::chrono::steady_clock::now();
-  SimulatedClock clock;
+namespace {
 
-  const Pose2D start{world.start_xy_yaw.x(), world.start_xy_yaw.y(), world.start_xy_yaw.z()};
-  SimulatedDiffDrive base(start, config.base);
-  NavigationLoop loop(base, config, detector, navlog_path);
-  if (config.loop.fence_world) {
-    loop.setFixedObstacles(rectangleFence(world.terrain.minXY(), world.terrain.maxXY(),
-                                          config.obstacles.decimation_m));
+Eigen::Vector3d xyYaw(const Pose2D& p) { return {p.x_m, p.y_m, p.yaw_rad}; }
+
+// One run in progress: the simulated base, the loop and the ground truth it is checked against.
+class ScenarioRun {
+ public:
+  ScenarioRun(const sim::WorldSpec& world, const NavConfig& config, ObstacleDetector detector,
+              const std::string& navlog_path)
+      : world_(world),
+        config_(config),
+        base_(Pose2D{world.start_xy_yaw.x(), world.start_xy_yaw.y(), world.start_xy_yaw.z()},
+              config.base),
+        loop_(base_, config, detector, navlog_path),
+        truth_(world.terrain, config.loop.truth_cell_m) {
+    if (config.loop.fence_world) {
+      loop_.setFixedObstacles(rectangleFence(world.terrain.minXY(), world.terrain.maxXY(),
+                                             config.obstacles.decimation_m));
+    }
   }
-  const TruthRaster truth(world.terrain, config.loop.truth_cell_m);
+
+  // The state after a step, checked against the truth.
+  TrajectorySample sample(NavState state) const {
+    TrajectorySample s;
+    s.t_s = base_.timeS();
+    s.pose_world_robot = base_.pose();
+    const Eigen::Vector3d pose = xyYaw(s.pose_world_robot);
+    s.z_m = sim::bodyPoseOnTerrain(world_.terrain, pose, config_.body).translation().z();
+    s.command = base_.lastCommand();
+    s.clearance_m = truth_.clearance(pose, config_.body, config_.loop.clearance_search_m);
+    s.collision = s.clearance_m <= 0.0;
+    s.state = state;
+    return s;
+  }
+
+  // One control step: render the camera from the body pose on the terrain, add the frame,
+  // step the navigator and move the base. frame_ms: the frame's scoring time.
+  TrajectorySample step(int k, SimulatedClock& clock, double& frame_ms) {
+    clock.set(base_.timeS());
+    const Eigen::Isometry3d body =
+        sim::bodyPoseOnTerrain(world_.terrain, xyYaw(base_.pose()), config_.body);
+    const PointCloud cloud =
+        sim::renderCameraWorld(world_.terrain, body, config_.camera, config_.depth_noise,
+                               static_cast<std::uint32_t>(config_.loop.seed + k));
+    const FrameEvidence& ev = loop_.addFrame(cloud, base_.timeS(), body.translation().z());
+    frame_ms = ev.score_ms;
+    const NavState state = loop_.step();
+    base_.advance(config_.loop.control_period_s);
+    TrajectorySample s = sample(state);
+    s.obstacle_points = loop_.navigator()->lastObstacleCount();
+    s.frame_nontraversable = ev.obstacles_world.size();
+    return s;
+  }
+
+  SimulatedDiffDrive& base() { return base_; }
+  NavigationLoop& loop() { return loop_; }
+
+ private:
+  const sim::WorldSpec& world_;
+  const NavConfig& config_;
+  SimulatedDiffDrive base_;
+  NavigationLoop loop_;
+  const sim::TruthRaster truth_;
+};
+
+// The run's totals from its trajectory and the loop's end state.
+void summarize(ScenarioRun& run, const sim::WorldSpec& world, const NavConfig& config,
+               NavState state, double frame_ms_sum, ScenarioResult& r) {
+  r.navigator = run.loop().outcome();
+  run.loop().finish();
+  const Pose2D end = run.base().pose();
+  r.final_distance_to_goal_m = std::hypot(end.x_m - world.goal_xy.x(), end.y_m - world.goal_xy.y());
+  r.reached = r.navigator.target_reached && state == NavState::Idle;
+  if (r.reached) r.end = RunEnd::GoalReached;
+  r.sim_time_s = run.base().timeS();
+  r.min_clearance_m = config.loop.clearance_search_m;
+  for (std::size_t i = 1; i < r.trajectory.size(); ++i) {
+    r.min_clearance_m = std::min(r.min_clearance_m, r.trajectory[i].clearance_m);
+    r.collision_steps += r.trajectory[i].collision ? 1 : 0;
+  }
+  r.mean_frame_ms = r.steps > 0 ? frame_ms_sum / r.steps : 0.0;
+  r.grid = run.loop().grid();
+  r.route = run.loop().route();
+  r.failed_plans = run.loop().failedPlans();
+  r.replanning_stopped = run.loop().replanningStopped();
+}
+
+}  // namespace
+
+ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
+                           const NavConfig& config, ObstacleDetector detector,
+                           const std::string& navlog_path, const StepCallback& on_step) {
+  config.validate();
+  const Stopwatch wall;
+  SimulatedClock clock;
+  ScenarioRun run(world, config, detector, navlog_path);
 
   ScenarioResult r;
   r.scenario = name;
   r.detector = detector;
   r.goal_xy = world.goal_xy;
-  const auto sample = [&](NavState state) {
-    TrajectorySample s;
-    s.t_s = base.timeS();
-    s.pose_world_robot = base.pose();
-    s.z_m = bodyPoseOnTerrain(world.terrain, s.pose_world_robot, config.body).translation().z();
-    s.command = base.lastCommand();
-    s.clearance_m =
-        truth.clearance(s.pose_world_robot, config.body, config.loop.clearance_search_m);
-    s.collision = s.clearance_m <= 0.0;
-    s.state = state;
-    return s;
-  };
-  r.trajectory.push_back(sample(NavState::Navigating));
+  r.trajectory.push_back(run.sample(NavState::Navigating));
 
-  loop.navigateTo(world.goal_xy);
+  run.loop().navigateTo(world.goal_xy);
   double frame_ms_sum = 0.0;
   NavState state = NavState::Navigating;
   r.end = RunEnd::TimeLimit;
   for (int k = 0;; ++k) {
-    clock.set(base.timeS());
-    const Eigen::Isometry3d body = bodyPoseOnTerrain(world.terrain, base.pose(), config.body);
-    const PointCloud cloud =
-        renderCameraWorld(world.terrain, body, config.camera, config.depth_noise,
-                          static_cast<std::uint32_t>(config.loop.seed + k));
-    const FrameEvidence& ev = loop.addFrame(cloud, base.timeS(), body.translation().z());
-    frame_ms_sum += ev.score_ms;
-    state = loop.step();
-    base.advance(config.loop.control_period_s);
-
-    TrajectorySample s = sample(state);
-    s.obstacle_points = loop.navigator()->lastObstacleCount();
-    s.frame_nontraversable = ev.obstacles_world.size();
+    double frame_ms = 0.0;
+    const TrajectorySample s = run.step(k, clock, frame_ms);
+    frame_ms_sum += frame_ms;
+    state = s.state;
     const auto& prev = r.trajectory.back().pose_world_robot;
     r.path_length_m +=
         std::hypot(s.pose_world_robot.x_m - prev.x_m, s.pose_world_robot.y_m - prev.y_m);
@@ -128,28 +189,11 @@ ScenarioResult runScenario(const WorldSpec& world, const std::string& name, cons
       r.end = RunEnd::NavigatorStopped;
       break;
     }
-    if (base.timeS() >= config.loop.max_time_s) break;
+    if (run.base().timeS() >= config.loop.max_time_s) break;
   }
-  r.navigator = loop.outcome();
-  loop.finish();
-
-  const Pose2D end = base.pose();
-  r.final_distance_to_goal_m = std::hypot(end.x_m - world.goal_xy.x(), end.y_m - world.goal_xy.y());
-  r.reached = r.navigator.target_reached && state == NavState::Idle;
-  if (r.reached) r.end = RunEnd::GoalReached;
-  r.sim_time_s = base.timeS();
-  r.min_clearance_m = config.loop.clearance_search_m;
-  for (std::size_t i = 1; i < r.trajectory.size(); ++i) {
-    r.min_clearance_m = std::min(r.min_clearance_m, r.trajectory[i].clearance_m);
-    r.collision_steps += r.trajectory[i].collision ? 1 : 0;
-  }
-  r.mean_frame_ms = r.steps > 0 ? frame_ms_sum / r.steps : 0.0;
-  r.grid = loop.grid();
-  r.route = loop.route();
-  r.failed_plans = loop.failedPlans();
-  r.replanning_stopped = loop.replanningStopped();
+  summarize(run, world, config, state, frame_ms_sum, r);
   r.navlog_path = navlog_path;
-  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  r.wall_time_s = wall.elapsedMs() / 1000.0;
   return r;
 }
 
@@ -204,8 +248,8 @@ struct TopView {
 
 cv::Vec3b bgr(const std::array<std::uint8_t, 3>& rgb) { return {rgb[2], rgb[1], rgb[0]}; }
 
-void drawFootprint(cv::Mat& img, const TopView& v, const Pose2D& pose, const RobotBodyParams& body,
-                   const cv::Scalar& colour) {
+void drawFootprint(cv::Mat& img, const TopView& v, const Pose2D& pose,
+                   const sim::RobotBodyParams& body, const cv::Scalar& colour) {
   const double hl = 0.5 * body.length_m, hw = 0.5 * body.width_m;
   std::vector<cv::Point> poly;
   for (const auto& c : {Eigen::Vector2d(hl, hw), Eigen::Vector2d(hl, -hw),
@@ -219,8 +263,9 @@ void drawFootprint(cv::Mat& img, const TopView& v, const Pose2D& pose, const Rob
 }
 
 cv::Mat drawPathImage(const TopView& v, const std::function<cv::Vec3b(double, double)>& background,
-                      const ScenarioResult& r, const WorldSpec& world, const RobotBodyParams& body,
-                      const std::string& title, const std::string& subtitle) {
+                      const ScenarioResult& r, const sim::WorldSpec& world,
+                      const sim::RobotBodyParams& body, const std::string& title,
+                      const std::string& subtitle) {
   const int header = 44;
   cv::Mat img(v.height + header, v.width, CV_8UC3, cv::Scalar(255, 255, 255));
   cv::Mat map = img(cv::Rect(0, header, v.width, v.height));
@@ -276,8 +321,8 @@ void writePng(const std::string& path, const cv::Mat& img) {
 
 }  // namespace
 
-void writeScenarioOutputs(const ScenarioResult& r, const WorldSpec& world,
-                          const RobotBodyParams& body, const std::string& output_dir) {
+void writeScenarioOutputs(const ScenarioResult& r, const sim::WorldSpec& world,
+                          const sim::RobotBodyParams& body, const std::string& output_dir) {
   std::error_code ec;
   fs::create_directories(output_dir, ec);
   if (ec) throw std::runtime_error("output directory " + output_dir + ": " + ec.message());

@@ -36,16 +36,9 @@ struct ColourPngLayout {
 ColourPngLayout writeColourPng(const TraversabilityGrid& grid, const std::string& path,
                                int pixels_per_cell = 0);
 
-/// Values of the trinary PGM written by writeRosMap.
-inline constexpr std::uint8_t kRosOccupied = 0;
-inline constexpr std::uint8_t kRosFree = 254;
-inline constexpr std::uint8_t kRosUnknown = 205;
-
-/// Writes path_without_ext + ".pgm" and ".yaml" in ROS map_server's format: a binary P5 PGM,
-/// north up (image row 0 is y max), 0 = non-traversable, 254 = traversable, 205 = unknown (from
-/// labelOf, so the thresholds of GridParams decide), and a YAML with image (the PGM's file name,
-/// relative), resolution, origin [x_min, y_min, 0.0] (the lower-left corner of the lower-left
-/// pixel), negate 0, occupied_thresh 0.65, free_thresh 0.196, mode trinary.
+/// Writes path_without_ext + ".pgm" and ".yaml" in ROS map_server's format through
+/// io::writeRosMap (upd/io/ros_map.h: the PGM values io::kRosOccupied, kRosFree, kRosUnknown),
+/// each cell's label from labelOf, so the thresholds of GridParams decide.
 void writeRosMap(const TraversabilityGrid& grid, const std::string& path_without_ext);
 
 }  // namespace upd::maps

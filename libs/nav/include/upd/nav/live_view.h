@@ -7,7 +7,7 @@
 #include "upd/nav/perception.h"
 #include "upd/nav/robot_base.h"
 #include "upd/nav/route_planner.h"
-#include "upd/nav/simulation.h"
+#include "upd/sim/robot.h"
 
 #include <memory>
 #include <string>
@@ -20,7 +20,7 @@ bool displayAvailable();
 class LiveView {
  public:
   /// Opens the window; throws std::runtime_error when there is no display.
-  LiveView(const std::string& title, const RobotBodyParams& body);
+  LiveView(const std::string& title, const sim::RobotBodyParams& body);
   ~LiveView();
   LiveView(const LiveView&) = delete;
   LiveView& operator=(const LiveView&) = delete;

@@ -13,7 +13,6 @@
 
 #include "upd/core/baselines.h"
 #include "upd/core/pipeline.h"
-#include "upd/core/render.h"
 #include "upd/maps/fusion.h"
 #include "upd/maps/traversability_grid.h"
 #include "upd/nav/navigator.h"
@@ -21,7 +20,8 @@
 #include "upd/nav/obstacles.h"
 #include "upd/nav/robot_base.h"
 #include "upd/nav/route_planner.h"
-#include "upd/nav/simulation.h"
+#include "upd/sim/render.h"
+#include "upd/sim/robot.h"
 
 #include <string>
 #include <vector>
@@ -54,9 +54,9 @@ struct NavConfig {
   BaselineParams baseline;
   maps::GridParams grid;
   maps::FusionParams fusion;
-  DepthNoise depth_noise;
-  RobotBodyParams body;
-  CameraMountParams camera;
+  sim::DepthNoise depth_noise;
+  sim::RobotBodyParams body;
+  sim::CameraMountParams camera;
   SimulatedBaseParams base;
   ObstacleParams obstacles;
   NegativeObstacleParams negative;

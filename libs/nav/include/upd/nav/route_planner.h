@@ -7,7 +7,8 @@
 // search over what the map knows resolves both; the navigator still does the driving and the
 // obstacle avoidance between waypoints.
 //
-// The search (A*, 8-connected, on the grid's cells) treats a cell as
+// The search is the project's one grid planner (upd/maps/grid_planner.h: A*, 8-connected, on
+// the grid's cells); this unit prepares its raster. It treats a cell as
 //  - blocked when it is NonTraversable (labelOf) or holds a fixed obstacle point, or lies
 //    closer than inflation_m to such a cell (the robot's half-width plus a margin);
 //  - free otherwise, Unknown cells included (optimistic: unexplored ground may be crossed;

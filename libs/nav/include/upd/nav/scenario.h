@@ -1,19 +1,22 @@
 // The closed loop in simulation (`upd navigate`): a kinematic Dune in a generated world
-// (terrain.h makeWorld), its depth camera rendered from the body pose at every control step,
-// the UPD (or the roughness index), the fused map, MRPT's reactive navigator and its velocity
-// commands, until the goal is reached, the navigator reports an error, or the time limit.
+// (sim::makeWorld), its depth camera rendered from the body pose at every control step (upd/sim/
+// robot.h), the UPD (or the roughness index), the fused map, MRPT's reactive navigator and its
+// velocity commands, until the goal is reached, the navigator reports an error, or the time
+// limit.
 //
-// Each step is checked against the ground truth (TruthRaster): a collision is a step where the
-// robot's footprint overlaps NonTraversable truth; clearance is the footprint's distance to it.
+// Each step is checked against the ground truth (sim::TruthRaster): a collision is a step where
+// the robot's footprint overlaps NonTraversable truth; clearance is the footprint's distance to
+// it.
 #pragma once
 
-#include "upd/core/terrain.h"
 #include "upd/maps/traversability_grid.h"
 #include "upd/nav/nav_config.h"
 #include "upd/nav/navigator.h"
 #include "upd/nav/perception.h"
 #include "upd/nav/robot_base.h"
 #include "upd/nav/route_planner.h"
+#include "upd/sim/robot.h"
+#include "upd/sim/terrain.h"
 
 #include <nlohmann/json.hpp>
 
@@ -68,9 +71,9 @@ using StepCallback = std::function<void(const TrajectorySample&)>;
 
 /// Runs the loop on world (name is recorded). navlog_path: where the MRPT navlog goes (empty:
 /// none). Restores MRPT's clock to real time when it returns.
-ScenarioResult runScenario(const WorldSpec& world, const std::string& name, const NavConfig& config,
-                           ObstacleDetector detector, const std::string& navlog_path = "",
-                           const StepCallback& on_step = {});
+ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
+                           const NavConfig& config, ObstacleDetector detector,
+                           const std::string& navlog_path = "", const StepCallback& on_step = {});
 
 /// summary.json's content: reached, end state, navigator error, simulated time, path length,
 /// minimum clearance, collisions, ...
@@ -79,7 +82,7 @@ nlohmann::json summaryJson(const ScenarioResult& result);
 /// Writes trajectory.csv, path_map.png (the path over the fused map), path_truth.png (over the
 /// ground truth) and summary.json into output_dir (created if missing), each atomically.
 /// The footprint (body) is drawn at the start and the end of the path.
-void writeScenarioOutputs(const ScenarioResult& result, const WorldSpec& world,
-                          const RobotBodyParams& body, const std::string& output_dir);
+void writeScenarioOutputs(const ScenarioResult& result, const sim::WorldSpec& world,
+                          const sim::RobotBodyParams& body, const std::string& output_dir);
 
 }  // namespace upd::nav

@@ -1,11 +1,11 @@
-#include "upd/core/scenes.h"
+#include "upd/sim/scenes.h"
 
 #include <cmath>
 #include <random>
 #include <stdexcept>
 #include <utility>
 
-namespace upd {
+namespace upd::sim {
 
 namespace sg = scene_geometry;
 
@@ -163,4 +163,4 @@ Scene makeScene(const std::string& name, const SceneParams& params) {
   return s;
 }
 
-}  // namespace upd
+}  // namespace upd::sim

@@ -9,8 +9,8 @@
 // sampleSurface() samples them. Outside the extent the world is the plane z = 0 and its truth
 // is Unknown.
 //
-// Ground truth (truthAt) answers "could a small rover (Dune: 0.7 x 0.45 m, 0.2 m wheels) stand
-// here?" by a local rule, evaluated in this order:
+// Ground truth (truthAt) answers "could a small rover (the Dune, upd/sim/robot.h) stand here?"
+// by a local rule, evaluated in this order:
 //  1. outside the extent: Unknown;
 //  2. NonTraversable inside a ditch or within border_m of it (floor, walls and both rims);
 //  3. NonTraversable on a wall Box (Box::wall) or within border_m of it;
@@ -37,7 +37,7 @@
 #include <string>
 #include <vector>
 
-namespace upd {
+namespace upd::sim {
 
 /// Ground-truth thresholds for a small rover.
 struct TruthParams {
@@ -210,6 +210,11 @@ class Terrain {
   struct Segment {
     Eigen::Vector2d a, b;
   };
+  struct Ray;  // terrain_raycast.cpp
+  std::optional<Eigen::Vector3d> walkCells(const Ray& ray, double t_in, double t_out,
+                                           bool& to_sky) const;
+  std::optional<Eigen::Vector3d> marchCell(const Ray& ray, double t, double t_end, double bound,
+                                           double march_dt, double& t_above) const;
   static Shape orientedShape(const Eigen::Vector2d& origin, double yaw_rad);
   void addShape(const Shape& s);
   void rebuildIndex();
@@ -281,4 +286,4 @@ std::vector<std::string> worldNames();
 /// Throws std::invalid_argument listing the valid names for an unknown name.
 WorldSpec makeWorld(const std::string& name);
 
-}  // namespace upd
+}  // namespace upd::sim

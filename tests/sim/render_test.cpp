@@ -1,6 +1,6 @@
 // The simulated depth camera and the terrain ray caster: analytic depths, vertical faces,
 // the Kinect noise model, invalid pixels and the labelled organized cloud.
-#include "upd/core/render.h"
+#include "upd/sim/render.h"
 
 #include <gtest/gtest.h>
 
@@ -13,19 +13,19 @@ namespace {
 
 using upd::Label;
 
-upd::DepthNoise noiseFree() {
-  upd::DepthNoise n;
+upd::sim::DepthNoise noiseFree() {
+  upd::sim::DepthNoise n;
   n.sigma_coeff_per_m = 0.0;
   n.quantize_mm = false;
   return n;
 }
 
-upd::Terrain flatWorld() { return upd::Terrain({-50, -50}, {50, 50}); }
+upd::sim::Terrain flatWorld() { return upd::sim::Terrain({-50, -50}, {50, 50}); }
 
 // A wall whose face is the plane x = distance_m, 10 m wide and 5 m high.
-upd::Terrain wallWorld(double distance_m) {
-  upd::Terrain t({-20, -20}, {20, 20});
-  upd::Box wall;
+upd::sim::Terrain wallWorld(double distance_m) {
+  upd::sim::Terrain t({-20, -20}, {20, 20});
+  upd::sim::Box wall;
   wall.center_xy = {distance_m + 0.25, 0.0};
   wall.length_m = 0.5;
   wall.width_m = 10.0;
@@ -41,23 +41,23 @@ Eigen::Vector3d pixelRay(const upd::CameraIntrinsics& K, int u, int v) {
 
 TEST(CameraPose, LooksAtTheTargetWithRowsDown) {
   const Eigen::Vector3d eye(1, 2, 1.5), target(4, 0, 0);
-  const Eigen::Isometry3d pose = upd::cameraPoseLookingAt(eye, target);
+  const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt(eye, target);
   EXPECT_TRUE(pose.translation().isApprox(eye));
   EXPECT_TRUE(pose.linear().col(2).isApprox((target - eye).normalized()));
   EXPECT_NEAR(pose.linear().col(0).z(), 0.0, 1e-12);  // image rows are level
   EXPECT_LT(pose.linear().col(1).z(), 0.0);           // image y points down
   EXPECT_NEAR(pose.linear().determinant(), 1.0, 1e-12);
   EXPECT_TRUE((pose.linear().transpose() * pose.linear()).isIdentity(1e-12));
-  EXPECT_THROW(upd::cameraPoseLookingAt(eye, eye), std::invalid_argument);
-  EXPECT_THROW(upd::cameraPoseLookingAt(eye, eye - Eigen::Vector3d::UnitZ()),
+  EXPECT_THROW(upd::sim::cameraPoseLookingAt(eye, eye), std::invalid_argument);
+  EXPECT_THROW(upd::sim::cameraPoseLookingAt(eye, eye - Eigen::Vector3d::UnitZ()),
                std::invalid_argument);
 }
 
 TEST(RenderDepth, FlatGroundMatchesTheRayPlaneIntersection) {
   const upd::CameraIntrinsics K;
-  const Eigen::Isometry3d pose = upd::cameraPoseLookingAt({0, 0, 1.0}, {3, 0.5, 0});
-  const upd::DepthNoise noise = noiseFree();
-  const upd::DepthImage img = upd::renderDepth(flatWorld(), pose, K, noise, 1);
+  const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 1.0}, {3, 0.5, 0});
+  const upd::sim::DepthNoise noise = noiseFree();
+  const upd::DepthImage img = upd::sim::renderDepth(flatWorld(), pose, K, noise, 1);
   ASSERT_EQ(img.width, K.width);
   ASSERT_EQ(img.height, K.height);
   std::size_t valid = 0, sky = 0;
@@ -82,15 +82,15 @@ TEST(RenderDepth, FlatGroundMatchesTheRayPlaneIntersection) {
 
 TEST(RenderDepth, SkyPixelsAreInvalid) {
   const upd::CameraIntrinsics K;
-  const Eigen::Isometry3d pose = upd::cameraPoseLookingAt({0, 0, 1.0}, {3, 0, 3.0});
-  const upd::DepthImage img = upd::renderDepth(flatWorld(), pose, K, upd::DepthNoise{}, 1);
+  const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 1.0}, {3, 0, 3.0});
+  const upd::DepthImage img = upd::sim::renderDepth(flatWorld(), pose, K, upd::sim::DepthNoise{}, 1);
   for (float d : img.depth_m) ASSERT_EQ(d, 0.f);
 }
 
 TEST(RenderDepth, VerticalWallAppearsAtItsDistance) {
   const upd::CameraIntrinsics K;
-  const Eigen::Isometry3d pose = upd::cameraPoseLookingAt({0, 0, 1.0}, {1, 0, 1.0});
-  const upd::DepthImage img = upd::renderDepth(wallWorld(3.0), pose, K, noiseFree(), 1);
+  const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 1.0}, {1, 0, 1.0});
+  const upd::DepthImage img = upd::sim::renderDepth(wallWorld(3.0), pose, K, noiseFree(), 1);
   // Looking straight at a wall perpendicular to the optical axis every pixel has z = 3 (the
   // bottom rows reach z = 0 at 1 / 0.456 = 2.19 m: they see the ground first).
   std::size_t on_wall = 0;
@@ -110,11 +110,11 @@ TEST(RenderDepth, VerticalWallAppearsAtItsDistance) {
 
 TEST(RenderDepth, NoiseSigmaGrowsWithTheSquareOfDepth) {
   const upd::CameraIntrinsics K;
-  const Eigen::Isometry3d pose = upd::cameraPoseLookingAt({0, 0, 2.5}, {1, 0, 2.5});
+  const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 2.5}, {1, 0, 2.5});
   for (double z : {2.0, 4.0}) {
     SCOPED_TRACE(z);
-    upd::DepthNoise noise;  // Kinect defaults: 1.2e-3 z^2, millimetre steps
-    const upd::DepthImage img = upd::renderDepth(wallWorld(z), pose, K, noise, 7);
+    upd::sim::DepthNoise noise;  // Kinect defaults: 1.2e-3 z^2, millimetre steps
+    const upd::DepthImage img = upd::sim::renderDepth(wallWorld(z), pose, K, noise, 7);
     double sum = 0, sum2 = 0;
     std::size_t n = 0;
     for (float d : img.depth_m) {
@@ -135,11 +135,11 @@ TEST(RenderDepth, NoiseSigmaGrowsWithTheSquareOfDepth) {
 
 TEST(RenderDepth, SameSeedSameImageOtherSeedOther) {
   const upd::CameraIntrinsics K;
-  const Eigen::Isometry3d pose = upd::cameraPoseLookingAt({0, 0, 1.0}, {3, 0, 0});
-  const upd::WorldSpec w = upd::makeWorld("mixed");
-  const upd::DepthImage a = upd::renderDepth(w.terrain, pose, K, upd::DepthNoise{}, 3);
-  const upd::DepthImage b = upd::renderDepth(w.terrain, pose, K, upd::DepthNoise{}, 3);
-  const upd::DepthImage c = upd::renderDepth(w.terrain, pose, K, upd::DepthNoise{}, 4);
+  const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 1.0}, {3, 0, 0});
+  const upd::sim::WorldSpec w = upd::sim::makeWorld("mixed");
+  const upd::DepthImage a = upd::sim::renderDepth(w.terrain, pose, K, upd::sim::DepthNoise{}, 3);
+  const upd::DepthImage b = upd::sim::renderDepth(w.terrain, pose, K, upd::sim::DepthNoise{}, 3);
+  const upd::DepthImage c = upd::sim::renderDepth(w.terrain, pose, K, upd::sim::DepthNoise{}, 4);
   EXPECT_EQ(a.depth_m, b.depth_m);
   std::size_t differ = 0;
   for (std::size_t i = 0; i < a.depth_m.size(); ++i) differ += a.depth_m[i] != c.depth_m[i];
@@ -148,13 +148,13 @@ TEST(RenderDepth, SameSeedSameImageOtherSeedOther) {
 
 TEST(RenderDepth, RangeLimitsInvalidateDepth) {
   const upd::CameraIntrinsics K;
-  const Eigen::Isometry3d pose = upd::cameraPoseLookingAt({0, 0, 2.5}, {1, 0, 2.5});
+  const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 2.5}, {1, 0, 2.5});
   // Nearer than min_range_m: the wall fills the image.
-  const upd::DepthImage near = upd::renderDepth(wallWorld(0.3), pose, K, noiseFree(), 1);
+  const upd::DepthImage near = upd::sim::renderDepth(wallWorld(0.3), pose, K, noiseFree(), 1);
   for (float d : near.depth_m) ASSERT_EQ(d, 0.f);
   // Beyond max_range_m: the upper half sees only the wall (the lower half sees the ground
   // within 5.5 m).
-  const upd::DepthImage far = upd::renderDepth(wallWorld(9.0), pose, K, noiseFree(), 1);
+  const upd::DepthImage far = upd::sim::renderDepth(wallWorld(9.0), pose, K, noiseFree(), 1);
   for (int v = 0; v < K.height; ++v) {
     for (int u = 0; u < K.width; ++u) {
       const double ground_s = (v - K.cy) > 0 ? 2.5 / ((v - K.cy) / K.fy) : 1e9;
@@ -167,10 +167,10 @@ TEST(RenderDepth, RangeLimitsInvalidateDepth) {
 }
 
 TEST(RenderDepth, BadParametersThrowNamingTheField) {
-  upd::DepthNoise n;
+  upd::sim::DepthNoise n;
   n.max_range_m = 0.1;  // below min_range_m
   try {
-    upd::renderDepth(flatWorld(), Eigen::Isometry3d::Identity(), upd::CameraIntrinsics{}, n, 1);
+    upd::sim::renderDepth(flatWorld(), Eigen::Isometry3d::Identity(), upd::CameraIntrinsics{}, n, 1);
     FAIL() << "nothing thrown";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("DepthNoise.max_range_m"), std::string::npos) << e.what();
@@ -182,7 +182,7 @@ TEST(RenderDepth, BadParametersThrowNamingTheField) {
 
 // Hit point on the surface: at the height there, or on a vertical face (between the heights
 // just either side of it).
-bool onSurface(const upd::Terrain& t, const Eigen::Vector3d& p, double tol_m) {
+bool onSurface(const upd::sim::Terrain& t, const Eigen::Vector3d& p, double tol_m) {
   if (std::abs(p.z() - t.heightAt(p.x(), p.y())) < tol_m) return true;
   const double e = 10 * tol_m;
   double lo = 1e9, hi = -1e9;
@@ -196,11 +196,11 @@ bool onSurface(const upd::Terrain& t, const Eigen::Vector3d& p, double tol_m) {
 }
 
 TEST(RenderScene, OrganizedCloudLandsOnTheTerrainWithTruth) {
-  const upd::WorldSpec w = upd::makeWorld("mixed");
+  const upd::sim::WorldSpec w = upd::sim::makeWorld("mixed");
   const upd::CameraIntrinsics K;
   // Looking from the start along the ramp, platform, ditch and step side of the world.
-  const Eigen::Isometry3d pose = upd::cameraPoseLookingAt({1.5, 0.0, 1.2}, {6.0, -2.0, 0.0});
-  const upd::RenderedScene r = upd::renderScene(w.terrain, pose, K, noiseFree(), 1, "mixed");
+  const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({1.5, 0.0, 1.2}, {6.0, -2.0, 0.0});
+  const upd::sim::RenderedScene r = upd::sim::renderScene(w.terrain, pose, K, noiseFree(), 1, "mixed");
   const upd::PointCloud& c = r.scene.cloud;
   ASSERT_TRUE(c.isOrganized());
   ASSERT_EQ(c.width, static_cast<std::size_t>(K.width));
@@ -235,13 +235,13 @@ TEST(RenderScene, OrganizedCloudLandsOnTheTerrainWithTruth) {
 }
 
 TEST(Raycast, HitsVerticalFacesAndFloors) {
-  upd::Terrain t({-5, -5}, {5, 5});
-  upd::Box step;
+  upd::sim::Terrain t({-5, -5}, {5, 5});
+  upd::sim::Box step;
   step.center_xy = {1.5, 0.0};
   step.length_m = 1.0;  // face at x = 1
   step.width_m = 2.0;
   step.height_m = 0.15;
-  upd::Ditch ditch;
+  upd::sim::Ditch ditch;
   ditch.center_xy = {-2.0, 0.0};
   ditch.length_m = 0.6;  // walls at x = -2.3 and -1.7
   ditch.width_m = 2.0;
@@ -278,8 +278,8 @@ TEST(Raycast, HitsVerticalFacesAndFloors) {
 
 // The fast ray caster (cell skipping, 1 cm march, bisection) against a plain 1 mm march.
 TEST(Raycast, AgreesWithABruteForceMarch) {
-  const upd::WorldSpec w = upd::makeWorld("mixed");
-  const upd::Terrain& t = w.terrain;
+  const upd::sim::WorldSpec w = upd::sim::makeWorld("mixed");
+  const upd::sim::Terrain& t = w.terrain;
   std::mt19937 rng(42);
   std::uniform_real_distribution<double> ux(0.5, 11.5), uy(-3.5, 3.5), uz(0.4, 2.0),
       angle(-3.14159, 3.14159), down(0.1, 1.2);

@@ -1,6 +1,7 @@
 // The synthetic scenes and worlds: exact sampling, truth regions, noise, named worlds.
-#include "upd/core/scenes.h"
-#include "upd/core/terrain.h"
+#include "upd/sim/robot.h"
+#include "upd/sim/scenes.h"
+#include "upd/sim/terrain.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +16,7 @@
 namespace {
 
 using upd::Label;
-namespace sg = upd::scene_geometry;
+namespace sg = upd::sim::scene_geometry;
 
 std::string thrownMessage(const std::function<void()>& fn) {
   try {
@@ -35,7 +36,7 @@ std::size_t countLabel(const std::vector<Label>& labels, Label l) {
 // ------------------------------------------------------------------------------ corner
 
 TEST(CornerScene, HasExactlyTheDocumentedPoints) {
-  const upd::Scene s = upd::makeScene("corner", {});
+  const upd::sim::Scene s = upd::sim::makeScene("corner", {});
   ASSERT_EQ(s.cloud.size(), 101u * 101u + 101u * 100u);
   ASSERT_EQ(s.truth.size(), s.cloud.size());
   const std::size_t floor_points = 101u * 101u;
@@ -60,14 +61,14 @@ TEST(CornerScene, HasExactlyTheDocumentedPoints) {
 }
 
 TEST(CornerScene, SpacingThatDoesNotDivideTheSideStopsInside) {
-  upd::SceneParams p;
+  upd::sim::SceneParams p;
   p.spacing_m = 0.03;  // 33 steps of 0.03 m: last sample at 0.99
-  const upd::Scene s = upd::makeScene("corner", p);
+  const upd::sim::Scene s = upd::sim::makeScene("corner", p);
   EXPECT_EQ(s.cloud.size(), 34u * 34u + 34u * 33u);
 }
 
 TEST(CornerScene, TruthIsTheEdgeBandAndTheWall) {
-  const upd::Scene s = upd::makeScene("corner", {});
+  const upd::sim::Scene s = upd::sim::makeScene("corner", {});
   for (std::size_t i = 0; i < s.cloud.size(); ++i) {
     const bool wall = s.cloud.z[i] > 0.f;
     const bool band = s.cloud.x[i] <= sg::kCornerEdgeBand_m + 1e-6;
@@ -79,12 +80,12 @@ TEST(CornerScene, TruthIsTheEdgeBandAndTheWall) {
 // ------------------------------------------------------------------------------ all scenes
 
 TEST(Scenes, EveryNamedSceneHasBothLabelsAndNoUnknown) {
-  ASSERT_EQ(upd::sceneNames().size(), 6u);
-  for (const std::string& name : upd::sceneNames()) {
+  ASSERT_EQ(upd::sim::sceneNames().size(), 6u);
+  for (const std::string& name : upd::sim::sceneNames()) {
     SCOPED_TRACE(name);
-    upd::SceneParams p;
+    upd::sim::SceneParams p;
     p.spacing_m = 0.02;
-    const upd::Scene s = upd::makeScene(name, p);
+    const upd::sim::Scene s = upd::sim::makeScene(name, p);
     EXPECT_EQ(s.name, name);
     ASSERT_EQ(s.truth.size(), s.cloud.size());
     EXPECT_EQ(s.cloud.countFinite(), s.cloud.size());
@@ -95,10 +96,10 @@ TEST(Scenes, EveryNamedSceneHasBothLabelsAndNoUnknown) {
 }
 
 TEST(Scenes, TerrainScenesAreAboutThreeMetresWide) {
-  for (const std::string& name : upd::sceneNames()) {
+  for (const std::string& name : upd::sim::sceneNames()) {
     if (name == "corner") continue;
     SCOPED_TRACE(name);
-    const upd::Terrain t = upd::makeSceneTerrain(name);
+    const upd::sim::Terrain t = upd::sim::makeSceneTerrain(name);
     const Eigen::Vector2d size = t.maxXY() - t.minXY();
     EXPECT_GE(size.minCoeff(), 3.0);
     EXPECT_LE(size.maxCoeff(), 5.0);
@@ -106,7 +107,7 @@ TEST(Scenes, TerrainScenesAreAboutThreeMetresWide) {
 }
 
 TEST(StepScene, HeightsTruthAndRiser) {
-  const upd::Scene s = upd::makeScene("step", {});
+  const upd::sim::Scene s = upd::sim::makeScene("step", {});
   std::size_t riser = 0;
   for (std::size_t i = 0; i < s.cloud.size(); ++i) {
     const float x = s.cloud.x[i], z = s.cloud.z[i];
@@ -130,7 +131,7 @@ TEST(StepScene, HeightsTruthAndRiser) {
 }
 
 TEST(RampScene, BodyFootAndGroundAreTraversableSidesAreNot) {
-  const upd::Scene s = upd::makeScene("ramp", {});
+  const upd::sim::Scene s = upd::sim::makeScene("ramp", {});
   const double tan_slope = std::tan(sg::kRampSlope_rad);
   std::size_t body = 0, foot = 0, ground = 0, side = 0;
   for (std::size_t i = 0; i < s.cloud.size(); ++i) {
@@ -162,8 +163,8 @@ TEST(RampScene, BodyFootAndGroundAreTraversableSidesAreNot) {
 }
 
 TEST(StairsScene, TreadMiddlesTraversableRiserBandsNot) {
-  const upd::Scene s = upd::makeScene("stairs", {});
-  const upd::Terrain t = upd::makeSceneTerrain("stairs");
+  const upd::sim::Scene s = upd::sim::makeScene("stairs", {});
+  const upd::sim::Terrain t = upd::sim::makeSceneTerrain("stairs");
   std::size_t faces = 0, treads = 0;
   for (std::size_t i = 0; i < s.cloud.size(); ++i) {
     const double x = s.cloud.x[i], y = s.cloud.y[i], z = s.cloud.z[i];
@@ -192,7 +193,7 @@ TEST(StairsScene, TreadMiddlesTraversableRiserBandsNot) {
 }
 
 TEST(DitchScene, DitchAndRimsAreNonTraversable) {
-  const upd::Scene s = upd::makeScene("ditch", {});
+  const upd::sim::Scene s = upd::sim::makeScene("ditch", {});
   const double half = 0.5 * sg::kDitchWidth_m;
   std::size_t walls = 0;
   for (std::size_t i = 0; i < s.cloud.size(); ++i) {
@@ -216,10 +217,10 @@ TEST(DitchScene, DitchAndRimsAreNonTraversable) {
 }
 
 TEST(RocksScene, RocksAreNonTraversablePebblesAndGroundAreNot) {
-  const upd::Scene s = upd::makeScene("rocks", {});
-  const upd::Terrain t = upd::makeSceneTerrain("rocks");
+  const upd::sim::Scene s = upd::sim::makeScene("rocks", {});
+  const upd::sim::Terrain t = upd::sim::makeSceneTerrain("rocks");
   ASSERT_FALSE(t.rocks().empty());
-  for (const upd::Rock& r : t.rocks()) {
+  for (const upd::sim::Rock& r : t.rocks()) {
     const Label at_top = t.truthAt(r.center_xy.x(), r.center_xy.y());
     EXPECT_NEAR(t.heightAt(r.center_xy.x(), r.center_xy.y()), r.height_m, 0.03);
     EXPECT_EQ(at_top,
@@ -231,7 +232,7 @@ TEST(RocksScene, RocksAreNonTraversablePebblesAndGroundAreNot) {
   for (std::size_t i = 0; i < s.cloud.size(); ++i) {
     const Eigen::Vector2d p(s.cloud.x[i], s.cloud.y[i]);
     bool near_rock = false;
-    for (const upd::Rock& r : t.rocks()) {
+    for (const upd::sim::Rock& r : t.rocks()) {
       near_rock |= (p - r.center_xy).norm() < std::max(r.radius_x_m, r.radius_y_m) + 0.1;
     }
     if (near_rock) continue;
@@ -246,13 +247,13 @@ TEST(RocksScene, RocksAreNonTraversablePebblesAndGroundAreNot) {
 // ------------------------------------------------------------------------------ noise, params
 
 TEST(Scenes, NoiseHasTheRequestedSigmaAndIsReproducible) {
-  upd::SceneParams clean;
-  upd::SceneParams noisy;
+  upd::sim::SceneParams clean;
+  upd::sim::SceneParams noisy;
   noisy.noise_m = 0.01;
   noisy.seed = 5;
-  const upd::Scene a = upd::makeScene("corner", clean);
-  const upd::Scene b = upd::makeScene("corner", noisy);
-  const upd::Scene c = upd::makeScene("corner", noisy);
+  const upd::sim::Scene a = upd::sim::makeScene("corner", clean);
+  const upd::sim::Scene b = upd::sim::makeScene("corner", noisy);
+  const upd::sim::Scene c = upd::sim::makeScene("corner", noisy);
   ASSERT_EQ(a.cloud.size(), b.cloud.size());
   double sum = 0, sum2 = 0;
   std::size_t n = 0;
@@ -272,7 +273,7 @@ TEST(Scenes, NoiseHasTheRequestedSigmaAndIsReproducible) {
   EXPECT_EQ(a.truth, b.truth);  // noise leaves the truth alone
 
   noisy.seed = 6;
-  const upd::Scene other = upd::makeScene("corner", noisy);
+  const upd::sim::Scene other = upd::sim::makeScene("corner", noisy);
   std::size_t differ = 0;
   for (std::size_t i = 0; i < b.cloud.size(); ++i)
     differ += b.cloud.point(i) != other.cloud.point(i);
@@ -280,54 +281,54 @@ TEST(Scenes, NoiseHasTheRequestedSigmaAndIsReproducible) {
 }
 
 TEST(Scenes, UnknownNameThrowsListingValidNames) {
-  const std::string msg = thrownMessage([] { upd::makeScene("volcano", {}); });
-  for (const std::string& name : upd::sceneNames())
+  const std::string msg = thrownMessage([] { upd::sim::makeScene("volcano", {}); });
+  for (const std::string& name : upd::sim::sceneNames())
     EXPECT_NE(msg.find(name), std::string::npos) << msg;
   EXPECT_NE(msg.find("volcano"), std::string::npos);
-  EXPECT_THROW(upd::makeSceneTerrain("corner"), std::invalid_argument);
-  EXPECT_THROW(upd::makeSceneTerrain("volcano"), std::invalid_argument);
+  EXPECT_THROW(upd::sim::makeSceneTerrain("corner"), std::invalid_argument);
+  EXPECT_THROW(upd::sim::makeSceneTerrain("volcano"), std::invalid_argument);
 }
 
 TEST(Scenes, BadParamsThrowNamingTheField) {
-  upd::SceneParams p;
+  upd::sim::SceneParams p;
   p.spacing_m = 0.0;
-  EXPECT_NE(thrownMessage([&] { upd::makeScene("corner", p); }).find("SceneParams.spacing_m"),
+  EXPECT_NE(thrownMessage([&] { upd::sim::makeScene("corner", p); }).find("SceneParams.spacing_m"),
             std::string::npos);
   p.spacing_m = -0.01;
-  EXPECT_NE(thrownMessage([&] { upd::makeScene("ramp", p); }).find("SceneParams.spacing_m"),
+  EXPECT_NE(thrownMessage([&] { upd::sim::makeScene("ramp", p); }).find("SceneParams.spacing_m"),
             std::string::npos);
   p = {};
   p.noise_m = -0.001;
-  EXPECT_NE(thrownMessage([&] { upd::makeScene("corner", p); }).find("SceneParams.noise_m"),
+  EXPECT_NE(thrownMessage([&] { upd::sim::makeScene("corner", p); }).find("SceneParams.noise_m"),
             std::string::npos);
   p = {};
   p.seed = -1;
   EXPECT_NE(thrownMessage([&] { p.validate(); }).find("SceneParams.seed"), std::string::npos);
-  EXPECT_NO_THROW(upd::SceneParams{}.validate());
+  EXPECT_NO_THROW(upd::sim::SceneParams{}.validate());
 }
 
 // ------------------------------------------------------------------------------ terrain
 
 TEST(Terrain, PrimitivesHaveTheirHeights) {
-  upd::Terrain t({-5, -5}, {5, 5});
-  upd::Box box;
+  upd::sim::Terrain t({-5, -5}, {5, 5});
+  upd::sim::Box box;
   box.center_xy = {2.0, 2.0};
   box.length_m = 1.0;
   box.width_m = 0.4;
   box.height_m = 0.2;
   box.yaw_rad = 90.0 * upd::kDegToRad;  // long along y
-  upd::Stairs st;
+  upd::sim::Stairs st;
   st.start_xy = {-3.0, 0.0};
   st.steps = 2;
   st.rise_m = 0.1;
   st.run_m = 0.4;
   st.top_length_m = 0.5;
-  upd::Ditch d;
+  upd::sim::Ditch d;
   d.center_xy = {0.0, -3.0};
   d.length_m = 2.0;
   d.width_m = 0.5;
   d.depth_m = 0.25;
-  upd::Rock r;
+  upd::sim::Rock r;
   r.center_xy = {3.0, -2.0};
   r.radius_x_m = 0.4;
   r.radius_y_m = 0.2;
@@ -350,21 +351,21 @@ TEST(Terrain, PrimitivesHaveTheirHeights) {
 }
 
 TEST(Terrain, TruthRuleOnPrimitives) {
-  upd::Terrain t({-5, -5}, {5, 5});
-  upd::Box low;  // a 3 cm step: a wheel climbs it
+  upd::sim::Terrain t({-5, -5}, {5, 5});
+  upd::sim::Box low;  // a 3 cm step: a wheel climbs it
   low.center_xy = {-3.0, 3.0};
   low.height_m = 0.03;
-  upd::Box wall;
+  upd::sim::Box wall;
   wall.center_xy = {3.0, 3.0};
   wall.length_m = 2.0;
   wall.width_m = 0.3;
   wall.height_m = 1.0;
   wall.wall = true;
-  upd::Ramp ramp;  // 20 deg, rising along +x from x = -1
+  upd::sim::Ramp ramp;  // 20 deg, rising along +x from x = -1
   ramp.start_xy = {-1.0, -3.0};
   ramp.width_m = 1.0;
   ramp.height_m = 0.4;
-  upd::Ramp steep = ramp;
+  upd::sim::Ramp steep = ramp;
   steep.start_xy = {-1.0, 0.0};
   steep.slope_rad = 35.0 * upd::kDegToRad;
   t.add(low).add(wall).add(ramp).add(steep);
@@ -393,14 +394,14 @@ TEST(Terrain, TruthRuleOnPrimitives) {
 }
 
 TEST(Terrain, SampleSurfaceLabelsFacePointsNonTraversable) {
-  upd::Terrain t({-1, -1}, {1, 1});
-  upd::Box b;
+  upd::sim::Terrain t({-1, -1}, {1, 1});
+  upd::sim::Box b;
   b.center_xy = {0.0, 0.0};
   b.length_m = 1.0;
   b.width_m = 1.0;
   b.height_m = 0.2;
   t.add(b);
-  const upd::SurfaceSamples s = t.sampleSurface(0.02);
+  const upd::sim::SurfaceSamples s = t.sampleSurface(0.02);
   ASSERT_EQ(s.surface_points, 101u * 101u);
   ASSERT_EQ(s.truth.size(), s.cloud.size());
   // Four sides of 51 columns; the corner columns are sampled once: 4 * 50 columns of 9 points.
@@ -413,22 +414,22 @@ TEST(Terrain, SampleSurfaceLabelsFacePointsNonTraversable) {
 }
 
 TEST(Terrain, InvalidPrimitivesThrowNamingTheField) {
-  upd::Terrain t({0, 0}, {1, 1});
-  upd::Ramp r;
+  upd::sim::Terrain t({0, 0}, {1, 1});
+  upd::sim::Ramp r;
   r.slope_rad = 0.0;
   EXPECT_NE(thrownMessage([&] { t.add(r); }).find("Ramp.slope_rad"), std::string::npos);
-  upd::Box b;
+  upd::sim::Box b;
   b.width_m = -1;
   EXPECT_NE(thrownMessage([&] { t.add(b); }).find("Box.width_m"), std::string::npos);
-  upd::Stairs st;
+  upd::sim::Stairs st;
   st.steps = 0;
   EXPECT_NE(thrownMessage([&] { t.add(st); }).find("Stairs.steps"), std::string::npos);
-  upd::TruthParams tp;
+  upd::sim::TruthParams tp;
   tp.border_m = -0.1;
   EXPECT_NE(thrownMessage([&] { t.setTruthParams(tp); }).find("TruthParams.border_m"),
             std::string::npos);
   EXPECT_NE(thrownMessage([] {
-              upd::Terrain bad({0, 0}, {0, 1});
+              upd::sim::Terrain bad({0, 0}, {0, 1});
             }).find("Terrain.max_xy"),
             std::string::npos);
 }
@@ -439,7 +440,7 @@ TEST(Terrain, InvalidPrimitivesThrowNamingTheField) {
 // is Traversable (outside the extent counts as blocked), then 8-connected search.
 class Reach {
  public:
-  Reach(const upd::Terrain& t, double clearance_m, double cell_m = 0.05) : t_(t), cell_(cell_m) {
+  Reach(const upd::sim::Terrain& t, double clearance_m, double cell_m = 0.05) : t_(t), cell_(cell_m) {
     nx_ = static_cast<int>((t.maxXY().x() - t.minXY().x()) / cell_m) + 1;
     ny_ = static_cast<int>((t.maxXY().y() - t.minXY().y()) / cell_m) + 1;
     std::vector<char> ok(static_cast<std::size_t>(nx_) * ny_);
@@ -518,54 +519,55 @@ class Reach {
   int cellY(double y) const {
     return std::clamp(static_cast<int>(std::lround((y - t_.minXY().y()) / cell_)), 0, ny_ - 1);
   }
-  const upd::Terrain& t_;
+  const upd::sim::Terrain& t_;
   double cell_;
   int nx_ = 0, ny_ = 0;
   std::vector<char> free_;
 };
 
-// The Dune's circumscribed radius (0.7 x 0.45 m): a planner that inflates by it must still
-// find the way in every solvable world.
-constexpr double kRobotRadius_m = 0.42;
+// The Dune's circumscribed radius: a planner that inflates by it must still find the way in
+// every solvable world.
+const double kRobotRadius_m =
+    0.5 * std::hypot(upd::sim::RobotBodyParams{}.length_m, upd::sim::RobotBodyParams{}.width_m);
 
 TEST(Worlds, NamesStartsAndGoals) {
-  const std::vector<std::string> names = upd::worldNames();
+  const std::vector<std::string> names = upd::sim::worldNames();
   for (const char* n : {"mixed", "rocks", "ramp", "ditch", "corridor", "trapped"}) {
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
   }
   for (const std::string& name : names) {
     SCOPED_TRACE(name);
-    const upd::WorldSpec w = upd::makeWorld(name);
+    const upd::sim::WorldSpec w = upd::sim::makeWorld(name);
     EXPECT_FALSE(w.description.empty());
-    const upd::Terrain& t = w.terrain;
+    const upd::sim::Terrain& t = w.terrain;
     EXPECT_TRUE(t.contains(w.start_xy_yaw.x(), w.start_xy_yaw.y()));
     EXPECT_TRUE(t.contains(w.goal_xy.x(), w.goal_xy.y()));
     EXPECT_EQ(t.truthAt(w.start_xy_yaw.x(), w.start_xy_yaw.y()), Label::Traversable);
     EXPECT_EQ(t.truthAt(w.goal_xy.x(), w.goal_xy.y()), Label::Traversable);
   }
-  const std::string msg = thrownMessage([] { upd::makeWorld("moon"); });
+  const std::string msg = thrownMessage([] { upd::sim::makeWorld("moon"); });
   for (const std::string& name : names) EXPECT_NE(msg.find(name), std::string::npos) << msg;
 }
 
 TEST(Worlds, SolvableWorldsAreSolvableByTheRobot) {
   for (const char* name : {"mixed", "rocks", "ramp", "ditch", "corridor"}) {
     SCOPED_TRACE(name);
-    const upd::WorldSpec w = upd::makeWorld(name);
+    const upd::sim::WorldSpec w = upd::sim::makeWorld(name);
     const Reach reach(w.terrain, kRobotRadius_m);
     EXPECT_TRUE(reach.reachable(w.start_xy_yaw.head<2>(), w.goal_xy));
   }
 }
 
 TEST(Worlds, MixedWorldHasItsFeatures) {
-  const upd::WorldSpec w = upd::makeWorld("mixed");
-  const upd::Terrain& t = w.terrain;
+  const upd::sim::WorldSpec w = upd::sim::makeWorld("mixed");
+  const upd::sim::Terrain& t = w.terrain;
   EXPECT_NEAR((t.maxXY() - t.minXY()).x(), 12.0, 1e-9);
   EXPECT_NEAR((t.maxXY() - t.minXY()).y(), 8.0, 1e-9);
   ASSERT_EQ(t.ramps().size(), 1u);
   EXPECT_NEAR(t.ramps()[0].slope_rad, 20.0 * upd::kDegToRad, 1e-12);
   EXPECT_GE(t.rocks().size(), 3u);
   bool step = false, platform = false;
-  for (const upd::Box& b : t.boxes()) {
+  for (const upd::sim::Box& b : t.boxes()) {
     step |= std::abs(b.height_m - 0.15) < 1e-9;
     platform |= std::abs(b.height_m - 0.3) < 1e-9;
   }
@@ -573,11 +575,11 @@ TEST(Worlds, MixedWorldHasItsFeatures) {
   EXPECT_TRUE(platform);
   ASSERT_EQ(t.ditches().size(), 1u);
   EXPECT_NEAR(t.ditches()[0].width_m, 0.6, 1e-12);
-  const upd::Ditch& d = t.ditches()[0];
+  const upd::sim::Ditch& d = t.ditches()[0];
   EXPECT_EQ(t.truthAt(d.center_xy.x(), d.center_xy.y()), Label::NonTraversable);
   EXPECT_NEAR(t.heightAt(d.center_xy.x(), d.center_xy.y()), -d.depth_m, 1e-12);
   // Climbing the ramp reaches the platform top.
-  const upd::Ramp& r = t.ramps()[0];
+  const upd::sim::Ramp& r = t.ramps()[0];
   const Eigen::Vector2d dir(std::cos(r.yaw_rad), std::sin(r.yaw_rad));
   const Eigen::Vector2d mid = r.start_xy + 0.5 * r.slopeLength() * dir;
   const Eigen::Vector2d top = r.start_xy + (r.slopeLength() + 0.5) * dir;
@@ -585,18 +587,18 @@ TEST(Worlds, MixedWorldHasItsFeatures) {
   EXPECT_NEAR(t.heightAt(top.x(), top.y()), 0.3, 1e-9);
   EXPECT_EQ(t.truthAt(mid.x(), mid.y()), Label::Traversable);
   EXPECT_EQ(t.truthAt(top.x(), top.y()), Label::Traversable);
-  for (const upd::Rock& rock : t.rocks()) {
+  for (const upd::sim::Rock& rock : t.rocks()) {
     const Label l = t.truthAt(rock.center_xy.x(), rock.center_xy.y());
     EXPECT_EQ(l, rock.height_m > 0.05 ? Label::NonTraversable : Label::Traversable);
   }
 }
 
 TEST(Worlds, RampWorldPlatformIsReachedOnlyByTheRamp) {
-  const upd::WorldSpec w = upd::makeWorld("ramp");
-  const upd::Terrain& t = w.terrain;
+  const upd::sim::WorldSpec w = upd::sim::makeWorld("ramp");
+  const upd::sim::Terrain& t = w.terrain;
   EXPECT_NEAR(t.heightAt(w.goal_xy.x(), w.goal_xy.y()), 0.3, 1e-9);  // goal on the platform
   ASSERT_EQ(t.ramps().size(), 1u);
-  const upd::Ramp& r = t.ramps()[0];
+  const upd::sim::Ramp& r = t.ramps()[0];
   EXPECT_NEAR(r.slope_rad, 20.0 * upd::kDegToRad, 1e-12);
   ASSERT_NEAR(r.yaw_rad, 90.0 * upd::kDegToRad, 1e-12);  // climbs +y: the block below uses it
   Reach reach(t, kRobotRadius_m);
@@ -614,7 +616,7 @@ TEST(Worlds, RampWorldPlatformIsReachedOnlyByTheRamp) {
 TEST(Worlds, ObstacleWorldsBlockTheStraightLine) {
   for (const char* name : {"rocks", "ditch", "corridor", "trapped"}) {
     SCOPED_TRACE(name);
-    const upd::WorldSpec w = upd::makeWorld(name);
+    const upd::sim::WorldSpec w = upd::sim::makeWorld(name);
     const Reach reach(w.terrain, 0.0);
     if (std::string(name) == "corridor") {
       // The chicane: two steps each blocking half of the corridor.
@@ -628,14 +630,14 @@ TEST(Worlds, ObstacleWorldsBlockTheStraightLine) {
 
 TEST(Worlds, DitchAndCorridorHaveOneWayThrough) {
   {
-    const upd::WorldSpec w = upd::makeWorld("ditch");
+    const upd::sim::WorldSpec w = upd::sim::makeWorld("ditch");
     Reach reach(w.terrain, 0.0);
     ASSERT_TRUE(reach.reachable(w.start_xy_yaw.head<2>(), w.goal_xy));
     reach.block({4.0, 2.0}, {6.0, 4.0});  // the way round the ditch's end
     EXPECT_FALSE(reach.reachable(w.start_xy_yaw.head<2>(), w.goal_xy));
   }
   {
-    const upd::WorldSpec w = upd::makeWorld("corridor");
+    const upd::sim::WorldSpec w = upd::sim::makeWorld("corridor");
     Reach reach(w.terrain, 0.0);
     ASSERT_TRUE(reach.reachable(w.start_xy_yaw.head<2>(), w.goal_xy));
     reach.block({5.9, -1.6}, {6.1, 1.6});  // across the corridor
@@ -644,7 +646,7 @@ TEST(Worlds, DitchAndCorridorHaveOneWayThrough) {
 }
 
 TEST(Worlds, TrappedGoalIsUnreachable) {
-  const upd::WorldSpec w = upd::makeWorld("trapped");
+  const upd::sim::WorldSpec w = upd::sim::makeWorld("trapped");
   const Reach reach(w.terrain, 0.0);
   EXPECT_FALSE(reach.reachable(w.start_xy_yaw.head<2>(), w.goal_xy));
   EXPECT_GT(w.terrain.heightAt(w.goal_xy.x() + 1.125, w.goal_xy.y()), 0.5);  // a wall

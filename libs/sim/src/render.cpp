@@ -1,10 +1,10 @@
-#include "upd/core/render.h"
+#include "upd/sim/render.h"
 
 #include <cmath>
 #include <random>
 #include <stdexcept>
 
-namespace upd {
+namespace upd::sim {
 
 void DepthNoise::validate() const {
   requireParam(std::isfinite(sigma_coeff_per_m) && sigma_coeff_per_m >= 0, "DepthNoise",
@@ -106,4 +106,4 @@ RenderedScene renderScene(const Terrain& terrain, const Eigen::Isometry3d& pose_
   return out;
 }
 
-}  // namespace upd
+}  // namespace upd::sim

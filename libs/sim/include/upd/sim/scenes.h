@@ -36,13 +36,13 @@
 
 #include "upd/core/params.h"
 #include "upd/core/point_cloud.h"
-#include "upd/core/terrain.h"
+#include "upd/sim/terrain.h"
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-namespace upd {
+namespace upd::sim {
 
 /// Geometry constants of the scenes, as documented above.
 namespace scene_geometry {
@@ -93,4 +93,4 @@ Terrain makeSceneTerrain(const std::string& name);
 /// Throws std::invalid_argument listing the valid names, or naming the bad parameter.
 Scene makeScene(const std::string& name, const SceneParams& params = SceneParams{});
 
-}  // namespace upd
+}  // namespace upd::sim

@@ -12,15 +12,15 @@
 
 #include "upd/core/camera.h"
 #include "upd/core/params.h"
-#include "upd/core/scenes.h"
-#include "upd/core/terrain.h"
+#include "upd/sim/scenes.h"
+#include "upd/sim/terrain.h"
 
 #include <Eigen/Geometry>
 
 #include <cstdint>
 #include <string>
 
-namespace upd {
+namespace upd::sim {
 
 struct DepthNoise {
   double sigma_coeff_per_m = 1.2e-3;  ///< axial sigma = coeff * z^2 [1/m]; 0 = noise-free
@@ -62,4 +62,4 @@ RenderedScene renderScene(const Terrain& terrain, const Eigen::Isometry3d& pose_
                           const CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed,
                           const std::string& name = "rendered");
 
-}  // namespace upd
+}  // namespace upd::sim
