@@ -603,7 +603,7 @@ json peerCase(const std::string& name, const std::string& source, const PointClo
             {"fast_exact_band", params.upd.fast_exact_band}};
   omp_set_num_threads(1);
   PipelineParams fast = params;
-  fast.upd.method = static_cast<int>(UpdMethod::Fast);
+  fast.upd.method = UpdMethod::Fast;
   PipelineResult fr;
   const double ours = timeMedian([&] { fr = runPipeline(cloud, fast); }, repeats);
   c["points_scored"] = fr.cloud.size();
@@ -614,7 +614,7 @@ json peerCase(const std::string& name, const std::string& source, const PointClo
                            {"classify_ms", fr.timings.classify_ms}};
   // Our exact path, once, single core like the peer.
   PipelineParams exact = params;
-  exact.upd.method = static_cast<int>(UpdMethod::Exact);
+  exact.upd.method = UpdMethod::Exact;
   double ours_exact = kNaN;
   const double exact_cost = peerCostEstimate(cloud, params);
   const bool run_exact_full = exact_cost < (o.quick ? 3e8 : 3e9);

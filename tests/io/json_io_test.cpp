@@ -116,6 +116,10 @@ struct FieldCounter {
     ++n;
   }
   void angleDeg(const char*, double&, const char*) { ++n; }
+  template <class E, std::size_t N>
+  void choice(const char*, E&, const upd::EnumName<E> (&)[N], const char*) {
+    ++n;
+  }
 };
 
 TEST(JsonIo, ParamsUseIniKeysAndDegrees) {
@@ -233,7 +237,7 @@ TEST(JsonIo, SummaryOfARealPipelineRun) {
   EXPECT_GT(near, 0u);
   EXPECT_EQ(jb["exact_band"]["points"], near);
   EXPECT_EQ(jb["exact_band"]["band"], 0.05);
-  p.upd.method = static_cast<int>(upd::UpdMethod::Exact);
+  p.upd.method = upd::UpdMethod::Exact;
   const json exact = upd::io::summaryJson(upd::runPipeline(cloud, p), p, cloud.size());
   EXPECT_EQ(exact["method"], "exact");
   EXPECT_EQ(exact["normals_method"], "exact (k-d tree)");
