@@ -51,7 +51,8 @@ struct NormalParams {
     v("radius_m", radius_m, "PCA neighbourhood radius [m] (used when knn = 0)");
     v("knn", knn, "if > 0, use the k nearest points instead of the radius");
     v.choice("weighting", weighting, kNormalWeightingNames,
-             "covariance weights xi (eq. 4): uniform or gaussian (or 0, 1)");
+             "covariance weights xi (eq. 4): uniform or gaussian; the numbers 0, 1 are also "
+             "accepted");
     v.angleDeg("vertical_band_deg", vertical_band_rad,
                "normals this close to horizontal are oriented towards the sensor [deg]");
     v("fast_block_px", fast_block_px,
