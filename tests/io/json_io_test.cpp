@@ -136,6 +136,9 @@ TEST(JsonIo, ParamsUseIniKeysAndDegrees) {
   EXPECT_DOUBLE_EQ(j["preprocess"]["voxel_m"].get<double>(), 0.05);
   EXPECT_EQ(j["preprocess"]["voxel_enabled"], true);
   EXPECT_EQ(j["upd"]["min_neighbors"], p.upd.min_neighbors);
+  // Enums by their ini name, so the params can be written back into an ini file.
+  EXPECT_EQ(j["upd"]["method"], "auto");
+  EXPECT_EQ(j["normals"]["weighting"], "uniform");
   // Vector fields print as their float value, not its double expansion.
   EXPECT_EQ(j["preprocess"]["box_min_m"], json::array({-10.0, -10.0, -10.0}));
   // Every field of every struct is there: count them against the structs' own visit().
