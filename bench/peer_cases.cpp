@@ -23,7 +23,7 @@ double timeOursExact(const PointCloud& cloud, const PipelineParams& params, doub
                      const Options& o) {
   if (exact_cost >= (o.quick ? 3e8 : 3e9)) return kNaN;
   PipelineParams exact = params;
-  exact.upd.method = static_cast<int>(UpdMethod::Exact);
+  exact.upd.method = UpdMethod::Exact;
   const Stopwatch watch;
   const PipelineResult er = runPipeline(cloud, exact);
   return watch.elapsedMs();
@@ -62,7 +62,7 @@ json peerCase(const std::string& name, const std::string& source, const PointClo
             {"fast_exact_band", params.upd.fast_exact_band}};
   omp_set_num_threads(1);
   PipelineParams fast = params;
-  fast.upd.method = static_cast<int>(UpdMethod::Fast);
+  fast.upd.method = UpdMethod::Fast;
   PipelineResult fr;
   const double ours = timeMedian([&] { fr = runPipeline(cloud, fast); }, repeats);
   c["points_scored"] = fr.cloud.size();

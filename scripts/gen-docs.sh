@@ -15,8 +15,9 @@ same as an ini file to start a config from.
 Units are in the key names (`_m` metres, `_deg` degrees, `_s` seconds); SI units and radians
 are used inside the library. In an ini file, a key that is absent keeps its default; an unknown
 section or key, or a value that does not parse or breaks its rule, stops the program with a
-message naming the file, section, key and value. The robot configs in `config/` set only what
-differs from these defaults.
+message naming the file, section, key and value. A key with a fixed set of values (`method`,
+`weighting`) takes their names; the numbers older configs hold still load. The robot configs in
+`config/` set only what differs from these defaults.
 HEAD
   "$UPD" params --markdown
 } > "$ROOT/docs/PARAMETERS.md.tmp"

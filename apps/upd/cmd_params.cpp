@@ -45,6 +45,11 @@ struct Printer {
   void angleDeg(const char* key, const double& radians, const char* doc) {
     (*this)(key, radians * kRadToDeg, doc);
   }
+  template <class E, std::size_t N>
+  void choice(const char* key, const E& value, const EnumName<E> (&names)[N], const char* doc) {
+    const char* name = enumName(names, value);
+    (*this)(key, std::string(name != nullptr ? name : "?"), doc);
+  }
 };
 
 }  // namespace

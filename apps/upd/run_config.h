@@ -2,12 +2,8 @@
 // strictly (an unknown section or key is an error) and listed by `upd params`.
 #pragma once
 
-#include "upd/core/baselines.h"
-#include "upd/maps/fusion.h"
-#include "upd/maps/traversability_grid.h"
-#include "upd/maps/traversability_octree.h"
-#include "upd/mrpt/pose_source.h"
-#include "upd/mrpt/simulated_run.h"
+#include "upd/core/params.h"
+#include "upd/mrpt/robot_config.h"
 #include "upd/mrpt/upd_observer.h"
 
 #include <string>
@@ -41,45 +37,27 @@ struct RunConfig {
   mrptbridge::SimulationParams simulation;
   EvaluationParams evaluation;
   BaselineParams baseline;
-};
 
-/// The `up` key of [PipelineParams] as a visitable section.
-struct UpSection {
-  Eigen::Vector3f& up;
-  void validate() const {}
-  template <class V>
-  void visit(V& v) {
-    v("up", up, "gravity-up direction x,y,z in the cloud frame (any length)");
+  /// Every part of the robot config (mrptbridge::forEachRobotSection's list).
+  mrptbridge::RobotConfigParts parts() {
+    mrptbridge::RobotConfigParts p;
+    p.pipeline = &observer.pipeline;
+    p.baseline = &baseline;
+    p.source = &observer.source;
+    p.grid = &grid;
+    p.fusion = &fusion;
+    p.octree = &octree;
+    p.ground_truth = &ground_truth;
+    p.simulation = &simulation;
+    return p;
   }
 };
 
-/// Calls f(section_name, description, params) for every section, in documentation order.
+/// Calls f(section_name, description, params) for every section, in documentation order: the
+/// robot config's list, then the app's own [EvaluationParams].
 template <class F>
 void forEachSection(RunConfig& c, F&& f) {
-  UpSection up{c.observer.pipeline.up};
-  f("PipelineParams", "Frames of the UPD pipeline.", up);
-  f("PreprocessParams",
-    "Pre-processing (paper section 3): range cut-off, voxel down-sampling, outlier removal.",
-    c.observer.pipeline.preprocess);
-  f("NormalParams", "PCA normals (paper eqs. 4-5).", c.observer.pipeline.normals);
-  f("UpdParams", "The Unevenness Point Descriptor (paper eqs. 6-8).", c.observer.pipeline.upd);
-  f("ClassifyParams", "Traversability labels and cost from the UPD.",
-    c.observer.pipeline.classify);
-  f("BaselineParams", "The paper's baselines (roughness and inclination index).", c.baseline);
-  f("SourceParams", "How MRPT observations become clouds (LiDAR ranges, stereo calibration).",
-    c.observer.source);
-  f("StereoMatchParams", "OpenCV StereoSGBM disparity for CObservationStereoImages.",
-    c.observer.source.stereo);
-  f("GridParams", "The 2.5D traversability grid (a window that follows the robot).", c.grid);
-  f("FusionParams", "Log-odds fusion of per-point evidence into cells and voxels.", c.fusion);
-  f("OctreeParams", "The OctoMap traversability tree.", c.octree);
-  f("GroundTruthParams", "Ground-truth pose files (TUM) given to `upd playback --poses`.",
-    c.ground_truth);
-  f("SimulationParams", "The simulated Dune of `upd simulate`.", c.simulation);
-  f("RobotBodyParams", "The simulated robot's body (`upd simulate`; `upd navigate` reads it "
-    "from the navigation config).", c.simulation.body);
-  f("CameraMountParams", "The simulated robot's depth camera (`upd simulate`; `upd navigate` "
-    "reads it from the navigation config).", c.simulation.camera);
+  mrptbridge::forEachRobotSection(c.parts(), f);
   f("EvaluationParams", "Scoring a map against a ground-truth grid.", c.evaluation);
 }
 

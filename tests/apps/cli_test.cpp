@@ -4,6 +4,7 @@
 #include "run_upd.h"
 #include "test_data.h"
 #include "upd/io/cloud_io.h"
+#include "upd/mrpt/robot_config.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,7 @@
 #include <fstream>
 #include <memory>
 #include <sys/wait.h>
+#include <utility>
 
 namespace upd {
 namespace {
@@ -213,6 +215,33 @@ TEST_F(Cli, ParamsIniIsAValidRobotConfig) {
   EXPECT_NE(nav.output.find("[NavigatorParams]"), std::string::npos);
   EXPECT_NE(nav.output.find("[LoopParams]"), std::string::npos);
   EXPECT_NE(runUpd("params --ini --nav-ini").exit_code, 0);
+}
+
+// `upd params --ini` writes enum keys by name, and a name written back loads as its value.
+TEST_F(Cli, ParamsIniEnumNamesRoundTrip) {
+  const CmdResult ini = runUpd("params --ini");
+  ASSERT_EQ(ini.exit_code, 0) << ini.output;
+  std::string text = ini.output;
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"\nmethod = auto\n",
+                                                                      "\nmethod = exact\n"},
+                                 {"\nweighting = uniform\n", "\nweighting = gaussian\n"}}) {
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from << " not in:\n" << text;
+    text.replace(at, from.size(), to);
+  }
+  std::ofstream(path("names.ini")) << text;
+  mrptbridge::IniReader reader(path("names.ini"));
+  PipelineParams p;
+  mrptbridge::RobotConfigParts parts;
+  parts.pipeline = &p;
+  mrptbridge::readRobotConfig(reader, parts);
+  EXPECT_EQ(p.upd.method, UpdMethod::Exact);
+  EXPECT_EQ(p.normals.weighting, NormalWeighting::Gaussian);
+  EXPECT_DOUBLE_EQ(p.upd.radius_m, UpdParams{}.radius_m);
+  // The docs table shows the names too.
+  const CmdResult r = runUpd("params --markdown");
+  EXPECT_NE(r.output.find("| `method` | `auto` |"), std::string::npos);
+  EXPECT_NE(r.output.find("| `weighting` | `uniform` |"), std::string::npos);
 }
 
 }  // namespace

@@ -46,7 +46,7 @@ RenderedScene kinectFrame() {
 }
 
 TEST(FastNormals, GridEqualsTheExactPath) {
-  for (const int weighting : {0, 1}) {
+  for (const NormalWeighting weighting : {NormalWeighting::Uniform, NormalWeighting::Gaussian}) {
     PointCloud c = test::makeRandomCloud(3000, 5, 1.f);
     c.sensor_origin = Eigen::Vector3f(0, 0, 3);
     NormalParams p;
@@ -208,7 +208,7 @@ TEST(FastPipeline, ExactBandFollowsTheClassifierThreshold) {
   PipelineParams p;
   p.up = s.up;
   p.preprocess.disableAll();
-  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  p.upd.method = UpdMethod::Fast;
   p.upd.fast_exact_band = 0.02;
   for (const double zeta_min : {0.9, 0.95}) {
     p.classify.zeta_min = zeta_min;
@@ -235,7 +235,7 @@ TEST(FastPipeline, KinectFrameAgreesWithTheExactPath) {
   p.preprocess.disableAll();  // keep the image: every pixel is scored
   p.normals.radius_m = 0.05;
   p.upd.radius_m = 0.5;
-  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  p.upd.method = UpdMethod::Fast;
   const PipelineResult fast = runPipeline(rs.scene.cloud, p);
   ASSERT_EQ(fast.method, UpdMethod::Fast);
   ASSERT_TRUE(fast.organized_normals);
@@ -256,7 +256,7 @@ TEST(FastUpd, PlaneOfAnyTiltHasZetaOneAndTheTiltAsSlope) {
                         .toRotationMatrix();
     PipelineParams p;
     p.preprocess.disableAll();
-    p.upd.method = static_cast<int>(UpdMethod::Fast);
+    p.upd.method = UpdMethod::Fast;
     const PipelineResult r = runPipeline(test::makePlane(1.6, 0.02, pose), p);
     for (std::size_t i = 0; i < r.cloud.size(); ++i) {
       ASSERT_TRUE(r.upd.isValid(i));
@@ -279,7 +279,7 @@ TEST(FastUpd, TranslationFarFromOriginChangesNothing) {
   PipelineParams p;
   p.preprocess.disableAll();
   p.upd.radius_m = 0.4;
-  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  p.upd.method = UpdMethod::Fast;
   const PipelineResult a = runPipeline(c, p);
   const PipelineResult b = runPipeline(test::transformed(c, T), p);
   ASSERT_EQ(a.upd.size(), b.upd.size());
@@ -391,15 +391,15 @@ TEST(FastPipeline, MethodRuleIsExplicit) {
   EXPECT_EQ(resolveMethod(p), UpdMethod::Fast);  // auto, radius neighbourhoods
   p.upd.knn = 16;
   EXPECT_EQ(resolveMethod(p), UpdMethod::Exact);  // auto falls back for knn
-  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  p.upd.method = UpdMethod::Fast;
   EXPECT_THROW(p.validate(), std::invalid_argument);
   p = PipelineParams{};
   p.normals.knn = 16;
-  p.upd.method = static_cast<int>(UpdMethod::Fast);
+  p.upd.method = UpdMethod::Fast;
   EXPECT_THROW(p.validate(), std::invalid_argument);
-  p.upd.method = static_cast<int>(UpdMethod::Exact);
+  p.upd.method = UpdMethod::Exact;
   EXPECT_EQ(resolveMethod(p), UpdMethod::Exact);
-  p.upd.method = 3;
+  p.upd.method = static_cast<UpdMethod>(3);
   EXPECT_THROW(p.validate(), std::invalid_argument);
 }
 

@@ -105,7 +105,7 @@ TEST(Normals, GaussianWeightsKeepPlanesExact) {
   const PointCloud c = test::makePlane(0.6, 0.02);
   const KdTree tree(c);
   NormalParams p;
-  p.weighting = static_cast<int>(NormalWeighting::Gaussian);
+  p.weighting = NormalWeighting::Gaussian;
   const Normals n = computeNormals(c, tree, p, kUp);
   EXPECT_EQ(n.invalid, 0u);
   for (std::size_t i = 0; i < c.size(); ++i) EXPECT_NEAR(n.nz[i], 1.f, 1e-5f);
@@ -203,7 +203,7 @@ PipelineParams noPreprocess(double radius_m) {
   PipelineParams p;
   p.preprocess.disableAll();
   p.upd.radius_m = radius_m;
-  p.upd.method = static_cast<int>(UpdMethod::Exact);  // the exact path's invariances
+  p.upd.method = UpdMethod::Exact;  // the exact path's invariances
   return p;
 }
 

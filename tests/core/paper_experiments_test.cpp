@@ -24,7 +24,7 @@ PipelineResult scoreScene(const Scene& s, double d_m, double normal_radius_m) {
   p.up = s.up;
   p.upd.radius_m = d_m;
   p.normals.radius_m = normal_radius_m;
-  p.upd.method = static_cast<int>(UpdMethod::Exact);  // the paper's experiments: exact sums
+  p.upd.method = UpdMethod::Exact;  // the paper's experiments: exact sums
   return runPipeline(s.cloud, p);
 }
 

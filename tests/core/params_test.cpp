@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iterator>
 
 namespace upd {
 namespace {
@@ -54,6 +55,37 @@ TEST(Params, OtherRulesNameTheirField) {
   p = {};
   p.upd.knn = 2;
   EXPECT_NE(errorOf(p).find("UpdParams.knn = 2"), std::string::npos);
+}
+
+// Enum fields hold the enum; each has one table of ini names, one name per value.
+TEST(Params, EnumNameTablesCoverEveryValueOnce) {
+  EXPECT_STREQ(enumName(kUpdMethodNames, UpdMethod::Auto), "auto");
+  EXPECT_STREQ(enumName(kUpdMethodNames, UpdMethod::Exact), "exact");
+  EXPECT_STREQ(enumName(kUpdMethodNames, UpdMethod::Fast), "fast");
+  EXPECT_EQ(enumName(kUpdMethodNames, static_cast<UpdMethod>(3)), nullptr);
+  EXPECT_EQ(enumNameList(kUpdMethodNames), "auto|exact|fast");
+  EXPECT_STREQ(enumName(kNormalWeightingNames, NormalWeighting::Uniform), "uniform");
+  EXPECT_STREQ(enumName(kNormalWeightingNames, NormalWeighting::Gaussian), "gaussian");
+  EXPECT_EQ(enumNameList(kNormalWeightingNames), "uniform|gaussian");
+  // The old numbers of user configs are the enums' values.
+  for (std::size_t i = 0; i < std::size(kUpdMethodNames); ++i) {
+    EXPECT_EQ(static_cast<std::size_t>(kUpdMethodNames[i].value), i);
+  }
+  EXPECT_EQ(UpdParams{}.method, UpdMethod::Auto);
+  EXPECT_EQ(NormalParams{}.weighting, NormalWeighting::Uniform);
+}
+
+TEST(Params, EnumOutOfRangeNamesFieldAndValue) {
+  PipelineParams p;
+  p.upd.method = static_cast<UpdMethod>(7);
+  EXPECT_EQ(errorOf(p), "UpdParams.method = 7: must be auto, exact or fast");
+  p = {};
+  p.normals.weighting = static_cast<NormalWeighting>(-1);
+  EXPECT_EQ(errorOf(p), "NormalParams.weighting = -1: must be uniform or gaussian");
+  p = {};
+  p.upd.method = UpdMethod::Fast;
+  p.normals.knn = 16;
+  EXPECT_NE(errorOf(p).find("UpdParams.method = fast"), std::string::npos) << errorOf(p);
 }
 
 TEST(Params, RunPipelineRejectsBadParameters) {

@@ -116,6 +116,10 @@ struct FieldCounter {
     ++n;
   }
   void angleDeg(const char*, double&, const char*) { ++n; }
+  template <class E, std::size_t N>
+  void choice(const char*, E&, const upd::EnumName<E> (&)[N], const char*) {
+    ++n;
+  }
 };
 
 TEST(JsonIo, ParamsUseIniKeysAndDegrees) {
@@ -132,6 +136,9 @@ TEST(JsonIo, ParamsUseIniKeysAndDegrees) {
   EXPECT_DOUBLE_EQ(j["preprocess"]["voxel_m"].get<double>(), 0.05);
   EXPECT_EQ(j["preprocess"]["voxel_enabled"], true);
   EXPECT_EQ(j["upd"]["min_neighbors"], p.upd.min_neighbors);
+  // Enums by their ini name, so the params can be written back into an ini file.
+  EXPECT_EQ(j["upd"]["method"], "auto");
+  EXPECT_EQ(j["normals"]["weighting"], "uniform");
   // Vector fields print as their float value, not its double expansion.
   EXPECT_EQ(j["preprocess"]["box_min_m"], json::array({-10.0, -10.0, -10.0}));
   // Every field of every struct is there: count them against the structs' own visit().
@@ -233,7 +240,7 @@ TEST(JsonIo, SummaryOfARealPipelineRun) {
   EXPECT_GT(near, 0u);
   EXPECT_EQ(jb["exact_band"]["points"], near);
   EXPECT_EQ(jb["exact_band"]["band"], 0.05);
-  p.upd.method = static_cast<int>(upd::UpdMethod::Exact);
+  p.upd.method = upd::UpdMethod::Exact;
   const json exact = upd::io::summaryJson(upd::runPipeline(cloud, p), p, cloud.size());
   EXPECT_EQ(exact["method"], "exact");
   EXPECT_EQ(exact["normals_method"], "exact (k-d tree)");

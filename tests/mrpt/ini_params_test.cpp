@@ -94,6 +94,43 @@ TEST_F(IniFile, OutOfRangeValueNamesFileSectionFieldAndValue) {
             std::string::npos);
 }
 
+// Enum keys take their names (any case) and, so that configs written before the names still
+// load, the old numbers.
+TEST_F(IniFile, EnumsLoadByNameOrOldNumber) {
+  PipelineParams params;
+  loadPipelineParams(write("[UpdParams]\nmethod = exact\n[NormalParams]\nweighting = gaussian\n"),
+                     params);
+  EXPECT_EQ(params.upd.method, UpdMethod::Exact);
+  EXPECT_EQ(params.normals.weighting, NormalWeighting::Gaussian);
+  params = {};
+  loadPipelineParams(write("[UpdParams]\nmethod = 2\n[NormalParams]\nweighting = 1\n"), params);
+  EXPECT_EQ(params.upd.method, UpdMethod::Fast);
+  EXPECT_EQ(params.normals.weighting, NormalWeighting::Gaussian);
+  params = {};
+  loadPipelineParams(write("[UpdParams]\nmethod = Auto   ; the default\n"), params);
+  EXPECT_EQ(params.upd.method, UpdMethod::Auto);
+  params = {};
+  loadPipelineParams(write("[UpdParams]\nmethod = 1\n[NormalParams]\nweighting = 0\n"), params);
+  EXPECT_EQ(params.upd.method, UpdMethod::Exact);
+  EXPECT_EQ(params.normals.weighting, NormalWeighting::Uniform);
+}
+
+TEST_F(IniFile, UnknownEnumNameNamesFileKeyValueAndTheValidNames) {
+  const std::string p = write("[UpdParams]\nmethod = fastest\n");
+  PipelineParams params;
+  EXPECT_THROW(loadPipelineParams(p, params), std::invalid_argument);
+  const std::string e = errorOf("[UpdParams]\nmethod = fastest\n");
+  EXPECT_EQ(e, "config file " + path_ +
+                   ": [UpdParams] method = 'fastest': not one of auto, exact, fast (or their old "
+                   "numbers 0, 1, 2)");
+  // A number that names no value is no better than an unknown name.
+  EXPECT_NE(errorOf("[UpdParams]\nmethod = 3\n").find("method = '3': not one of auto, exact, fast"),
+            std::string::npos);
+  EXPECT_NE(errorOf("[NormalParams]\nweighting = 1.0\n")
+                .find("[NormalParams] weighting = '1.0': not one of uniform, gaussian"),
+            std::string::npos);
+}
+
 TEST_F(IniFile, TheFileIsNeverRewritten) {
   const std::string text = "[UpdParams]\nradius_m = 0.7\n";
   const std::string p = write(text);

@@ -377,7 +377,7 @@ void shareBlockNormals(const float* __restrict range, const float* __restrict x,
 
 bool organizedNormalsApply(const PointCloud& cloud, const NormalParams& params) {
   return cloud.isOrganized() && params.knn == 0 &&
-         params.weighting == static_cast<int>(NormalWeighting::Uniform);
+         params.weighting == NormalWeighting::Uniform;
 }
 
 Normals computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params,
@@ -393,7 +393,7 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   if (!organizedNormalsApply(cloud, params)) {
     throw std::invalid_argument(
         "computeNormalsOrganized: needs an organized cloud (height > 1), NormalParams.knn = 0 "
-        "and NormalParams.weighting = 0 (uniform)");
+        "and NormalParams.weighting = uniform");
   }
   const std::size_t W = cloud.width, H = cloud.height, N = cloud.size();
   // Every pixel's normal is written below (a normal or NaN): no fill, and the caller's
@@ -696,7 +696,7 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
   }
 
   const float radius2 = static_cast<float>(params.radius_m * params.radius_m);
-  const bool gaussian = params.weighting == static_cast<int>(NormalWeighting::Gaussian);
+  const bool gaussian = params.weighting == NormalWeighting::Gaussian;
   const float sigma = 0.5f * static_cast<float>(params.radius_m);
   const float inv_2s2 = 1.f / (2.f * sigma * sigma);
   std::size_t invalid = N - start.back();

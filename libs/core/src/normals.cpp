@@ -11,8 +11,8 @@ void NormalParams::validate() const {
   requireParam(std::isfinite(radius_m) && radius_m > 0, "NormalParams", "radius_m", radius_m,
                "must be > 0");
   requireParam(knn == 0 || knn >= 3, "NormalParams", "knn", knn, "must be 0 (radius) or >= 3");
-  requireParam(weighting == 0 || weighting == 1, "NormalParams", "weighting", weighting,
-               "must be 0 (uniform) or 1 (gaussian)");
+  requireParam(enumName(kNormalWeightingNames, weighting) != nullptr, "NormalParams", "weighting",
+               static_cast<int>(weighting), "must be uniform or gaussian");
   requireParam(vertical_band_rad >= 0 && vertical_band_rad < 0.5 * M_PI, "NormalParams",
                "vertical_band_deg", vertical_band_rad * kRadToDeg, "must be in [0, 90)");
   requireParam(fast_block_px >= 1 && fast_block_px <= 16, "NormalParams", "fast_block_px",
@@ -69,7 +69,7 @@ Normals computeNormals(const PointCloud& cloud, const KdTree& tree, const Normal
   const std::size_t n_pts = cloud.size();
   Normals out = Normals::unset(n_pts);
   const float radius = static_cast<float>(params.radius_m);
-  const bool gaussian = params.weighting == static_cast<int>(NormalWeighting::Gaussian);
+  const bool gaussian = params.weighting == NormalWeighting::Gaussian;
   const float sigma = params.knn > 0 ? 0.f : 0.5f * radius;
   std::size_t invalid = 0;
 

@@ -3,8 +3,8 @@
 #include "upd/core/fast_normals.h"
 #include "upd/core/fast_upd.h"
 #include "upd/core/kdtree.h"
+#include "upd/core/stopwatch.h"
 
-#include <chrono>
 #include <cmath>
 
 namespace upd {
@@ -16,13 +16,12 @@ void PipelineParams::validate() const {
   normals.validate();
   upd.validate();
   classify.validate();
-  requireParam(upd.method != static_cast<int>(UpdMethod::Fast) || normals.knn == 0, "UpdParams",
-               "method", upd.method,
-               "the fast path (2) needs radius neighbourhoods: NormalParams.knn must be 0");
+  requireParam(upd.method != UpdMethod::Fast || normals.knn == 0, "UpdParams", "method", "fast",
+               "the fast path needs radius neighbourhoods: NormalParams.knn must be 0");
 }
 
 UpdMethod resolveMethod(const PipelineParams& params) {
-  switch (static_cast<UpdMethod>(params.upd.method)) {
+  switch (params.upd.method) {
     case UpdMethod::Exact: return UpdMethod::Exact;
     case UpdMethod::Fast: return UpdMethod::Fast;
     case UpdMethod::Auto: break;
@@ -31,18 +30,12 @@ UpdMethod resolveMethod(const PipelineParams& params) {
 }
 
 namespace {
-class Stopwatch {
- public:
-  double lapMs() {
-    const auto now = std::chrono::steady_clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-    return ms;
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
+/// The time since the last lap (or the start) [ms]; the next lap starts now.
+double lapMs(Stopwatch& lap) {
+  const double ms = lap.elapsedMs();
+  lap.restart();
+  return ms;
+}
 }  // namespace
 
 PipelineResult runPipeline(const PointCloud& input, const PipelineParams& params) {
@@ -57,7 +50,7 @@ void runPipeline(const PointCloud& input, const PipelineParams& params, Pipeline
   res.timings = StageTimings{};
   Stopwatch total, lap;
   preprocess(input, params.preprocess, res.cloud, &res.preprocess_stats);
-  res.timings.preprocess_ms = lap.lapMs();
+  res.timings.preprocess_ms = lapMs(lap);
   res.method = resolveMethod(params);
   if (res.method == UpdMethod::Fast) {
     // No index to build: the normals and the UPD bin the points themselves.
@@ -67,26 +60,26 @@ void runPipeline(const PointCloud& input, const PipelineParams& params, Pipeline
     } else {
       res.normals = computeNormalsGrid(res.cloud, params.normals, up);
     }
-    res.timings.normals_ms = lap.lapMs();
+    res.timings.normals_ms = lapMs(lap);
     FastUpdStats stats;
     computeUpdFast(res.cloud, res.normals, params.upd, res.upd, &stats, params.classify.zeta_min);
     res.exact_band_points = stats.exact_points;
     res.fast_cells_per_radius = stats.cells_per_radius;
-    res.timings.upd_ms = lap.lapMs();
+    res.timings.upd_ms = lapMs(lap);
   } else {
     res.organized_normals = false;
     res.exact_band_points = 0;
     res.fast_cells_per_radius = 0;
     const KdTree tree(res.cloud);
-    res.timings.index_ms = lap.lapMs();
+    res.timings.index_ms = lapMs(lap);
     res.normals = computeNormals(res.cloud, tree, params.normals, up);
-    res.timings.normals_ms = lap.lapMs();
+    res.timings.normals_ms = lapMs(lap);
     res.upd = computeUpd(res.cloud, tree, res.normals, params.upd);
-    res.timings.upd_ms = lap.lapMs();
+    res.timings.upd_ms = lapMs(lap);
   }
   classify(res.upd, up, params.classify, res.classes);
-  res.timings.classify_ms = lap.lapMs();
-  res.timings.total_ms = total.lapMs();
+  res.timings.classify_ms = lapMs(lap);
+  res.timings.total_ms = total.elapsedMs();
 }
 
 }  // namespace upd

@@ -11,10 +11,10 @@ void UpdParams::validate() const {
                "must be > 0");
   requireParam(knn == 0 || knn >= 3, "UpdParams", "knn", knn, "must be 0 (radius) or >= 3");
   requireParam(min_neighbors >= 1, "UpdParams", "min_neighbors", min_neighbors, "must be >= 1");
-  requireParam(method >= 0 && method <= 2, "UpdParams", "method", method,
-               "must be 0 (auto), 1 (exact) or 2 (fast)");
-  requireParam(method != static_cast<int>(UpdMethod::Fast) || knn == 0, "UpdParams", "method",
-               method, "the fast path (2) sums over the radius d_m: it needs knn = 0");
+  requireParam(enumName(kUpdMethodNames, method) != nullptr, "UpdParams", "method",
+               static_cast<int>(method), "must be auto, exact or fast");
+  requireParam(method != UpdMethod::Fast || knn == 0, "UpdParams", "method", "fast",
+               "the fast path sums over the radius d_m: it needs knn = 0");
   requireParam(fast_cells_per_radius >= 2 && fast_cells_per_radius <= 16, "UpdParams",
                "fast_cells_per_radius", fast_cells_per_radius, "must be in [2, 16]");
   requireParam(std::isfinite(fast_cells_per_point) && fast_cells_per_point >= 0, "UpdParams",

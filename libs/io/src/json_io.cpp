@@ -9,6 +9,7 @@
 #include <limits>
 #include <ostream>
 #include <stdexcept>
+#include <utility>
 
 namespace upd::io {
 
@@ -49,6 +50,12 @@ struct JsonParamVisitor {
   }
   void angleDeg(const char* key, double& radians, const char* /*doc*/) {
     out[key] = doubleValue(radians * kRadToDeg);
+  }
+  /// Enums by their ini name, so the params can be copied back into an ini file.
+  template <class E, std::size_t N>
+  void choice(const char* key, E& value, const EnumName<E> (&names)[N], const char* /*doc*/) {
+    const char* name = enumName(names, value);
+    out[key] = name != nullptr ? json(name) : json(static_cast<int>(value));
   }
 };
 
@@ -92,10 +99,12 @@ json paramsJson(const PipelineParams& params) {
   return j;
 }
 
-json summaryJson(const PipelineResult& result, const PipelineParams& params,
-                 std::size_t points_in) {
-  const std::vector<float>& zeta = result.upd.zeta;
-  std::size_t scored = 0;
+namespace {
+
+/// {min, mean, max, histogram} of the finite zeta values (null statistics when there are none);
+/// scored receives their number.
+json zetaJson(const std::vector<float>& zeta, std::size_t& scored) {
+  scored = 0;
   double sum = 0.0;
   float zmin = std::numeric_limits<float>::infinity();
   float zmax = -std::numeric_limits<float>::infinity();
@@ -106,43 +115,42 @@ json summaryJson(const PipelineResult& result, const PipelineParams& params,
     zmin = std::min(zmin, z);
     zmax = std::max(zmax, z);
   }
-  // Scored-cloud points without a zeta, including points scored while non-finite (when
-  // pre-processing kept them). zeta may be shorter than the cloud if a stage did not run.
-  const std::size_t cloud_n = result.cloud.size();
-  const std::size_t unscored = cloud_n > scored ? cloud_n - scored : 0;
-  // PreprocessStats.non_finite counts the non-finite input points; those still in the scored
-  // cloud are already among the unscored ones, only the dropped ones are added.
-  std::size_t kept_non_finite = 0;
-  for (std::size_t i = 0; i < cloud_n; ++i) kept_non_finite += result.cloud.isFinite(i) ? 0 : 1;
-  const std::size_t non_finite = result.preprocess_stats.non_finite;
-  const std::size_t dropped_non_finite =
-      non_finite > kept_non_finite ? non_finite - kept_non_finite : 0;
-
-  std::size_t traversable = 0, non_traversable = 0, unknown = 0;
-  for (Label l : result.classes.label) {
-    switch (l) {
-      case Label::Traversable: ++traversable; break;
-      case Label::NonTraversable: ++non_traversable; break;
-      case Label::Unknown: ++unknown; break;
-    }
-  }
-
   json z = json::object();
   z["min"] = scored ? floatValue(zmin) : json(nullptr);
   z["mean"] = scored ? doubleValue(sum / static_cast<double>(scored)) : json(nullptr);
   z["max"] = scored ? floatValue(zmax) : json(nullptr);
   z["histogram"] =
       histogramJson(zeta, kZetaHistogramMin, kZetaHistogramMax, kZetaHistogramBins);
+  return z;
+}
 
-  const StageTimings& t = result.timings;
-  const PreprocessStats& s = result.preprocess_stats;
-  json j = json::object();
-  j["points_in"] = points_in;
-  j["points_scored"] = scored;
-  j["points_invalid"] = unscored + dropped_non_finite;
-  j["points_after_preprocess"] = cloud_n;
-  j["radius_m"] = doubleValue(params.upd.radius_m);
-  // Which path scored the cloud (params.upd.method 0 lets the pipeline choose).
+/// Non-finite input points that pre-processing dropped. PreprocessStats.non_finite counts the
+/// non-finite input points; those still in the scored cloud are already among the unscored.
+std::size_t droppedNonFinite(const PipelineResult& result) {
+  std::size_t kept_non_finite = 0;
+  for (std::size_t i = 0; i < result.cloud.size(); ++i) {
+    kept_non_finite += result.cloud.isFinite(i) ? 0 : 1;
+  }
+  const std::size_t non_finite = result.preprocess_stats.non_finite;
+  return non_finite > kept_non_finite ? non_finite - kept_non_finite : 0;
+}
+
+json labelsJson(const std::vector<Label>& labels) {
+  std::size_t traversable = 0, non_traversable = 0, unknown = 0;
+  for (Label l : labels) {
+    switch (l) {
+      case Label::Traversable: ++traversable; break;
+      case Label::NonTraversable: ++non_traversable; break;
+      case Label::Unknown: ++unknown; break;
+    }
+  }
+  return {{"traversable", traversable},
+          {"non_traversable", non_traversable},
+          {"unknown", unknown}};
+}
+
+/// Which path scored the cloud (UpdParams::method auto lets the pipeline choose), into j.
+void addMethod(json& j, const PipelineResult& result, const PipelineParams& params) {
   j["method"] = result.method == UpdMethod::Fast ? "fast" : "exact";
   j["normals_method"] = result.method == UpdMethod::Exact ? "exact (k-d tree)"
                         : result.organized_normals        ? "organized window scans"
@@ -155,22 +163,45 @@ json summaryJson(const PipelineResult& result, const PipelineParams& params,
     // The lattice used: fast_cells_per_radius, or finer on a dense cloud (fast_cells_per_point).
     j["lattice_cells_per_radius"] = result.fast_cells_per_radius;
   }
-  j["zeta"] = z;
-  j["labels"] = {{"traversable", traversable},
-                 {"non_traversable", non_traversable},
-                 {"unknown", unknown}};
-  j["timing_ms"] = {{"preprocess", doubleValue(t.preprocess_ms)},
-                    {"index", doubleValue(t.index_ms)},
-                    {"normals", doubleValue(t.normals_ms)},
-                    {"upd", doubleValue(t.upd_ms)},
-                    {"classify", doubleValue(t.classify_ms)},
-                    {"total", doubleValue(t.total_ms)}};
-  j["preprocess"] = {{"points_in", s.points_in},
-                     {"non_finite", s.non_finite},
-                     {"range_removed", s.range_removed},
-                     {"after_voxel", s.after_voxel},
-                     {"outliers_removed", s.outliers_removed},
-                     {"points_out", s.points_out}};
+}
+
+json timingJson(const StageTimings& t) {
+  return {{"preprocess", doubleValue(t.preprocess_ms)}, {"index", doubleValue(t.index_ms)},
+          {"normals", doubleValue(t.normals_ms)},       {"upd", doubleValue(t.upd_ms)},
+          {"classify", doubleValue(t.classify_ms)},     {"total", doubleValue(t.total_ms)}};
+}
+
+json preprocessJson(const PreprocessStats& s) {
+  return {{"points_in", s.points_in},
+          {"non_finite", s.non_finite},
+          {"range_removed", s.range_removed},
+          {"after_voxel", s.after_voxel},
+          {"outliers_removed", s.outliers_removed},
+          {"points_out", s.points_out}};
+}
+
+}  // namespace
+
+json summaryJson(const PipelineResult& result, const PipelineParams& params,
+                 std::size_t points_in) {
+  std::size_t scored = 0;
+  json z = zetaJson(result.upd.zeta, scored);
+  // Scored-cloud points without a zeta, including points scored while non-finite (when
+  // pre-processing kept them). zeta may be shorter than the cloud if a stage did not run.
+  const std::size_t cloud_n = result.cloud.size();
+  const std::size_t unscored = cloud_n > scored ? cloud_n - scored : 0;
+
+  json j = json::object();
+  j["points_in"] = points_in;
+  j["points_scored"] = scored;
+  j["points_invalid"] = unscored + droppedNonFinite(result);
+  j["points_after_preprocess"] = cloud_n;
+  j["radius_m"] = doubleValue(params.upd.radius_m);
+  addMethod(j, result, params);
+  j["zeta"] = std::move(z);
+  j["labels"] = labelsJson(result.classes.label);
+  j["timing_ms"] = timingJson(result.timings);
+  j["preprocess"] = preprocessJson(result.preprocess_stats);
   j["normals_invalid"] = result.normals.invalid;
   j["params"] = paramsJson(params);
   return j;

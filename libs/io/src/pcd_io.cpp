@@ -163,19 +163,15 @@ void requireValidAsciiBody(const std::string& path, const pcl::PCLPointCloud2& h
   }
 }
 
-}  // namespace
-
-PointCloud readPcd(const std::string& path) {
-  detail::requireReadableFile(path);
-  const QuietPclConsole quiet;
-  pcl::PCDReader reader;
+// Reads and checks the header, and checks the body against it before PCL parses the body (PCL
+// itself reads past a truncated one). Throws naming path.
+void checkPcdFile(const std::string& path, pcl::PCDReader& reader) {
   pcl::PCLPointCloud2 blob;
   Eigen::Vector4f origin = Eigen::Vector4f::Zero();
   Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
   int version = 0;
   int data_type = 0;
   unsigned int data_idx = 0;
-
   int rc = -1;
   try {
     rc = reader.readHeader(path, blob, origin, orientation, version, data_type, data_idx);
@@ -199,22 +195,16 @@ PointCloud readPcd(const std::string& path) {
   }
   requireCompleteBody(path, blob, data_type, data_idx);
   if (data_type == 0) requireValidAsciiBody(path, blob, data_idx);
+}
 
-  try {
-    rc = reader.read(path, blob, origin, orientation, version);
-  } catch (const std::exception& e) {
-    throw fileError(path, std::string("corrupt PCD data: ") + e.what());
-  }
+// The cloud of a read blob: x, y, z (any numeric type) and the packed colour when there is one.
+PointCloud cloudFromBlob(const std::string& path, const pcl::PCLPointCloud2& blob) {
   const std::size_t n = std::size_t{blob.width} * blob.height;
-  if (rc < 0 || blob.data.size() < n * blob.point_step) {
-    throw fileError(path, "corrupt or truncated PCD data (" + std::to_string(n) +
-                              " points declared)");
-  }
   // The body may carry different field offsets than the header said (PCL re-derives them);
   // look them up again.
-  fx = findField(blob, "x");
-  fy = findField(blob, "y");
-  fz = findField(blob, "z");
+  const pcl::PCLPointField* fx = findField(blob, "x");
+  const pcl::PCLPointField* fy = findField(blob, "y");
+  const pcl::PCLPointField* fz = findField(blob, "z");
   if (!fx || !fy || !fz) throw fileError(path, "has no x/y/z fields after reading");
 
   // rgb is a float whose bits are the packed colour, rgba a uint32: either way the 4 bytes are
@@ -254,6 +244,33 @@ PointCloud readPcd(const std::string& path) {
     cloud.width = n;
     cloud.height = 1;
   }
+  return cloud;
+}
+
+}  // namespace
+
+PointCloud readPcd(const std::string& path) {
+  detail::requireReadableFile(path);
+  const QuietPclConsole quiet;
+  pcl::PCDReader reader;
+  checkPcdFile(path, reader);
+
+  pcl::PCLPointCloud2 blob;
+  Eigen::Vector4f origin = Eigen::Vector4f::Zero();
+  Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
+  int version = 0;
+  int rc = -1;
+  try {
+    rc = reader.read(path, blob, origin, orientation, version);
+  } catch (const std::exception& e) {
+    throw fileError(path, std::string("corrupt PCD data: ") + e.what());
+  }
+  const std::size_t n = std::size_t{blob.width} * blob.height;
+  if (rc < 0 || blob.data.size() < n * blob.point_step) {
+    throw fileError(path, "corrupt or truncated PCD data (" + std::to_string(n) +
+                              " points declared)");
+  }
+  PointCloud cloud = cloudFromBlob(path, blob);
   cloud.sensor_origin = origin.head<3>();
   return cloud;
 }

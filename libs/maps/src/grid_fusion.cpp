@@ -205,24 +205,17 @@ void addChunkRuns(const std::size_t* run_begin, std::size_t count, std::size_t c
   }
 }
 
-}  // namespace
+// The buffers integrateScan shares among its team: the calling thread's, kept for its next
+// frame (taken before the parallel region).
+struct ScanBuffers {
+  std::uint32_t* cell_of;       // per point: its cell code
+  std::size_t* run_begin;       // per point slot: where the runs of each thread's chunk start
+  std::size_t* run_count;       // per thread: the runs of its chunk
+  std::uint32_t* runs_per_row;  // per thread, per grid row: the runs in that row
+  RunInputs in;                 // what step 2 reads (cell_of among them) and fills
+};
 
-GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& points,
-                              const Eigen::Vector2d& robot_xy, double time_s,
-                              const FusionParams& params) {
-  params.validate();
-  points.validate();
-  requireParam(std::isfinite(time_s), "integrateScan", "time_s", time_s, "must be finite");
-  GridFusionStats stats;
-  stats.window_moved = grid.moveTo(robot_xy);
-
-  // Aggregate first: one log-odds update per cell per frame, whatever its point count.
-  const int size_x = grid.sizeX(), size_y = grid.sizeY();
-  const GridCellIndexer ix = grid.indexer();
-  const Window window{ix.inv_cell, ix.i0, ix.i0 + ix.size_x, ix.j0, ix.j0 + ix.size_y,
-                      static_cast<std::uint32_t>(size_x)};
-  const int max_team = openmp::maxThreads();
-  // Buffers shared by the team: the calling thread's, taken before the parallel region.
+ScanBuffers takeScanBuffers(const PointsWorld& points, int size_x, int size_y, int max_team) {
   static thread_local std::vector<std::uint32_t> point_cell, slot_of_cell, row_span_of;
   static thread_local std::vector<std::size_t> run_begin_of, run_count_of;
   static thread_local std::vector<std::uint32_t> runs_per_row_of;  // per thread, per grid row
@@ -239,59 +232,155 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
   if (!(points.zeta && points.slope_rad && points.cost) && no_values.size() < points.size) {
     no_values.assign(points.size, std::numeric_limits<float>::quiet_NaN());
   }
-  std::uint32_t* const cell_of = point_cell.data();
-  std::size_t* const run_begin = run_begin_of.data();
-  std::size_t* const run_count = run_count_of.data();
-  std::uint32_t* const runs_per_row = runs_per_row_of.data();
-  std::uint32_t* const slots = slot_of_cell.data();
-  std::uint32_t* const row_span = row_span_of.data();
-  const RunInputs run_inputs{cell_of,
-                             {points.z, points.zeta ? points.zeta : no_values.data(),
-                              points.slope_rad ? points.slope_rad : no_values.data(),
-                              points.cost ? points.cost : no_values.data()},
-                             points.label,
-                             1.0 / size_x,
-                             window.size_x,
-                             slots,
-                             row_span};
+  const RunInputs in{point_cell.data(),
+                     {points.z, points.zeta ? points.zeta : no_values.data(),
+                      points.slope_rad ? points.slope_rad : no_values.data(),
+                      points.cost ? points.cost : no_values.data()},
+                     points.label,
+                     1.0 / size_x,
+                     static_cast<std::uint32_t>(size_x),
+                     slot_of_cell.data(),
+                     row_span_of.data()};
+  return ScanBuffers{point_cell.data(), run_begin_of.data(), run_count_of.data(),
+                     runs_per_row_of.data(), in};
+}
+
+// Step 1 for the chunk [chunk_begin, chunk_end): the cell of every point (or why it has none),
+// where the runs of points sharing a cell start (into my_runs; returns their number), and the
+// runs per grid row (into my_rows, size_y entries). Adds the invalid and unknown points.
+std::size_t findChunkRuns(const PointsWorld& points, const Window& window, double inv_size_x,
+                          std::size_t chunk_begin, std::size_t chunk_end, std::uint32_t* cell_of,
+                          std::size_t* my_runs, std::uint32_t* my_rows, int size_y,
+                          std::size_t& invalid, std::size_t& unknown) {
+  std::size_t n_runs = 0;
+  std::fill(my_rows, my_rows + size_y, 0u);
+  std::uint8_t starts[kBlock];
+  for (std::size_t block = chunk_begin; block < chunk_end; block += kBlock) {
+    const std::size_t block_end = std::min(chunk_end, block + kBlock);
+    std::uint32_t block_invalid, block_unknown;
+    cellCodes(points.x, points.y, points.z, points.label, window, block, block_end, cell_of,
+              block_invalid, block_unknown);
+    invalid += block_invalid;
+    unknown += block_unknown;
+    // The chunk's first points have fewer than three points before them in the chunk.
+    std::size_t i = block;
+    for (std::uint32_t last = kInvalid; i < std::min(block_end, chunk_begin + 3); ++i) {
+      starts[i - block] = (cell_of[i] < kOutside) & (cell_of[i] != last);
+      last = cell_of[i] < kOutside ? cell_of[i] : last;
+    }
+    runStarts(cell_of, i, block_end, starts + (i - block));
+    const std::size_t block_runs = n_runs;
+    for (i = block; i < block_end; ++i) {
+      my_runs[n_runs] = i;  // kept only where a run starts: no branch
+      n_runs += starts[i - block];
+    }
+    for (std::size_t r = block_runs; r < n_runs; ++r) {
+      ++my_rows[static_cast<std::uint32_t>((cell_of[my_runs[r]] + 0.5) * inv_size_x)];
+    }
+  }
+  return n_runs;
+}
+
+// The first grid row with at least `share` runs (of all team chunks) in the rows before it.
+std::uint32_t rowAfter(std::size_t share, const std::uint32_t* runs_per_row, int team,
+                       int size_y) {
+  std::size_t before = 0;
+  for (int row = 0; row < size_y; ++row) {
+    if (before >= share) return static_cast<std::uint32_t>(row);
+    for (int c = 0; c < team; ++c) {
+      before += runs_per_row[static_cast<std::size_t>(c) * size_y + row];
+    }
+  }
+  return static_cast<std::uint32_t>(size_y);
+}
+
+// Points and cells counted by step 3 (one thread's share, summed by the reduction).
+struct CellCounts {
+  std::size_t used = 0, updated = 0, hit = 0, sparse = 0;
+};
+
+// One frame's log-odds update and running means of one cell from its FrameCell.
+inline void updateCell(GridCell& c, const FrameCell& f, double update, double time_s,
+                       const FusionParams& params) {
+  const std::uint32_t n = f.count[kZ];
+  c.logodds_nontrav = fuseLogOdds(c.logodds_nontrav, update, params);
+  c.elevation_m = mergeMean(c.elevation_m, c.hits, f.sum[kZ], n);
+  c.elevation_max_m = std::fmax(c.elevation_max_m, -f.least[kZ]);
+  if (f.count[kZeta] > 0) c.zeta_min = std::fmin(c.zeta_min, f.least[kZeta]);
+  c.zeta_mean = mergeMean(c.zeta_mean, c.zeta_count, f.sum[kZeta], f.count[kZeta]);
+  c.slope_rad = mergeMean(c.slope_rad, c.slope_count, f.sum[kSlope], f.count[kSlope]);
+  c.cost_mean = mergeMean(c.cost_mean, c.cost_count, f.sum[kCost], f.count[kCost]);
+  c.hits = addSaturating(c.hits, n);
+  c.zeta_count = addSaturating(c.zeta_count, f.count[kZeta]);
+  c.slope_count = addSaturating(c.slope_count, f.count[kSlope]);
+  c.cost_count = addSaturating(c.cost_count, f.count[kCost]);
+  c.last_seen_s = time_s;
+}
+
+// Step 3 for the rows [row_lo, row_hi): one update per touched cell, in grid order (the grid is
+// larger than the caches, and sequential access lets the hardware prefetch); resets the slot
+// table and row spans it reads.
+void updateRows(TraversabilityGrid& grid, const std::vector<FrameCell>& frame,
+                const RunInputs& in, std::uint32_t row_lo, std::uint32_t row_hi, double time_s,
+                const FusionParams& params, CellCounts& counts) {
+  const std::size_t size_x = in.size_x;
+  for (int cy = static_cast<int>(row_lo); cy < static_cast<int>(row_hi); ++cy) {
+    std::uint32_t* const row_slots = in.slots + static_cast<std::size_t>(cy) * size_x;
+    std::uint32_t* const span = in.row_span + 2 * cy;
+    const int first = static_cast<int>(span[0]), last = static_cast<int>(span[1]);
+    span[0] = span[1] = 0;
+    for (int cx = first; cx < last; ++cx) {
+      // FrameCells are in first-touch order, and step 2 has streamed the points through the
+      // caches since: fetch them a few cells ahead.
+      const std::uint32_t ahead = cx + 8 < last ? row_slots[cx + 8] : kNoSlot;
+      if (ahead != kNoSlot) __builtin_prefetch(frame.data() + ahead);
+      if (row_slots[cx] == kNoSlot) continue;
+      const FrameCell& f = frame[row_slots[cx]];
+      row_slots[cx] = kNoSlot;
+      const std::uint32_t n = f.count[kZ];
+      counts.used += n;
+      const double update = frameLogOddsUpdate(f.n_nontrav, n - f.n_nontrav, params);
+      if (update == 0.0) {
+        ++counts.sparse;
+        continue;
+      }
+      updateCell(grid.at(cx, cy), f, update, time_s, params);
+      ++counts.updated;
+      if (update > 0) ++counts.hit;
+    }
+  }
+}
+
+}  // namespace
+
+GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& points,
+                              const Eigen::Vector2d& robot_xy, double time_s,
+                              const FusionParams& params) {
+  params.validate();
+  points.validate();
+  requireParam(std::isfinite(time_s), "integrateScan", "time_s", time_s, "must be finite");
+  GridFusionStats stats;
+  stats.window_moved = grid.moveTo(robot_xy);
+
+  // Aggregate first: one log-odds update per cell per frame, whatever its point count.
+  const int size_x = grid.sizeX(), size_y = grid.sizeY();
+  const GridCellIndexer ix = grid.indexer();
+  const Window window{ix.inv_cell, ix.i0, ix.i0 + ix.size_x, ix.j0, ix.j0 + ix.size_y,
+                      static_cast<std::uint32_t>(size_x)};
+  const ScanBuffers buf = takeScanBuffers(points, size_x, size_y, openmp::maxThreads());
+  const RunInputs& run_inputs = buf.in;
 
   std::size_t invalid = 0, unknown = 0, used = 0, updated = 0, hit = 0, sparse = 0;
 #pragma omp parallel reduction(+ : invalid, unknown, used, updated, hit, sparse)
   {
     const int team = openmp::teamSize(), me = openmp::threadIndex();
-    // 1. Each thread takes a chunk of the points: the cell of every point (or why it has none),
-    // and where the runs of points sharing a cell start.
+    // 1. Each thread takes a chunk of the points: their cells and where their runs start.
     const std::size_t chunk_begin = points.size * me / team,
                       chunk_end = points.size * (me + 1) / team;
-    std::size_t* const my_runs = run_begin + chunk_begin;
-    std::size_t n_runs = 0;
-    std::uint32_t* const my_rows = runs_per_row + static_cast<std::size_t>(me) * size_y;
-    std::fill(my_rows, my_rows + size_y, 0u);
-    std::uint8_t starts[kBlock];
-    for (std::size_t block = chunk_begin; block < chunk_end; block += kBlock) {
-      const std::size_t block_end = std::min(chunk_end, block + kBlock);
-      std::uint32_t block_invalid, block_unknown;
-      cellCodes(points.x, points.y, points.z, points.label, window, block, block_end, cell_of,
-                block_invalid, block_unknown);
-      invalid += block_invalid;
-      unknown += block_unknown;
-      // The chunk's first points have fewer than three points before them in the chunk.
-      std::size_t i = block;
-      for (std::uint32_t last = kInvalid; i < std::min(block_end, chunk_begin + 3); ++i) {
-        starts[i - block] = (cell_of[i] < kOutside) & (cell_of[i] != last);
-        last = cell_of[i] < kOutside ? cell_of[i] : last;
-      }
-      runStarts(cell_of, i, block_end, starts + (i - block));
-      const std::size_t block_runs = n_runs;
-      for (i = block; i < block_end; ++i) {
-        my_runs[n_runs] = i;  // kept only where a run starts: no branch
-        n_runs += starts[i - block];
-      }
-      for (std::size_t r = block_runs; r < n_runs; ++r) {
-        ++my_rows[static_cast<std::uint32_t>((cell_of[my_runs[r]] + 0.5) * run_inputs.inv_size_x)];
-      }
-    }
-    run_count[me] = n_runs;
+    buf.run_count[me] = findChunkRuns(points, window, run_inputs.inv_size_x, chunk_begin,
+                                      chunk_end, buf.cell_of, buf.run_begin + chunk_begin,
+                                      buf.runs_per_row + static_cast<std::size_t>(me) * size_y,
+                                      size_y, invalid, unknown);
 #pragma omp barrier
 
     // 2. Per-frame sums per touched cell. Each thread takes a range of the grid's rows holding
@@ -300,68 +389,26 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
     // dense slot table over the grid (shared: each cell belongs to one thread; reset after
     // use) points each touched cell to its FrameCell; per row, the span of touched columns.
     std::size_t total_runs = 0;
-    for (int c = 0; c < team; ++c) total_runs += run_count[c];
-    // The first row with at least `share` runs in the rows before it.
-    const auto rowAfter = [&](std::size_t share) {
-      std::size_t before = 0;
-      for (int row = 0; row < size_y; ++row) {
-        if (before >= share) return static_cast<std::uint32_t>(row);
-        for (int c = 0; c < team; ++c) {
-          before += runs_per_row[static_cast<std::size_t>(c) * size_y + row];
-        }
-      }
-      return static_cast<std::uint32_t>(size_y);
-    };
-    const std::uint32_t row_lo = me == 0 ? 0 : rowAfter(total_runs * me / team);
-    const std::uint32_t row_hi = me == team - 1 ? static_cast<std::uint32_t>(size_y)
-                                                : rowAfter(total_runs * (me + 1) / team);
+    for (int c = 0; c < team; ++c) total_runs += buf.run_count[c];
+    const std::uint32_t row_lo =
+        me == 0 ? 0 : rowAfter(total_runs * me / team, buf.runs_per_row, team, size_y);
+    const std::uint32_t row_hi =
+        me == team - 1 ? static_cast<std::uint32_t>(size_y)
+                       : rowAfter(total_runs * (me + 1) / team, buf.runs_per_row, team, size_y);
     static thread_local std::vector<FrameCell> frame;  // this thread's own
     frame.clear();
     for (int c = 0; c < team; ++c) {
-      addChunkRuns(run_begin + points.size * c / team, run_count[c], points.size * (c + 1) / team,
-                   run_inputs, row_lo, row_hi, frame);
+      addChunkRuns(buf.run_begin + points.size * c / team, buf.run_count[c],
+                   points.size * (c + 1) / team, run_inputs, row_lo, row_hi, frame);
     }
 
-    // 3. One update per touched cell, in grid order: the grid is larger than the caches, and
-    // sequential access lets the hardware prefetch.
-    for (int cy = static_cast<int>(row_lo); cy < static_cast<int>(row_hi); ++cy) {
-      std::uint32_t* const row_slots = slots + static_cast<std::size_t>(cy) * size_x;
-      std::uint32_t* const span = row_span + 2 * cy;
-      const int first = static_cast<int>(span[0]), last = static_cast<int>(span[1]);
-      span[0] = span[1] = 0;
-      for (int cx = first; cx < last; ++cx) {
-        // FrameCells are in first-touch order, and step 2 has streamed the points through the
-        // caches since: fetch them a few cells ahead.
-        const std::uint32_t ahead = cx + 8 < last ? row_slots[cx + 8] : kNoSlot;
-        if (ahead != kNoSlot) __builtin_prefetch(frame.data() + ahead);
-        if (row_slots[cx] == kNoSlot) continue;
-        const FrameCell& f = frame[row_slots[cx]];
-        row_slots[cx] = kNoSlot;
-        const std::uint32_t n = f.count[kZ];
-        used += n;
-        const double update = frameLogOddsUpdate(f.n_nontrav, n - f.n_nontrav, params);
-        if (update == 0.0) {
-          ++sparse;
-          continue;
-        }
-        GridCell& c = grid.at(cx, cy);
-        c.logodds_nontrav = fuseLogOdds(c.logodds_nontrav, update, params);
-        ++updated;
-        if (update > 0) ++hit;
-
-        c.elevation_m = mergeMean(c.elevation_m, c.hits, f.sum[kZ], n);
-        c.elevation_max_m = std::fmax(c.elevation_max_m, -f.least[kZ]);
-        if (f.count[kZeta] > 0) c.zeta_min = std::fmin(c.zeta_min, f.least[kZeta]);
-        c.zeta_mean = mergeMean(c.zeta_mean, c.zeta_count, f.sum[kZeta], f.count[kZeta]);
-        c.slope_rad = mergeMean(c.slope_rad, c.slope_count, f.sum[kSlope], f.count[kSlope]);
-        c.cost_mean = mergeMean(c.cost_mean, c.cost_count, f.sum[kCost], f.count[kCost]);
-        c.hits = addSaturating(c.hits, n);
-        c.zeta_count = addSaturating(c.zeta_count, f.count[kZeta]);
-        c.slope_count = addSaturating(c.slope_count, f.count[kSlope]);
-        c.cost_count = addSaturating(c.cost_count, f.count[kCost]);
-        c.last_seen_s = time_s;
-      }
-    }
+    // 3. One update per touched cell.
+    CellCounts counts;
+    updateRows(grid, frame, run_inputs, row_lo, row_hi, time_s, params, counts);
+    used += counts.used;
+    updated += counts.updated;
+    hit += counts.hit;
+    sparse += counts.sparse;
   }
   stats.points_invalid = invalid;
   stats.points_unknown = unknown;

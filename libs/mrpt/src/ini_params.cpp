@@ -1,11 +1,13 @@
 #include "upd/mrpt/ini_params.h"
 
 #include "upd/core/pipeline.h"
+#include "upd/mrpt/robot_config.h"
 
 #include <mrpt/config/CConfigFile.h>
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -128,6 +130,29 @@ Eigen::Vector3f parseVector3(const IniReader& r, const std::string& s, const std
   return out;
 }
 
+std::size_t parseChoice(const IniReader& r, const std::string& s, const std::string& k,
+                        const std::string& v, const std::vector<std::string>& names,
+                        const std::vector<int>& numbers) {
+  std::string l = v;
+  std::transform(l.begin(), l.end(), l.begin(), [](unsigned char c) { return std::tolower(c); });
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (l == names[i]) return i;
+  }
+  int number = 0;
+  const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), number);
+  if (ec == std::errc() && end == v.data() + v.size()) {
+    for (std::size_t i = 0; i < numbers.size(); ++i) {
+      if (number == numbers[i]) return i;
+    }
+  }
+  std::string valid, old;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    valid += (i ? ", " : "") + names[i];
+    old += (i ? ", " : "") + std::to_string(numbers[i]);
+  }
+  r.fail(s, k, v, "not one of " + valid + " (or their old numbers " + old + ")");
+}
+
 void rethrowWithFile(const IniReader& r, const std::string& section) {
   try {
     throw;
@@ -138,25 +163,11 @@ void rethrowWithFile(const IniReader& r, const std::string& section) {
 
 }  // namespace detail
 
-namespace {
-struct UpOnly {
-  Eigen::Vector3f& up;
-  void validate() const {}
-  template <class V>
-  void visit(V& v) {
-    v("up", up, "gravity-up direction x,y,z in the cloud frame");
-  }
-};
-}  // namespace
-
 void loadPipelineParams(const std::string& ini_path, PipelineParams& params) {
   IniReader ini(ini_path);
-  UpOnly up{params.up};
-  ini.read("PipelineParams", up);
-  ini.read("PreprocessParams", params.preprocess);
-  ini.read("NormalParams", params.normals);
-  ini.read("UpdParams", params.upd);
-  ini.read("ClassifyParams", params.classify);
+  RobotConfigParts parts;
+  parts.pipeline = &params;
+  readRobotConfig(ini, parts);
   ini.checkAllKeysKnown();
   try {
     params.validate();

@@ -4,6 +4,7 @@
 #include "upd/core/stopwatch.h"
 #include "upd/mrpt/ini_params.h"
 #include "upd/mrpt/pose_source.h"
+#include "upd/mrpt/robot_config.h"
 
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/poses/CPose3D.h>
@@ -22,27 +23,11 @@ void ObserverParams::validate() const {
   source.validate();
 }
 
-namespace {
-// [PipelineParams] holds only `up` (the other parts have their own sections).
-struct UpKey {
-  Eigen::Vector3f& up;
-  void validate() const {}
-  template <class V>
-  void visit(V& v) {
-    v("up", up, "gravity-up direction x,y,z in the scored frame (robot frame: 0,0,1)");
-  }
-};
-}  // namespace
-
 void loadObserverParams(IniReader& ini, ObserverParams& params) {
-  UpKey up{params.pipeline.up};
-  ini.read("PipelineParams", up);
-  ini.read("PreprocessParams", params.pipeline.preprocess);
-  ini.read("NormalParams", params.pipeline.normals);
-  ini.read("UpdParams", params.pipeline.upd);
-  ini.read("ClassifyParams", params.pipeline.classify);
-  ini.read("SourceParams", params.source);
-  ini.read("StereoMatchParams", params.source.stereo);
+  RobotConfigParts parts;
+  parts.pipeline = &params.pipeline;
+  parts.source = &params.source;
+  readRobotConfig(ini, parts);
   try {
     params.validate();
   } catch (const std::invalid_argument& e) {

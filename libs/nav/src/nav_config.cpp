@@ -1,6 +1,7 @@
 #include "upd/nav/nav_config.h"
 
 #include "upd/mrpt/ini_params.h"
+#include "upd/mrpt/robot_config.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -65,7 +66,13 @@ NavConfig loadNavConfig(const std::string& robot_ini, const std::string& nav_ini
   NavConfig c;
   {
     mrptbridge::IniReader ini(robot_ini);
-    forEachRobotSection(c, [&](const char* name, auto& params) { ini.read(name, params); });
+    // The sections the loop uses; the others are the `upd` commands' (see the header comment).
+    mrptbridge::RobotConfigParts parts;
+    parts.pipeline = &c.pipeline;
+    parts.baseline = &c.baseline;
+    parts.grid = &c.grid;
+    parts.fusion = &c.fusion;
+    mrptbridge::readRobotConfig(ini, parts);
   }
   {
     mrptbridge::IniReader ini(nav_ini);

@@ -22,11 +22,14 @@ enum class NormalWeighting : int {
   Uniform = 0,   ///< xi_i = 1 (the paper's default)
   Gaussian = 1,  ///< xi_i = exp(-|p_i - p|^2 / (2 (radius/2)^2)): nearer points count more
 };
+/// The ini names of NormalWeighting ([NormalParams] weighting); the loader also takes the numbers.
+inline constexpr EnumName<NormalWeighting> kNormalWeightingNames[] = {
+    {"uniform", NormalWeighting::Uniform}, {"gaussian", NormalWeighting::Gaussian}};
 
 struct NormalParams {
   double radius_m = 0.1;  ///< neighbourhood radius for PCA [m]; used when knn == 0
   int knn = 0;            ///< > 0: use the knn nearest points instead of the radius
-  int weighting = static_cast<int>(NormalWeighting::Uniform);  ///< 0 uniform, 1 gaussian (eq. 4 xi)
+  NormalWeighting weighting = NormalWeighting::Uniform;  ///< xi_i of eq. 4
   /// A normal closer than this to horizontal is oriented towards the sensor [rad].
   double vertical_band_rad = 30.0 * kDegToRad;
   /// Fast path on organized clouds (fast_normals.h): one normal is computed per block of
@@ -47,7 +50,9 @@ struct NormalParams {
   void visit(V& v) {
     v("radius_m", radius_m, "PCA neighbourhood radius [m] (used when knn = 0)");
     v("knn", knn, "if > 0, use the k nearest points instead of the radius");
-    v("weighting", weighting, "covariance weights xi (eq. 4): 0 uniform, 1 gaussian");
+    v.choice("weighting", weighting, kNormalWeightingNames,
+             "covariance weights xi (eq. 4): uniform or gaussian; the numbers 0, 1 are also "
+             "accepted");
     v.angleDeg("vertical_band_deg", vertical_band_rad,
                "normals this close to horizontal are oriented towards the sensor [deg]");
     v("fast_block_px", fast_block_px,

@@ -11,10 +11,16 @@
 //   void operator()(const char* key, bool& v, const char* doc);
 //   void operator()(const char* key, Eigen::Vector3f& v, const char* doc);
 //   void angleDeg(const char* key, double& radians, const char* doc);
+//   template <class E, std::size_t N>
+//   void choice(const char* key, E& value, const EnumName<E> (&names)[N], const char* doc);
+// An enum field is visited through choice() with the table of its ini names (enumNames() of
+// the enum, defined beside it); the loader also accepts the enum's number, as configs written
+// before the names were introduced hold it.
 #pragma once
 
 #include <Eigen/Core>
 
+#include <cstddef>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -42,6 +48,30 @@ void requireParam(bool ok, const char* owner, const char* field, const T& value,
     throw std::invalid_argument(std::string(owner) + "." + field + " = " +
                                 detail::formatValue(value) + ": " + rule);
   }
+}
+
+/// One ini name of an enum value.
+template <class E>
+struct EnumName {
+  const char* name;
+  E value;
+};
+
+/// The name of value in names, or nullptr when the table lacks it.
+template <class E, std::size_t N>
+const char* enumName(const EnumName<E> (&names)[N], E value) {
+  for (const auto& n : names) {
+    if (n.value == value) return n.name;
+  }
+  return nullptr;
+}
+
+/// "a|b|c": the names of a table, for messages and docs.
+template <class E, std::size_t N>
+std::string enumNameList(const EnumName<E> (&names)[N]) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : "|") + std::string(n.name);
+  return out;
 }
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;

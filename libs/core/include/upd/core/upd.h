@@ -23,12 +23,15 @@ enum class UpdMethod : int {
   Exact = 1,  ///< k-d tree sums over the true neighbourhoods: equal to brute force
   Fast = 2,   ///< cost per point independent of d_m: window-scan normals, voxel-moment lattice UPD
 };
+/// The ini names of UpdMethod ([UpdParams] method); the loader also takes the numbers.
+inline constexpr EnumName<UpdMethod> kUpdMethodNames[] = {
+    {"auto", UpdMethod::Auto}, {"exact", UpdMethod::Exact}, {"fast", UpdMethod::Fast}};
 
 struct UpdParams {
   double radius_m = 0.5;  ///< d_m, the UPD search radius [m] (eq. 1); follows the robot's size
   int knn = 0;            ///< > 0: sum over the knn nearest points instead (sparse data)
   int min_neighbors = 3;  ///< fewer neighbours with valid normals: the point is not scored
-  int method = static_cast<int>(UpdMethod::Auto);  ///< UpdMethod: 0 auto, 1 exact, 2 fast
+  UpdMethod method = UpdMethod::Auto;  ///< the normals and UPD path (pipeline.h)
   /// Fast path: lattice cells per d_m (fast_upd.h). The node work grows as its 4th power; the
   /// error falls with it (4: mean |delta zeta| ~2e-3; 8: ~7e-4 on the generated scenes).
   int fast_cells_per_radius = 4;
@@ -51,10 +54,10 @@ struct UpdParams {
     v("radius_m", radius_m, "UPD search radius d_m [m] (eq. 1): 0.5 small rover, 1.0 tractor");
     v("knn", knn, "if > 0, sum over the k nearest points instead of the radius");
     v("min_neighbors", min_neighbors, "points with fewer valid-normal neighbours get NaN");
-    v("method", method,
-      "0 auto (fast unless knn > 0), 1 exact (k-d tree, brute-force equal), 2 fast "
-      "(cost per point independent of d_m: image-window normals on organized clouds, a "
-      "voxel-moment lattice for the UPD)");
+    v.choice("method", method, kUpdMethodNames,
+             "auto (fast unless knn > 0), exact (k-d tree, brute-force equal), fast (cost per "
+             "point independent of d_m: image-window normals on organized clouds, a "
+             "voxel-moment lattice for the UPD); the numbers 0, 1, 2 are also accepted");
     v("fast_cells_per_radius", fast_cells_per_radius,
       "fast path: lattice cells per d_m (2 .. 16); more is slower and closer to exact");
     v("fast_cells_per_point", fast_cells_per_point,

@@ -7,8 +7,11 @@
 // the struct's validate(), prefixed with the file.
 #pragma once
 
+#include "upd/core/params.h"
+
 #include <Eigen/Core>
 
+#include <cstddef>
 #include <map>
 #include <memory>
 #include <set>
@@ -63,6 +66,11 @@ bool parseBool(const IniReader& r, const std::string& s, const std::string& k,
                const std::string& v);
 Eigen::Vector3f parseVector3(const IniReader& r, const std::string& s, const std::string& k,
                              const std::string& v);
+/// The index in names of v: a name (any case) or, as configs written before the names hold,
+/// the number of one (numbers[i]). Fails naming the valid names otherwise.
+std::size_t parseChoice(const IniReader& r, const std::string& s, const std::string& k,
+                        const std::string& v, const std::vector<std::string>& names,
+                        const std::vector<int>& numbers);
 void rethrowWithFile(const IniReader& r, const std::string& section);
 
 struct IniVisitor {
@@ -87,6 +95,19 @@ struct IniVisitor {
     double deg = radians * 180.0 / 3.14159265358979323846;
     (*this)(key, deg, doc);
     radians = deg * 3.14159265358979323846 / 180.0;
+  }
+  template <class E, std::size_t N>
+  void choice(const char* key, E& value, const EnumName<E> (&names)[N], const char* /*doc*/) {
+    reader.markKnown(section, key);
+    if (!reader.hasKey(section, key)) return;
+    std::vector<std::string> texts;
+    std::vector<int> numbers;
+    for (const auto& n : names) {
+      texts.emplace_back(n.name);
+      numbers.push_back(static_cast<int>(n.value));
+    }
+    value = names[parseChoice(reader, section, key, reader.rawValue(section, key), texts, numbers)]
+                .value;
   }
 };
 }  // namespace detail

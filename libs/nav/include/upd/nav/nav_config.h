@@ -70,30 +70,6 @@ struct NavConfig {
   void validate() const;
 };
 
-/// The `up` key of [PipelineParams] as a visitable section.
-struct UpKey {
-  Eigen::Vector3f& up;
-  void validate() const {}
-  template <class V>
-  void visit(V& v) {
-    v("up", up, "gravity-up direction in the cloud frame (the navigation loop scores z-up)");
-  }
-};
-
-/// Calls f(section, params) for every section the loop reads from the robot config.
-template <class F>
-void forEachRobotSection(NavConfig& c, F&& f) {
-  UpKey up{c.pipeline.up};
-  f("PipelineParams", up);
-  f("PreprocessParams", c.pipeline.preprocess);
-  f("NormalParams", c.pipeline.normals);
-  f("UpdParams", c.pipeline.upd);
-  f("ClassifyParams", c.pipeline.classify);
-  f("BaselineParams", c.baseline);
-  f("GridParams", c.grid);
-  f("FusionParams", c.fusion);
-}
-
 /// Calls f(section, description, params) for every section of the navigation config
 /// ([NavigatorParams]'s two path keys aside), in documentation order.
 template <class F>
