@@ -53,9 +53,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::atomic<bool> g_stop{false};
-void onSignal(int) { g_stop = true; }
-
 Eigen::Vector2d parseGoal(const std::string& text) {
   std::istringstream is(text);
   double x = 0, y = 0;
@@ -139,6 +136,9 @@ void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTa
   io::writeJsonAtomically((std::filesystem::path(dir) / "summary.json").string(), j);
   std::printf("  outputs in %s\n", dir.c_str());
 }
+
+std::atomic<bool> g_stop{false};
+void onSignal(int) { g_stop = true; }
 
 // Ctrl-C and SIGTERM set g_stop while it lives.
 class StopOnSignal {
