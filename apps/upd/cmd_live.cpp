@@ -66,7 +66,7 @@ Eigen::Vector2d parseGoal(const std::string& text) {
 
 struct LiveOptions {
   std::string config_path, nav_path;
-  std::string oni;  ///< empty: the first connected device
+  std::string oni;     ///< empty: the first connected device
   int max_frames = 0;  ///< 0: no limit
   std::optional<Eigen::Vector2d> goal;
   std::optional<std::string> out;
@@ -169,6 +169,7 @@ struct LiveRun {
         camera_on_robot(nav::cameraOnRobot(c.camera)) {
     if (o.view) view = std::make_unique<nav::LiveView>("upd live", c.body);
     if (o.goal) loop.navigateTo(*o.goal);
+    t0 = last = last_report = now = Clock::now();  // the run starts after the set-up
   }
 
   const LiveOptions& opt;
@@ -177,7 +178,7 @@ struct LiveRun {
   nav::NavigationLoop loop;
   std::unique_ptr<nav::LiveView> view;
   const Eigen::Isometry3d camera_on_robot;
-  Clock::time_point t0 = Clock::now(), last = t0, last_report = t0, now = t0;
+  Clock::time_point t0, last, last_report, now;
   int frames = 0;
   double score_ms = 0;
 };
