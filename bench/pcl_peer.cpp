@@ -7,22 +7,17 @@
 #include <pcl/point_types.h>
 #include <pcl/search/kdtree.h>
 
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <vector>
 
 #include "upd/core/normals.h"
+#include "upd/core/stopwatch.h"
 
 namespace upd::bench {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const PointCloud& in, bool keep_layout) {
   auto out = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
@@ -45,86 +40,111 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const PointCloud& in, bool keep_layout
   return out;
 }
 
-}  // namespace
+using PclCloud = pcl::PointCloud<pcl::PointXYZ>;
 
-PeerResult runPclPipeline(const PointCloud& input, const PeerSettings& s) {
-  const auto cloud = toPcl(input, false);
-  PeerResult res;
-  const auto t_start = Clock::now();
+// The voxel grid, when enabled; else the input itself.
+PclCloud::Ptr voxelGrid(const PclCloud::Ptr& cloud, const PeerSettings& s) {
+  if (!s.voxel_enabled) return cloud;
+  auto scored = std::make_shared<PclCloud>();
+  pcl::VoxelGrid<pcl::PointXYZ> grid;
+  grid.setInputCloud(cloud);
+  const auto leaf = static_cast<float>(s.voxel_m);
+  grid.setLeafSize(leaf, leaf, leaf);
+  grid.filter(*scored);
+  return scored;
+}
 
-  auto t0 = Clock::now();
-  pcl::PointCloud<pcl::PointXYZ>::Ptr scored = cloud;
-  if (s.voxel_enabled) {
-    scored = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-    pcl::VoxelGrid<pcl::PointXYZ> grid;
-    grid.setInputCloud(cloud);
-    const auto leaf = static_cast<float>(s.voxel_m);
-    grid.setLeafSize(leaf, leaf, leaf);
-    grid.filter(*scored);
-  }
-  res.voxel_ms = msSince(t0);
+struct OrientedNormals {
+  std::vector<Eigen::Vector3f> normal;
+  std::vector<char> valid;
+};
 
-  t0 = Clock::now();
-  auto tree = std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+// NormalEstimation by radius search on tree, then the orientation rule of normals.h (up, or
+// towards the sensor near vertical), which the UPD needs.
+OrientedNormals peerNormals(const PclCloud::Ptr& scored,
+                            const pcl::search::KdTree<pcl::PointXYZ>::Ptr& tree,
+                            const Eigen::Vector3f& sensor_origin, const PeerSettings& s) {
   pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
   estimator.setInputCloud(scored);
   estimator.setSearchMethod(tree);
   estimator.setRadiusSearch(s.normal_radius_m);
-  estimator.setViewPoint(input.sensor_origin.x(), input.sensor_origin.y(), input.sensor_origin.z());
+  estimator.setViewPoint(sensor_origin.x(), sensor_origin.y(), sensor_origin.z());
   pcl::PointCloud<pcl::Normal> normals;
   estimator.compute(normals);
-  // The UPD needs the orientation rule of normals.h (up, or towards the sensor near vertical).
   const std::size_t n = scored->size();
-  std::vector<Eigen::Vector3f> oriented(n);
-  std::vector<char> valid(n, 0);
+  OrientedNormals out{std::vector<Eigen::Vector3f>(n), std::vector<char>(n, 0)};
   for (std::size_t i = 0; i < n; ++i) {
     const auto& nm = normals[i];
     if (!std::isfinite(nm.normal_x) || !std::isfinite(nm.normal_y) || !std::isfinite(nm.normal_z)) {
       continue;
     }
     const auto& p = (*scored)[i];
-    oriented[i] = orientNormal(Eigen::Vector3f(nm.normal_x, nm.normal_y, nm.normal_z),
-                               Eigen::Vector3f(p.x, p.y, p.z), input.sensor_origin, s.up,
-                               s.vertical_band_rad);
-    valid[i] = 1;
+    out.normal[i] = orientNormal(Eigen::Vector3f(nm.normal_x, nm.normal_y, nm.normal_z),
+                                 Eigen::Vector3f(p.x, p.y, p.z), sensor_origin, s.up,
+                                 s.vertical_band_rad);
+    out.valid[i] = 1;
   }
-  res.normals_ms = msSince(t0);
+  return out;
+}
 
-  // The UPD: a second radius search per point (the tree built by NormalEstimation).
-  t0 = Clock::now();
+// The UPD: a second radius search per point (the tree built by NormalEstimation), eqs. 6-8.
+UpdResult peerUpd(const PclCloud& scored, pcl::search::KdTree<pcl::PointXYZ>& tree,
+                  const OrientedNormals& normals, const PeerSettings& s) {
+  const std::size_t n = scored.size();
+  UpdResult upd;
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  res.upd.rx.assign(n, nan);
-  res.upd.ry.assign(n, nan);
-  res.upd.rz.assign(n, nan);
-  res.upd.zeta.assign(n, nan);
-  res.upd.k.assign(n, 0);
+  upd.rx.assign(n, nan);
+  upd.ry.assign(n, nan);
+  upd.rz.assign(n, nan);
+  upd.zeta.assign(n, nan);
+  upd.k.assign(n, 0);
   std::vector<int> indices;
   std::vector<float> dist_sq;
   for (std::size_t i = 0; i < n; ++i) {
-    tree->radiusSearch((*scored)[i], s.upd_radius_m, indices, dist_sq);
+    tree.radiusSearch(scored[i], s.upd_radius_m, indices, dist_sq);
     double x = 0, y = 0, z = 0;
     std::uint32_t k = 0;
     for (const int j : indices) {
-      if (!valid[static_cast<std::size_t>(j)]) continue;
-      const Eigen::Vector3f& nj = oriented[static_cast<std::size_t>(j)];
+      if (!normals.valid[static_cast<std::size_t>(j)]) continue;
+      const Eigen::Vector3f& nj = normals.normal[static_cast<std::size_t>(j)];
       x += nj.x(), y += nj.y(), z += nj.z();
       ++k;
     }
     if (k < static_cast<std::uint32_t>(s.min_neighbors)) {
-      ++res.upd.invalid;
+      ++upd.invalid;
       continue;
     }
-    res.upd.rx[i] = static_cast<float>(x);
-    res.upd.ry[i] = static_cast<float>(y);
-    res.upd.rz[i] = static_cast<float>(z);
-    res.upd.zeta[i] = static_cast<float>(std::sqrt(x * x + y * y + z * z) / k);
-    res.upd.k[i] = k;
+    upd.rx[i] = static_cast<float>(x);
+    upd.ry[i] = static_cast<float>(y);
+    upd.rz[i] = static_cast<float>(z);
+    upd.zeta[i] = static_cast<float>(std::sqrt(x * x + y * y + z * z) / k);
+    upd.k[i] = k;
   }
-  res.upd_ms = msSince(t0);
-  res.total_ms = msSince(t_start);
+  return upd;
+}
+
+}  // namespace
+
+PeerResult runPclPipeline(const PointCloud& input, const PeerSettings& s) {
+  const auto cloud = toPcl(input, false);
+  PeerResult res;
+  const Stopwatch total;
+  Stopwatch stage;
+  const PclCloud::Ptr scored = voxelGrid(cloud, s);
+  res.voxel_ms = stage.elapsedMs();
+
+  stage.restart();
+  auto tree = std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+  const OrientedNormals normals = peerNormals(scored, tree, input.sensor_origin, s);
+  res.normals_ms = stage.elapsedMs();
+
+  stage.restart();
+  res.upd = peerUpd(*scored, *tree, normals, s);
+  res.upd_ms = stage.elapsedMs();
+  res.total_ms = total.elapsedMs();
 
   res.cloud.sensor_origin = input.sensor_origin;
-  res.cloud.reserve(n);
+  res.cloud.reserve(scored->size());
   for (const auto& p : scored->points) res.cloud.push_back(p.x, p.y, p.z);
   return res;
 }
@@ -141,10 +161,10 @@ IntegralPeerResult runPclIntegralNormals(const PointCloud& organized, float max_
   estimator.setNormalSmoothingSize(normal_smoothing_size);
   estimator.setInputCloud(cloud);
   pcl::PointCloud<pcl::Normal> normals;
-  const auto t0 = Clock::now();
+  const Stopwatch watch;
   estimator.compute(normals);
   IntegralPeerResult res;
-  res.ms = msSince(t0);
+  res.ms = watch.elapsedMs();
   for (const auto& nm : normals.points) res.valid += std::isfinite(nm.normal_x) ? 1 : 0;
   return res;
 }

@@ -41,13 +41,14 @@ std::shared_ptr<mrpt::obs::CObservation> groundScan() {
 
 void expectConsistentSizes(const ObserverResult& r) {
   const std::size_t n = r.size();
-  EXPECT_EQ(r.normals_in_world.size(), n);
-  EXPECT_EQ(r.upd_in_world.size(), n);
-  EXPECT_EQ(r.upd_in_world.rx.size(), n);
-  EXPECT_EQ(r.classes.label.size(), n);
-  EXPECT_EQ(r.classes.cost.size(), n);
-  EXPECT_EQ(r.classes.slope_rad.size(), n);
-  EXPECT_EQ(r.classes.traversable + r.classes.non_traversable + r.classes.unknown, n);
+  EXPECT_EQ(r.scored.normals_world.size(), n);
+  EXPECT_EQ(r.scored.upd.size(), n);
+  EXPECT_EQ(r.scored.upd.rx.size(), n);
+  EXPECT_EQ(r.scored.classes.label.size(), n);
+  EXPECT_EQ(r.scored.classes.cost.size(), n);
+  EXPECT_EQ(r.scored.classes.slope_rad.size(), n);
+  const upd::Classification& c = r.scored.classes;
+  EXPECT_EQ(c.traversable + c.non_traversable + c.unknown, n);
 }
 
 TEST(UpdObserver, FloorIsTraversableAtTheRobotsWorldPosition) {
@@ -64,7 +65,7 @@ TEST(UpdObserver, FloorIsTraversableAtTheRobotsWorldPosition) {
   // Every scored point is on the floor, now at the robot's z in the world, near the robot.
   std::size_t on_floor = 0;
   for (std::size_t i = 0; i < r.size(); ++i) {
-    const Eigen::Vector3f p = r.points_in_world.point(i);
+    const Eigen::Vector3f p = r.scored.cloud_world.point(i);
     on_floor += std::abs(p.z() - 0.25f) < 0.05f ? 1 : 0;
     EXPECT_LT((p.head<2>() - Eigen::Vector2f(12.f, -3.f)).norm(), 3.f);
   }
@@ -72,17 +73,17 @@ TEST(UpdObserver, FloorIsTraversableAtTheRobotsWorldPosition) {
   // Normals point up in the world; the floor is traversable with zeta close to 1.
   std::size_t up = 0, valid = 0;
   for (std::size_t i = 0; i < r.size(); ++i) {
-    if (!r.normals_in_world.isValid(i)) continue;
+    if (!r.scored.normals_world.isValid(i)) continue;
     ++valid;
-    up += r.normals_in_world.nz[i] > 0.95f ? 1 : 0;
+    up += r.scored.normals_world.nz[i] > 0.95f ? 1 : 0;
   }
   EXPECT_GT(up, valid * 9 / 10);
-  EXPECT_GT(r.classes.traversable, r.size() * 8 / 10);
+  EXPECT_GT(r.scored.classes.traversable, r.size() * 8 / 10);
   // The sensor, 1.27 m above the robot origin, is 1.52 m above the world origin.
   EXPECT_NEAR(r.pose_world_sensor.translation().z(), 1.273 + 0.25, 0.01);
-  EXPECT_TRUE(r.points_in_world.sensor_origin.isApprox(
+  EXPECT_TRUE(r.scored.cloud_world.sensor_origin.isApprox(
       r.pose_world_sensor.translation().cast<float>(), 1e-5f));
-  EXPECT_GE(r.timings.total_ms, r.timings.convert_ms);
+  EXPECT_GE(r.total_ms, r.convert_ms);
 }
 
 // Moving or turning the robot on the ground changes nothing but where the points are.
@@ -96,14 +97,14 @@ TEST(UpdObserver, ScoresDoNotDependOnThePlanarRobotPose) {
   const ObserverResult rb = observer.observe(*obs, b);
   ASSERT_EQ(ra.size(), rb.size());
   for (std::size_t i = 0; i < ra.size(); ++i) {
-    ASSERT_EQ(ra.classes.label[i], rb.classes.label[i]);
-    if (ra.upd_in_world.isValid(i)) {
-      ASSERT_EQ(ra.upd_in_world.zeta[i], rb.upd_in_world.zeta[i]);
-      const Eigen::Vector3f r_rotated = b.linear().cast<float>() * ra.upd_in_world.r(i);
-      ASSERT_TRUE(r_rotated.isApprox(rb.upd_in_world.r(i), 1e-4f));
+    ASSERT_EQ(ra.scored.classes.label[i], rb.scored.classes.label[i]);
+    if (ra.scored.upd.isValid(i)) {
+      ASSERT_EQ(ra.scored.upd.zeta[i], rb.scored.upd.zeta[i]);
+      const Eigen::Vector3f r_rotated = b.linear().cast<float>() * ra.scored.upd.r(i);
+      ASSERT_TRUE(r_rotated.isApprox(rb.scored.upd.r(i), 1e-4f));
     }
-    const Eigen::Vector3d moved = b * ra.points_in_world.point(i).cast<double>();
-    ASSERT_LT((moved - rb.points_in_world.point(i).cast<double>()).norm(), 2e-3);
+    const Eigen::Vector3d moved = b * ra.scored.cloud_world.point(i).cast<double>();
+    ASSERT_LT((moved - rb.scored.cloud_world.point(i).cast<double>()).norm(), 2e-3);
   }
 }
 
@@ -123,9 +124,10 @@ TEST(UpdObserver, ReusedResultEqualsAFreshOne) {
   const ObserverResult fresh = observer.observe(*obs, b);
   ASSERT_EQ(reused.size(), fresh.size());
   ASSERT_GT(fresh.size(), 0u);
-  EXPECT_EQ(reused.points_in_world.x, fresh.points_in_world.x);
-  EXPECT_EQ(reused.points_in_world.z, fresh.points_in_world.z);
-  EXPECT_TRUE(reused.points_in_world.sensor_origin.isApprox(fresh.points_in_world.sensor_origin));
+  EXPECT_EQ(reused.scored.cloud_world.x, fresh.scored.cloud_world.x);
+  EXPECT_EQ(reused.scored.cloud_world.z, fresh.scored.cloud_world.z);
+  EXPECT_TRUE(
+      reused.scored.cloud_world.sensor_origin.isApprox(fresh.scored.cloud_world.sensor_origin));
   const auto same = [](const std::vector<float>& u, const std::vector<float>& v) {
     if (u.size() != v.size()) return false;
     for (std::size_t i = 0; i < u.size(); ++i) {
@@ -133,14 +135,14 @@ TEST(UpdObserver, ReusedResultEqualsAFreshOne) {
     }
     return true;
   };
-  EXPECT_TRUE(same(reused.normals_in_world.nx, fresh.normals_in_world.nx));
-  EXPECT_TRUE(same(reused.upd_in_world.ry, fresh.upd_in_world.ry));
-  EXPECT_TRUE(same(reused.upd_in_world.zeta, fresh.upd_in_world.zeta));
-  EXPECT_EQ(reused.upd_in_world.k, fresh.upd_in_world.k);
-  EXPECT_EQ(reused.classes.label, fresh.classes.label);
-  EXPECT_TRUE(same(reused.classes.cost, fresh.classes.cost));
-  EXPECT_EQ(reused.classes.traversable, fresh.classes.traversable);
-  EXPECT_EQ(reused.upd_in_world.invalid, fresh.upd_in_world.invalid);
+  EXPECT_TRUE(same(reused.scored.normals_world.nx, fresh.scored.normals_world.nx));
+  EXPECT_TRUE(same(reused.scored.upd.ry, fresh.scored.upd.ry));
+  EXPECT_TRUE(same(reused.scored.upd.zeta, fresh.scored.upd.zeta));
+  EXPECT_EQ(reused.scored.upd.k, fresh.scored.upd.k);
+  EXPECT_EQ(reused.scored.classes.label, fresh.scored.classes.label);
+  EXPECT_TRUE(same(reused.scored.classes.cost, fresh.scored.classes.cost));
+  EXPECT_EQ(reused.scored.classes.traversable, fresh.scored.classes.traversable);
+  EXPECT_EQ(reused.scored.upd.invalid, fresh.scored.upd.invalid);
   EXPECT_TRUE(reused.pose_world_sensor.isApprox(fresh.pose_world_sensor));
 }
 
@@ -155,11 +157,11 @@ TEST(UpdObserver, SlopeIsMeasuredAgainstGravity) {
   const ObserverResult tilted = observer.observe(
       *obs, upd::mrptbridge::toIsometry(mrpt::poses::CPose3D(0, 0, 0, 0, pitch, 0)));
   std::vector<float> sf, st;
-  for (std::size_t i = 0; i < flat.size(); ++i) {
-    if (std::isfinite(flat.classes.slope_rad[i])) sf.push_back(flat.classes.slope_rad[i]);
+  for (const float s : flat.scored.classes.slope_rad) {
+    if (std::isfinite(s)) sf.push_back(s);
   }
-  for (std::size_t i = 0; i < tilted.size(); ++i) {
-    if (std::isfinite(tilted.classes.slope_rad[i])) st.push_back(tilted.classes.slope_rad[i]);
+  for (const float s : tilted.scored.classes.slope_rad) {
+    if (std::isfinite(s)) st.push_back(s);
   }
   ASSERT_FALSE(sf.empty());
   ASSERT_FALSE(st.empty());
@@ -194,7 +196,7 @@ TEST(UpdObserver, VelodyneScanIsScored) {
   EXPECT_FALSE(r.organized_input);
   EXPECT_GT(r.size(), 1000u);
   expectConsistentSizes(r);
-  EXPECT_GT(r.classes.traversable + r.classes.non_traversable, r.size() / 4);
+  EXPECT_GT(r.scored.classes.traversable + r.scored.classes.non_traversable, r.size() / 4);
 }
 
 struct TempIni {

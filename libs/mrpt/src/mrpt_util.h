@@ -4,7 +4,6 @@
 #include <mrpt/core/Clock.h>
 #include <mrpt/rtti/CObject.h>
 
-#include <chrono>
 #include <string>
 
 namespace upd::mrptbridge::detail {
@@ -18,11 +17,5 @@ double toSeconds(const mrpt::Clock::time_point& t);
 /// MRPT exception texts span many lines (message, location, backtrace): keeps the "Message:"
 /// lines, joined, with non-printable bytes replaced (a corrupt file yields garbage class names).
 std::string condenseMessage(const std::string& what);
-
-/// Milliseconds since start.
-inline double elapsedMs(const std::chrono::steady_clock::time_point& start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 }  // namespace upd::mrptbridge::detail

@@ -1,15 +1,14 @@
 #include "upd/mrpt/upd_observer.h"
 
 #include "mrpt_util.h"
+#include "upd/core/stopwatch.h"
 #include "upd/mrpt/ini_params.h"
 #include "upd/mrpt/pose_source.h"
 
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/poses/CPose3D.h>
 
-#include <chrono>
 #include <stdexcept>
-#include <utility>
 
 namespace upd::mrptbridge {
 
@@ -57,7 +56,19 @@ void loadObserverParams(const std::string& ini_path, ObserverParams& params) {
   ini.checkAllKeysKnown();
 }
 
-UpdObserver::UpdObserver(const ObserverParams& params) : params_(params) { params_.validate(); }
+namespace {
+
+FrameScorerParams scorerParams(const ObserverParams& params) {
+  params.validate();
+  FrameScorerParams scorer;
+  scorer.pipeline = params.pipeline;
+  return scorer;
+}
+
+}  // namespace
+
+UpdObserver::UpdObserver(const ObserverParams& params)
+    : params_(params), scorer_(scorerParams(params)) {}
 
 ObserverResult UpdObserver::observe(const mrpt::obs::CObservation& obs,
                                     const mrpt::poses::CPose3D& pose_world_robot) const {
@@ -73,14 +84,12 @@ ObserverResult UpdObserver::observe(const mrpt::obs::CObservation& obs,
 
 void UpdObserver::observe(const mrpt::obs::CObservation& obs,
                           const Eigen::Isometry3d& pose_world_robot, ObserverResult& result) const {
-  const auto start = std::chrono::steady_clock::now();
-  // The calling thread's converted cloud, kept for its next frame.
-  static thread_local ObservationCloud cloud;
-  toCloud(obs, params_.source, cloud);
-  const double convert_ms = detail::elapsedMs(start);
-  observeCloud(cloud, pose_world_robot, result);
-  result.timings.convert_ms = convert_ms;
-  result.timings.total_ms = detail::elapsedMs(start);
+  const Stopwatch total;
+  toCloud(obs, params_.source, result.cloud);
+  const double convert_ms = total.elapsedMs();
+  observeCloud(result.cloud, pose_world_robot, result);
+  result.convert_ms = convert_ms;
+  result.total_ms = total.elapsedMs();
 }
 
 ObserverResult UpdObserver::observeCloud(const ObservationCloud& cloud,
@@ -93,57 +102,23 @@ ObserverResult UpdObserver::observeCloud(const ObservationCloud& cloud,
 void UpdObserver::observeCloud(const ObservationCloud& cloud,
                                const Eigen::Isometry3d& pose_world_robot,
                                ObserverResult& result) const {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch total;
   result.source_class = cloud.source_class;
   result.skipped_reason = cloud.skipped_reason;
   result.pose_world_robot = pose_world_robot;
   result.pose_world_sensor = composeSensorPose(pose_world_robot, cloud.sensor_pose_on_robot);
   result.organized_input = false;
   result.points_input = 0;
-  result.timings = ObserverTimings{};
+  result.convert_ms = 0;
   if (!cloud.ok()) {
-    result.points_in_world = PointCloud{};
-    result.normals_in_world = Normals{};
-    result.upd_in_world = UpdResult{};
-    result.classes = Classification{};
-    result.preprocess_stats = PreprocessStats{};
-    result.timings.total_ms = detail::elapsedMs(start);
+    result.scored = ScoredFrame{};
+    result.total_ms = total.elapsedMs();
     return;
   }
   result.organized_input = cloud.organized();
   result.points_input = cloud.cloud_in_robot.countFinite();
-
-  PipelineParams pipeline = params_.pipeline;
-  // Gravity (world +z) seen from the robot: +z for planar poses.
-  pipeline.up = (pose_world_robot.linear().transpose() * Eigen::Vector3d::UnitZ()).cast<float>();
-  // The robot-frame results: the calling thread's, kept for its next frame.
-  static thread_local PipelineResult scored;
-  runPipeline(cloud.cloud_in_robot, pipeline, scored);
-  result.timings.pipeline = scored.timings;
-
-  const auto to_world_start = std::chrono::steady_clock::now();
-  transformCloud(scored.cloud, pose_world_robot, result.points_in_world);
-  const Eigen::Matrix3f rotation = pose_world_robot.linear().cast<float>();
-  const std::size_t n = scored.cloud.size();
-  Normals& normals = result.normals_in_world;
-  normals.nx.resize(n), normals.ny.resize(n), normals.nz.resize(n);
-  rotateVectors(rotation, n, scored.normals.nx.data(), scored.normals.ny.data(),
-                scored.normals.nz.data(), normals.nx.data(), normals.ny.data(), normals.nz.data());
-  normals.curvature = scored.normals.curvature;
-  normals.invalid = scored.normals.invalid;
-  UpdResult& upd = result.upd_in_world;
-  upd.rx.resize(n), upd.ry.resize(n), upd.rz.resize(n);
-  rotateVectors(rotation, n, scored.upd.rx.data(), scored.upd.ry.data(), scored.upd.rz.data(),
-                upd.rx.data(), upd.ry.data(), upd.rz.data());
-  upd.zeta = scored.upd.zeta;
-  upd.k = scored.upd.k;
-  upd.invalid = scored.upd.invalid;
-  // Labels, costs and slopes are the same in both frames: the buffers change hands (the
-  // scratch gets result's previous ones, of the same size, to fill next frame).
-  std::swap(result.classes, scored.classes);
-  result.preprocess_stats = scored.preprocess_stats;
-  result.timings.to_world_ms = detail::elapsedMs(to_world_start);
-  result.timings.total_ms = detail::elapsedMs(start);
+  scorer_.score(cloud.cloud_in_robot, pose_world_robot, result.scored);
+  result.total_ms = total.elapsedMs();
 }
 
 }  // namespace upd::mrptbridge

@@ -63,13 +63,22 @@ std::string cacheDirFor(const std::string& cache_root, const std::string& ptg_in
   return (fs::path(cache_root) / hex).string();
 }
 
+FrameScorerParams scorerParams(const NavConfig& config, ObstacleDetector detector) {
+  FrameScorerParams p;
+  p.pipeline = config.pipeline;
+  p.detector = detector;
+  p.baseline = config.baseline;
+  p.obstacles_xy = true;  // the navigator's current-frame obstacles
+  return p;
+}
+
 }  // namespace
 
 NavigationLoop::NavigationLoop(RobotBase& base, const NavConfig& config, ObstacleDetector detector,
                                const std::string& navlog_path)
     : base_(base),
       config_(config),
-      detector_(detector),
+      scorer_(scorerParams(config, detector)),
       navlog_path_(navlog_path),
       grid_(config.grid),
       obstacles_(config.obstacles) {
@@ -81,7 +90,9 @@ NavigationLoop::~NavigationLoop() = default;
 
 const FrameEvidence& NavigationLoop::addFrame(const PointCloud& cloud_world, double time_s,
                                               double ground_z_m) {
-  last_frame_ = scoreFrame(cloud_world, detector_, config_.pipeline, config_.baseline);
+  // The cloud is already in the world frame: scored there, as the identity pose says.
+  scorer_.score(cloud_world, Eigen::Isometry3d::Identity(), last_frame_);
+  last_frame_.score_ms = last_frame_.timings.total_ms;
   BaseState s;
   if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
   const auto view = maps::viewPoints(last_frame_.cloud_world, last_frame_.classes,

@@ -3,7 +3,7 @@
 //
 // Per control step the caller
 //  1. hands in the latest depth frame, already in the world frame (z up) at the base's current
-//     pose: addFrame() scores it (UPD or roughness index), fuses it into the traversability grid,
+//     pose: addFrame() scores it (upd::FrameScorer: UPD or roughness index), fuses it into the traversability grid,
 //     adds the missing ground of its gaps (negative_obstacles.h) whose near side the map knows
 //     as traversable, and makes all its NonTraversable points the "current frame" obstacles;
 //  2. calls step(): every replan_period_s the route planner searches the map for a route to the
@@ -47,7 +47,8 @@ class NavigationLoop {
   NavigationLoop& operator=(const NavigationLoop&) = delete;
 
   /// Scores cloud_world (world frame, z up, sensor origin set; organized for the missing-ground
-  /// check) and fuses it at time_s. ground_z_m: height of the ground under the robot (0 on flat
+  /// check) with the loop's FrameScorer, reusing the last frame's buffers, and fuses it at
+  /// time_s. ground_z_m: height of the ground under the robot (0 on flat
   /// ground), the level below which hidden ground counts as missing.
   const FrameEvidence& addFrame(const PointCloud& cloud_world, double time_s,
                                 double ground_z_m = 0.0);
@@ -82,7 +83,7 @@ class NavigationLoop {
  private:
   RobotBase& base_;
   NavConfig config_;
-  ObstacleDetector detector_;
+  FrameScorer scorer_;
   std::string navlog_path_;
   maps::TraversabilityGrid grid_;
   ObstacleSource obstacles_;

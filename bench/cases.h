@@ -1,0 +1,58 @@
+// The report's tables, one function per table, in the order upd_bench prints them. Each prints
+// its rows as it measures them, adds its targets to the report and returns its JSON cases.
+#pragma once
+
+#include <vector>
+
+#include "frames.h"
+#include "pcl_peer.h"
+#include "report.h"
+#include "upd/core/pipeline.h"
+
+namespace upd::bench {
+
+// ---- The frame pipeline (frame_cases.cpp) ----
+
+/// The pipeline of the frame tables: no pre-processing (every pixel is scored), normals of
+/// 0.05 m, the UPD at d_m.
+PipelineParams frameParams(const Frame& f, double d_m);
+
+/// Each frame on one core and on two, then the peak memory; results gets each frame's last
+/// result (one core) for the agreement table.
+json frameTimingCases(const std::vector<Frame>& frames, const Options& o, Report& report,
+                      std::vector<PipelineResult>& results);
+
+/// The frame pipeline's agreement with the exact path at full resolution, and what the
+/// accuracy settings cost; stored into frame_cases[f]["agreement"] and ["accuracy_settings"].
+void frameAgreementCases(const std::vector<Frame>& frames,
+                         const std::vector<PipelineResult>& results, const Options& o,
+                         Report& report, json& frame_cases);
+
+/// computeNormalsOrganized against PCL's IntegralImageNormalEstimation.
+json normalsAloneCases(const std::vector<Frame>& frames, const Options& o);
+
+/// The generated frame's pipeline at d_m = 0.25, 0.5, 1 and 2 m.
+json growthWithRadiusCases(const Frame& generated, const Options& o, Report& report);
+
+// ---- The PCL peer's settings (peer_cases.cpp) ----
+
+/// UpdParams::fast_exact_band at the PCL peer's settings.
+constexpr double kExactBand = 0.02;
+
+/// Our pipeline at the PCL peer's settings (voxel_m 0: no voxel grid).
+PipelineParams pclSettings(const Eigen::Vector3f& up, double voxel_m, double normal_radius_m,
+                           double d_m);
+
+/// The peer's settings equal to p.
+PeerSettings peerOf(const PipelineParams& p);
+
+/// Neighbour visits the peer's UPD search would make: its cost, to decide whether to run it.
+double peerCostEstimate(const PointCloud& cloud, const PipelineParams& p);
+
+/// The Kinect frames voxelized, the LiDAR scan and the corner: ours fast, ours exact, PCL.
+json pclSettingsCases(const std::vector<Frame>& frames, const Options& o, Report& report);
+
+/// 1 to 16 tiles of the rocks scene at the PCL peer's settings.
+json growthWithSizeCases(const Options& o, Report& report);
+
+}  // namespace upd::bench

@@ -1,0 +1,66 @@
+// The benchmark's inputs and how a frame is timed: the Kinect frames (two real PCD files and a
+// generated depth image), the frame loop (depth image -> cloud -> runPipeline -> map update,
+// its buffers kept from frame to frame, as a sensor loop does) and the medians over its runs.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "report.h"
+#include "upd/core/camera.h"
+#include "upd/core/pipeline.h"
+#include "upd/core/point_cloud.h"
+
+namespace upd::bench {
+
+struct Frame {
+  std::string name, source;
+  bool available = false;
+  std::string skip_reason;
+  PointCloud cloud;                 // organized, camera frame
+  std::optional<DepthImage> depth;  // the generated frame starts from its depth image
+  CameraIntrinsics intrinsics;
+  Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  Eigen::Isometry3f pose_world_cloud = Eigen::Isometry3f::Identity();
+};
+
+/// The path of rel under --data, when that file exists.
+std::optional<std::string> dataFile(const Options& o, const std::string& rel);
+
+/// An organized PCD frame; not available (with the reason) when the file is missing.
+Frame pcdFrame(const Options& o, const std::string& name, const std::string& rel,
+               const Eigen::Vector3f& up);
+
+/// makeWorld("mixed") rendered by a simulated Kinect.
+Frame generatedFrame();
+
+/// The three Kinect frames of the report, in its order.
+std::vector<Frame> kinectFrames(const Options& o);
+
+/// What the map-update stage of the frame loop does (it depends on whether libs/maps is built).
+const char* mapStageKind();
+
+struct FrameTiming {
+  double total_ms = kNaN;
+  json stages;
+  std::size_t scored = 0, points = 0;
+};
+
+/// repeats frames after a warm-up frame, at the current thread count (pinned to one CPU when
+/// that is 1); the last frame's result into *last when given.
+FrameTiming timeFramePipeline(const Frame& f, const PipelineParams& params, int repeats,
+                              PipelineResult* last = nullptr);
+
+/// The same on one core and on two, frame by frame in turn: on a shared machine whose speed
+/// drifts, both medians then see the same conditions and their ratio is the second core's gain.
+std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const PipelineParams& params,
+                                                       int repeats,
+                                                       PipelineResult* last = nullptr);
+
+/// Median time of f over repeats runs after one warm-up run [ms].
+double timeMedian(const std::function<void()>& f, int repeats);
+
+}  // namespace upd::bench

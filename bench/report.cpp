@@ -1,0 +1,120 @@
+#include "report.h"
+
+#include <omp.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+
+#include "upd/core/stopwatch.h"
+
+namespace upd::bench {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+void printRule() { std::printf("%s\n", std::string(100, '-').c_str()); }
+
+void printTitle(const char* title) {
+  printRule();
+  std::printf("%s\n", title);
+  printRule();
+}
+
+double peakRssMb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+double copyBandwidthGBs() {
+  const std::size_t n = std::size_t(64) << 20;
+  std::vector<char> a(n, 1), b(n, 2);
+  double best = 0;
+  for (int r = 0; r < 5; ++r) {
+    const Stopwatch watch;
+    std::memcpy(b.data(), a.data(), n);
+    const double s = watch.elapsedMs() / 1e3;
+    best = std::max(best, 2.0 * static_cast<double>(n) / s / 1e9);
+    std::swap(a, b);
+  }
+  return best;
+}
+
+namespace {
+
+std::string cpuModel() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(colon + 2);
+    }
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+void describeMachine(Report& report, double bandwidth) {
+  // The OpenMP wait policy changes the two-core timings: threads woken from sleep for each
+  // parallel region (passive) cost more than threads that spin a while first (the default).
+  const char* policy_env = std::getenv("OMP_WAIT_POLICY");
+  const std::string policy = policy_env && *policy_env ? policy_env : "default";
+  report.root["machine"] = {{"cpu", cpuModel()},
+                            {"logical_cpus", omp_get_num_procs()},
+                            {"copy_bandwidth_GBps", bandwidth},
+                            {"compiler", __VERSION__},
+                            {"omp_wait_policy", policy}};
+  std::printf("machine: %s, %d logical CPUs, copy bandwidth %.1f GB/s, OMP_WAIT_POLICY %s\n",
+              cpuModel().c_str(), omp_get_num_procs(), bandwidth, policy.c_str());
+}
+
+int finish(Report& report, const Options& o, double bandwidth) {
+  json& root = report.root;
+  // The memory-bandwidth floor of a frame: read x, y, z once, write the per-pixel results once
+  // (normal 12 B, curvature 4, r 12, zeta 4, k 4, label 1, cost 4, slope 4 = 45 B).
+  const double floor_bytes = 307200.0 * (12 + 45);
+  root["bandwidth_floor"] = {{"bytes_per_frame", floor_bytes},
+                             {"copy_bandwidth_GBps", bandwidth},
+                             {"floor_ms", floor_bytes / (bandwidth * 1e9) * 1e3}};
+
+  printTitle("Targets");
+  json tj = json::array();
+  std::size_t met = 0;
+  for (const Target& t : report.targets) {
+    std::printf("  [%s] %-62s %10.4g %s %-6g %s\n", t.met() ? " met  " : "NOT MET", t.name.c_str(),
+                t.value, t.upper_bound ? "<=" : ">=", t.limit, t.unit.c_str());
+    tj.push_back({{"name", t.name},
+                  {"value", num(t.value)},
+                  {"limit", t.limit},
+                  {"bound", t.upper_bound ? "<=" : ">="},
+                  {"unit", t.unit},
+                  {"met", t.met()}});
+    met += t.met() ? 1 : 0;
+  }
+  std::printf("%zu of %zu targets met; memory-bandwidth floor of a frame %.2f ms\n", met,
+              report.targets.size(), floor_bytes / (bandwidth * 1e9) * 1e3);
+  root["targets"] = tj;
+  root["targets_met"] = met;
+  root["targets_total"] = report.targets.size();
+  if (!o.json_path.empty()) {
+    std::ofstream out(o.json_path);
+    if (!out) throw std::runtime_error("cannot write " + o.json_path);
+    out << root.dump(2) << "\n";
+    if (!out) throw std::runtime_error("error writing " + o.json_path);
+    std::printf("report written to %s\n", o.json_path.c_str());
+  }
+  return 0;
+}
+
+}  // namespace upd::bench

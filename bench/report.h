@@ -1,0 +1,82 @@
+// The benchmark's options, its targets and the report it prints and writes as JSON: what every
+// part of upd_bench shares.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace upd::bench {
+
+using json = nlohmann::json;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Median of v; NaN when v is empty.
+double median(std::vector<double> v);
+
+/// JSON number, or null for NaN / infinity (JSON has neither).
+inline json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+struct Options {
+  std::string data_dir = UPD_SHARED_DATA_DIR;
+  std::string json_path;
+  bool quick = false;
+  bool frames_only = false;  // the frame pipeline timings alone (one core, two cores, memory)
+  int repeats = 15;
+};
+
+// The performance targets the report checks (docs/PERFORMANCE.md, "Targets").
+constexpr double kFrameBudgetMs = 33.0;
+constexpr double kMinSpeedupVsPcl = 100.0;
+constexpr double kMaxDmRatio = 1.5;         // t(d_m = 2) / t(d_m = 0.25)
+constexpr double kMaxPerPointGrowth = 1.5;  // time per point at x16 / at x1
+constexpr double kMaxMeanDzeta = 0.005;
+constexpr double kMinSameLabel = 0.995;
+constexpr double kMinTwoCoreSpeedup = 1.7;
+constexpr double kMaxPeakMemoryMb = 300.0;
+
+struct Target {
+  std::string name;
+  double value = kNaN;
+  double limit = kNaN;
+  bool upper_bound = true;  // value <= limit (else value >= limit)
+  std::string unit;
+  bool met() const {
+    return std::isfinite(value) && (upper_bound ? value <= limit : value >= limit);
+  }
+};
+
+/// The JSON report being built and the targets checked so far.
+class Report {
+ public:
+  json root = json::object();
+  std::vector<Target> targets;
+
+  void target(const std::string& name, double value, double limit, bool upper,
+              const std::string& unit) {
+    targets.push_back({name, value, limit, upper, unit});
+  }
+};
+
+/// A line of dashes between the report's tables.
+void printRule();
+
+/// Prints a table's title between two rules.
+void printTitle(const char* title);
+
+/// Peak resident memory of this process [MB].
+double peakRssMb();
+
+/// Sustained copy bandwidth of this machine [GB/s] (read + write counted), for the floor.
+double copyBandwidthGBs();
+
+/// The machine, the compiler and the OpenMP wait policy: printed and stored under "machine".
+void describeMachine(Report& report, double bandwidth);
+
+/// The bandwidth floor of a frame, the targets table and, with --json, the JSON file.
+int finish(Report& report, const Options& o, double bandwidth);
+
+}  // namespace upd::bench
