@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages UPD-Nav needs (only those missing), then configures and
 # builds the project into build/. Sourced by the quick-start scripts; safe to run repeatedly.
+# libopenni2-dev is optional (the camera input of `upd live`); the rest is required.
 set -euo pipefail
 
 UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

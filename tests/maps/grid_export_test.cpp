@@ -1,9 +1,8 @@
-// The grid's outputs: MRPT occupancy grid, ROS map_server PGM + YAML, colour PNG with legend,
-// and atomic writes.
+// The grid's outputs: ROS map_server PGM + YAML, colour PNG with legend, and atomic writes (the
+// MRPT occupancy grid is tested with the bridge: tests/mrpt/occupancy_grid_test.cpp).
 #include "maps/frames.h"
 #include "upd/maps/grid_export.h"
 #include "upd/maps/grid_fusion.h"
-#include "upd/maps/occupancy_grid.h"
 #include "upd/io/ros_map.h"
 
 #include <gtest/gtest.h>
@@ -97,31 +96,6 @@ bool noTemporaryFiles(const TempDir& dir) {
 }
 
 }  // namespace
-
-TEST(OccupancyGrid, NonTraversableCellsAreOccupiedAtTheirPosition) {
-  const TraversabilityGrid g = makeGrid();
-  const mrpt::maps::COccupancyGridMap2D occ = upd::maps::toOccupancyGrid(g);
-  EXPECT_EQ(static_cast<int>(occ.getSizeX()), g.sizeX());
-  EXPECT_EQ(static_cast<int>(occ.getSizeY()), g.sizeY());
-  EXPECT_NEAR(occ.getResolution(), 0.1, 1e-6);
-  EXPECT_NEAR(occ.getXMin(), g.xMin(), 1e-4);
-  EXPECT_NEAR(occ.getYMin(), g.yMin(), 1e-4);
-  EXPECT_GT(occ.getPos(kObsX, kObsY), 0.9f);
-  EXPECT_LT(occ.getPos(kFreeX, kFreeY), 0.3f);
-  EXPECT_NEAR(occ.getPos(kObsX + 0.1, kObsY), 0.5f, 0.01f);  // unknown neighbour
-  EXPECT_NEAR(occ.getPos(-2.0, -5.0), 0.5f, 0.01f);
-  // Exactly one occupied and one free cell.
-  int occupied = 0, free = 0;
-  for (unsigned cy = 0; cy < occ.getSizeY(); ++cy) {
-    for (unsigned cx = 0; cx < occ.getSizeX(); ++cx) {
-      const float p = occ.getCell(static_cast<int>(cx), static_cast<int>(cy));
-      occupied += p > 0.65f ? 1 : 0;
-      free += p < 0.35f ? 1 : 0;
-    }
-  }
-  EXPECT_EQ(occupied, 1);
-  EXPECT_EQ(free, 1);
-}
 
 TEST(RosMap, PgmAndYamlFollowMapServerFormatAndOrientation) {
   const TraversabilityGrid g = makeGrid();

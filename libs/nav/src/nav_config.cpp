@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -91,23 +92,49 @@ NavConfig loadNavConfig(const std::string& robot_ini, const std::string& nav_ini
   return c;
 }
 
+namespace {
+
+// The data directory beside an executable at <exe_dir>: <exe_dir>/../share/upd-nav (installed:
+// <prefix>/bin/upd) and <exe_dir>/../../share/upd-nav (the build tree: build/apps/upd/upd).
+std::vector<fs::path> dataDirsBeside(const fs::path& exe_dir) {
+  return {(exe_dir / ".." / "share" / "upd-nav").lexically_normal(),
+          (exe_dir / ".." / ".." / "share" / "upd-nav").lexically_normal()};
+}
+
+bool holdsConfig(const fs::path& dir) {
+  std::error_code ec;
+  return fs::is_directory(dir / "config", ec);
+}
+
+}  // namespace
+
+std::string defaultDataDir() {
+  if (const char* env = std::getenv("UPD_NAV_DATA_DIR"); env != nullptr && *env != '\0') {
+    if (holdsConfig(env)) return env;
+    throw std::runtime_error(std::string("UPD_NAV_DATA_DIR = ") + env +
+                             " holds no config/ directory");
+  }
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) {
+    throw std::runtime_error("cannot find UPD-Nav's data: /proc/self/exe is unreadable (" +
+                             ec.message() + "); set UPD_NAV_DATA_DIR or pass the config files");
+  }
+  std::string searched;
+  for (const fs::path& dir : dataDirsBeside(exe.parent_path())) {
+    if (holdsConfig(dir)) return dir.string();
+    searched += (searched.empty() ? "" : ", ") + (dir / "config").string();
+  }
+  throw std::runtime_error("cannot find UPD-Nav's config/ directory (looked in " + searched +
+                           "): set UPD_NAV_DATA_DIR to the directory holding it, or pass the "
+                           "config files");
+}
+
 std::string defaultConfigDir() {
   if (const char* env = std::getenv("UPD_CONFIG_DIR"); env != nullptr && *env != '\0') {
     return env;
   }
-  std::error_code ec;
-#ifdef UPD_NAV_SOURCE_CONFIG_DIR
-  if (fs::is_directory(UPD_NAV_SOURCE_CONFIG_DIR, ec)) return UPD_NAV_SOURCE_CONFIG_DIR;
-#endif
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    for (const fs::path& candidate : {exe.parent_path().parent_path() / "config",
-                                      exe.parent_path().parent_path() / "share/upd-nav/config"}) {
-      if (fs::is_directory(candidate, ec)) return candidate.string();
-    }
-  }
-  throw std::runtime_error(
-      "cannot find the config/ directory: set UPD_CONFIG_DIR or pass the config files");
+  return (fs::path(defaultDataDir()) / "config").string();
 }
 
 std::string defaultPtgCacheDir() {

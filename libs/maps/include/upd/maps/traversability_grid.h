@@ -2,8 +2,9 @@
 // traversability evidence, over a bounded area.
 //
 // The grid is data only (like grid_map): named per-cell layers and coordinate conversions.
-// Filling it is integrateScan() (grid_fusion.h), exporting it is grid_export.h and
-// occupancy_grid.h. Cells live in an mrpt::containers::CDynamicGrid (kept out of this header).
+// Filling it is integrateScan() (grid_fusion.h), exporting it is grid_export.h and the MRPT
+// bridge's occupancy_grid.h. Cells live in an mrpt::containers::CDynamicGrid (kept out of this
+// header).
 //
 // Layers of a cell (GridCell, and GridLayer for named access). NaN means "never observed":
 //  - logodds_nontrav: fused log-odds that the cell is non-traversable (rule in fusion.h);

@@ -94,8 +94,12 @@ void forEachNavSection(NavConfig& c, F&& f) {
 /// std::invalid_argument naming the file, section, key and value.
 NavConfig loadNavConfig(const std::string& robot_ini, const std::string& nav_ini);
 
-/// Where the shipped config/ directory is: $UPD_CONFIG_DIR when set, else the source tree's
-/// config/ (compiled in), else config/ beside the executable's parent directory.
+/// UPD-Nav's data directory (config/, samples/; share/README.md): $UPD_NAV_DATA_DIR when set,
+/// else found from the running executable: <prefix>/bin/upd -> <prefix>/share/upd-nav once
+/// installed, build/apps/upd/upd -> build/share/upd-nav in the build tree (the first of the two
+/// that holds a config/ directory). Throws std::runtime_error naming the places searched.
+std::string defaultDataDir();
+/// The shipped configs: $UPD_CONFIG_DIR when set, else defaultDataDir()/config.
 std::string defaultConfigDir();
 /// $XDG_CACHE_HOME/upd-nav/ptg, else $HOME/.cache/upd-nav/ptg, else <temp>/upd-nav-ptg.
 std::string defaultPtgCacheDir();

@@ -9,8 +9,8 @@
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
 
-namespace upd::maps {
+namespace upd::mrptbridge {
 
-mrpt::maps::COccupancyGridMap2D toOccupancyGrid(const TraversabilityGrid& grid);
+mrpt::maps::COccupancyGridMap2D toOccupancyGrid(const maps::TraversabilityGrid& grid);
 
-}  // namespace upd::maps
+}  // namespace upd::mrptbridge

@@ -3,7 +3,8 @@
 // OpenNI2 is used directly (not through MRPT's COpenNI2Sensor, which aborts the process when no
 // device is attached): the constructor enumerates the devices first and fails with one line when
 // there is none. Frames come as z-depth images in metres with the intrinsics derived from the
-// stream's fields of view (camera-optical frame, camera.h).
+// stream's fields of view (camera-optical frame, camera.h). This library is optional: it is
+// built when OpenNI2 is found, and `upd live` reads a camera only then.
 #pragma once
 
 #include "upd/core/camera.h"
@@ -13,7 +14,7 @@
 #include <string>
 #include <vector>
 
-namespace upd::nav {
+namespace upd::openni2 {
 
 struct DepthFrame {
   DepthImage depth;          ///< z-depth [m]; 0 = invalid
@@ -51,4 +52,4 @@ class OpenNI2Camera {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace upd::nav
+}  // namespace upd::openni2

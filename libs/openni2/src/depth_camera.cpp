@@ -1,11 +1,11 @@
-#include "upd/nav/depth_camera.h"
+#include "upd/openni2/depth_camera.h"
 
 #include <OpenNI.h>
 
 #include <cmath>
 #include <stdexcept>
 
-namespace upd::nav {
+namespace upd::openni2 {
 
 DepthFrame decimate(const DepthFrame& frame, int downscale) {
   if (downscale < 1) {
@@ -183,4 +183,4 @@ bool OpenNI2Camera::read(DepthFrame& frame, int timeout_ms) {
   return true;
 }
 
-}  // namespace upd::nav
+}  // namespace upd::openni2

@@ -1,10 +1,10 @@
-#include "upd/maps/occupancy_grid.h"
+#include "upd/mrpt/occupancy_grid.h"
 
 #include <cmath>
 
-namespace upd::maps {
+namespace upd::mrptbridge {
 
-mrpt::maps::COccupancyGridMap2D toOccupancyGrid(const TraversabilityGrid& grid) {
+mrpt::maps::COccupancyGridMap2D toOccupancyGrid(const maps::TraversabilityGrid& grid) {
   const float res = static_cast<float>(grid.cellSize());
   mrpt::maps::COccupancyGridMap2D occ(
       static_cast<float>(grid.xMin()), static_cast<float>(grid.xMax()),
@@ -14,7 +14,7 @@ mrpt::maps::COccupancyGridMap2D toOccupancyGrid(const TraversabilityGrid& grid) 
   // float rounding of the limits cannot shift a cell into its neighbour.
   for (int cy = 0; cy < grid.sizeY(); ++cy) {
     for (int cx = 0; cx < grid.sizeX(); ++cx) {
-      const float p = probabilityOf(grid.at(cx, cy), grid.params());
+      const float p = maps::probabilityOf(grid.at(cx, cy), grid.params());
       if (std::isnan(p)) continue;
       const Eigen::Vector2d c = grid.cellCenter(cx, cy);
       const int ox = static_cast<int>(std::floor((c.x() - occ.getXMin()) / occ.getResolution()));
@@ -25,4 +25,4 @@ mrpt::maps::COccupancyGridMap2D toOccupancyGrid(const TraversabilityGrid& grid) 
   return occ;
 }
 
-}  // namespace upd::maps
+}  // namespace upd::mrptbridge
