@@ -135,6 +135,10 @@ class CellGrid {
   std::uint32_t find(std::int64_t x, std::int64_t y, std::int64_t z) const {
     return keyFits(x, y, z) ? map_.find(packKey(x, y, z)) : kNoIndex;
   }
+  /// The same for coordinates the caller knows to fit the key (no range test).
+  std::uint32_t findFitting(std::int32_t x, std::int32_t y, std::int32_t z) const {
+    return map_.find(packKey(x, y, z));
+  }
 
  private:
   CellMap map_;

@@ -273,15 +273,24 @@ void fillSparseColumns(ScanImages& im, OrganizedBuffers& buf) {
 // scanned every 2nd row and column, one wider than twice that every 4th: a regular sample of
 // its ball, still hundreds of points.
 struct WindowScan {
+  WindowScan(const ScanImages& images, const std::vector<float>& along_u,
+             const std::vector<float>& along_v, double radius_m, std::ptrdiff_t scan_px_)
+      : im(images),
+        pitch_u(along_u),
+        pitch_v(along_v),
+        radius(radius_m),
+        scan_px(scan_px_),
+        radius2(static_cast<float>(radius_m * radius_m)) {}
+
   const ScanImages& im;
   const std::vector<float>& pitch_u;
   const std::vector<float>& pitch_v;
   double radius;
   std::ptrdiff_t scan_px;
+  float radius2;
 
   Moments operator()(std::ptrdiff_t u, std::ptrdiff_t v, std::size_t i) const {
     const auto Wi = static_cast<std::ptrdiff_t>(im.W), Hi = static_cast<std::ptrdiff_t>(im.H);
-    const auto radius2 = static_cast<float>(radius * radius);
     const double angle = std::asin(std::min(1.0, radius / im.range[i]));
     const auto eu = std::min<std::ptrdiff_t>(
         kMaxHalf, static_cast<std::ptrdiff_t>(angle / pitch_u[static_cast<std::size_t>(u)]) + 1);
@@ -552,7 +561,7 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
     out = computeNormalsGrid(cloud, params, up);
     return;
   }
-  const WindowScan scan{im, pitch_u, pitch_v, params.radius_m, params.fast_scan_px};
+  const WindowScan scan(im, pitch_u, pitch_v, params.radius_m, params.fast_scan_px);
   // A normal is computed at the centre of every block of D x D pixels (pass 1). A pixel takes
   // the normal of the nearest block centre on its surface (ranges within max_depth_jump_ratio
   // of each other): its own block's, else the closest in range of the 8 blocks around it; a

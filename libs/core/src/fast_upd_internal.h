@@ -128,7 +128,9 @@ struct Bins {
   CellGrid grid;
   std::vector<CellSums> sums;
 
-  std::uint32_t cellOf(std::int32_t x, std::int32_t y, std::int32_t z) {
+  // Out of line: binRange calls it once per run of points in one cell; inlined there, the fast
+  // UPD ran ~2 % more instructions (callgrind, a full-resolution Kinect frame).
+  __attribute__((noinline)) std::uint32_t cellOf(std::int32_t x, std::int32_t y, std::int32_t z) {
     bool inserted = false;
     const std::uint32_t id = grid.insert(x, y, z, inserted);
     if (inserted) sums.emplace_back();

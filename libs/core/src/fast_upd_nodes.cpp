@@ -266,8 +266,9 @@ void LatticeIndex::around(std::size_t b, const std::vector<CellSums>& sums,
   cells.clear();
   const std::int32_t* xyz = blocks.xyz(b);
   for (int d = 0; d < 27; ++d) {
+    // (Blocks hold B > 1 cells a side: their coordinates and their neighbours' fit the key.)
     const std::uint32_t nb =
-        blocks.find(xyz[0] + d % 3 - 1, xyz[1] + (d / 3) % 3 - 1, xyz[2] + d / 9 - 1);
+        blocks.findFitting(xyz[0] + d % 3 - 1, xyz[1] + (d / 3) % 3 - 1, xyz[2] + d / 9 - 1);
     if (nb == kNoIndex) continue;
     for (std::uint32_t q = block_cells.start[nb]; q < block_cells.start[nb + 1]; ++q) {
       if (sums[block_cells.order[q]].count > 0.f) cells.push_back(block_cells.order[q]);
