@@ -1,6 +1,7 @@
-// Private to the fast paths: integer lattice keys, an open-addressing hash map from a key to a
-// dense index, and on it the one way the core bins points into cubic cells (CellGrid, binCells,
-// listByCell), shared by the fast UPD's lattice, the grid normals and the pre-processing grids.
+// Private to libs/core: integer lattice keys, an open-addressing hash map from a key to a dense
+// index, and on it the one way the core bins points into cubic cells (CellGrid, binCells,
+// listByCell), shared by the fast UPD's lattice, the grid normals, the voxel filter and the
+// outlier filter's grid.
 //
 // std::unordered_map allocates a node per entry and chases a pointer per lookup; the fast
 // paths look up a key per point, so they use a flat table with linear probing instead (keys

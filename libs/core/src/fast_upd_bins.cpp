@@ -1,5 +1,7 @@
 // The fast UPD's first stage: the points binned into the lattice's cells, with per cell the
-// sums the ball sums read (CellSums), in fixed chunks merged in chunk order.
+// sums the ball sums read (CellSums), in fixed chunks merged in chunk order. binRange is
+// binCells (fast_cell_map.h) specialized for the lattice: the cell coordinates of a stripe of
+// points in one vector loop, and the sums of a run of points in one cell added at once.
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>

@@ -14,8 +14,8 @@ void PreprocessParams::validate() const {
                range_min_m, "must be >= 0");
   requireParam(range_max_m > range_min_m, "PreprocessParams", "range_max_m", range_max_m,
                "must be > range_min_m");
-  requireParam((box_max_m - box_min_m).minCoeff() > 0, "PreprocessParams", "box_max_m", box_max_m,
-               "must be > box_min_m on every axis");
+  requireParam((box_max_m - box_min_m).minCoeff() > 0, "PreprocessParams", "box_max_m",
+               box_max_m, "must be > box_min_m on every axis");
   requireParam(std::isfinite(voxel_m) && voxel_m > 0, "PreprocessParams", "voxel_m", voxel_m,
                "must be > 0");
   requireParam(outlier_k >= 1, "PreprocessParams", "outlier_k", outlier_k, "must be >= 1");
@@ -115,9 +115,9 @@ PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
   };
   std::vector<Acc> voxels;
   voxels.reserve(in.size() / 4 + 16);
-  detail::CellGrid grid(in.size() / 4 + 16);
+  detail::CellMap map(in.size() / 4 + 16);
   const bool colour = in.hasColor();
-  std::int64_t last[3] = {0, 0, 0};
+  std::uint64_t last_key = 0;
   Acc* acc = nullptr;  // the voxel of the last point: consecutive points mostly share one
   for (std::size_t i = first; i < in.size(); ++i) {
     if (!in.isFinite(i)) continue;
@@ -130,14 +130,13 @@ PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
           ": the cloud spans more than 2^20 voxels along an axis; use a larger voxel or a "
           "range cut-off");
     }
-    if (acc == nullptr || cx != last[0] || cy != last[1] || cz != last[2]) {
+    const std::uint64_t key = detail::packKey(cx, cy, cz);
+    if (acc == nullptr || key != last_key) {
       bool inserted = false;
-      const std::uint32_t id =
-          grid.insert(static_cast<std::int32_t>(cx), static_cast<std::int32_t>(cy),
-                      static_cast<std::int32_t>(cz), inserted);
+      const std::uint32_t id = map.findOrInsert(key, inserted);
       if (inserted) voxels.emplace_back();
       acc = &voxels[id];
-      last[0] = cx, last[1] = cy, last[2] = cz;
+      last_key = key;
     }
     acc->sum += d;
     ++acc->n;

@@ -217,83 +217,78 @@ double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& fini
   return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
 }
 
-// The k + 1 nearest by the grid, for the points of one cell at a time: every point of a cell is
-// compared with the points of the 27 cells around (gathered once per cell); the answer is exact
-// where the (k + 1)-th distance is within the block's margin. Where it is not (the edge of the
-// data, a lone point), the block grows ring by ring up to kMaxRing; beyond, the point is left
-// to the k-d tree. One per thread.
-class GridNearest {
- public:
-  static constexpr int kMaxRing = 3;
-
-  GridNearest(const PointGrid& g, std::size_t want) : g_(g), best_(want) {}
-
-  // The mean distance to the k nearest of every point of cell c into mean_dist; the points the
-  // grid does not settle go to rest.
-  void cell(std::size_t c, std::vector<double>& mean_dist, std::vector<std::uint32_t>& rest) {
-    const std::int32_t* xyz = g_.cells.xyz(c);
-    const std::int32_t cell[3] = {xyz[0], xyz[1], xyz[2]};
-    shell(cell, 0);
-    ring1_ = around_;
-    shell(cell, 1);
-    ring1_.insert(ring1_.end(), around_.begin(), around_.end());
-    block_.fill(g_, ring1_);
-    bd2_.resize(block_.x.size());
-    for (std::uint32_t q = g_.start[c]; q < g_.start[c + 1]; ++q) {
-      if (!settle(q, cell)) {
-        rest.push_back(g_.index[q]);
-        continue;
+// The k + 1 nearest of every point by the grid g, their mean distance into mean_dist: every
+// point of a cell is compared with the points of the 27 cells around (gathered once per cell);
+// the answer is exact where the (k + 1)-th distance is within the block's margin. Where it is
+// not (the edge of the data, a lone point), the block grows ring by ring up to kMaxRing; the
+// points still unsettled go to rest (the k-d tree's).
+void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>& mean_dist,
+                       std::vector<std::uint32_t>& rest) {
+  constexpr int kMaxRing = 3;
+  const std::size_t n_cells = g.start.size() - 1;
+#pragma omp parallel
+  {
+    NearestK best(want);
+    std::vector<float> d2;
+    std::vector<std::uint32_t> around, ring1;  // cells of a block, of the 3 x 3 x 3 block
+    BlockPoints block;                         // the points of ring1, nearest cells first
+    std::vector<float> bd2;
+    std::vector<std::uint32_t> my_rest;
+    // The cells at Chebyshev distance `ring` from (cx, cy, cz), nearest first: the nearer
+    // points come first, so that NearestK rejects most later ones with one comparison. Ring 0
+    // and 1 make a cell's block (copied once per cell); the outer rings are scanned only for
+    // the few points whose k-th distance the block's margin does not settle.
+    const auto shell = [&](std::int32_t cx, std::int32_t cy, std::int32_t cz, int ring) {
+      around.clear();
+      for (const auto& d : shellOffsets(ring)) {
+        const std::uint32_t c = g.find(cx + d[0], cy + d[1], cz + d[2]);
+        if (c != detail::kNoIndex) around.push_back(c);
       }
-      mean_dist[g_.index[q]] = best_.meanWithoutFirst();
-    }
-  }
-
- private:
-  // The cells at Chebyshev distance `ring` from cell, nearest first: the nearer points come
-  // first, so that NearestK rejects most later ones with one comparison. Ring 0 and 1 make a
-  // cell's block (copied once per cell); the outer rings are scanned only for the few points
-  // whose k-th distance the block's margin does not settle.
-  void shell(const std::int32_t (&cell)[3], int ring) {
-    around_.clear();
-    for (const auto& d : shellOffsets(ring)) {
-      const std::uint32_t c = g_.find(cell[0] + d[0], cell[1] + d[1], cell[2] + d[2]);
-      if (c != detail::kNoIndex) around_.push_back(c);
-    }
-  }
-
-  // The k + 1 nearest of grid point q (of cell `cell`) into best_; false when they are not
-  // settled within kMaxRing rings.
-  bool settle(std::uint32_t q, const std::int32_t (&cell)[3]) {
-    const float qx = g_.x[q], qy = g_.y[q], qz = g_.z[q];
-    best_.clear();
-    // The 3 x 3 x 3 block: its distances in one vector pass, then the nearest kept.
-    distances2(block_.x.data(), block_.y.data(), block_.z.data(), block_.x.size(), qx, qy, qz,
-               bd2_.data());
-    for (std::size_t j = 0; j < block_.n; ++j) best_.offer(bd2_[j]);
-    for (int ring = 1;; ++ring) {
-      const double margin = blockMargin(g_, qx, qy, qz, cell[0], cell[1], cell[2], ring);
-      if (best_.full() && static_cast<double>(best_.worst()) <= margin * margin) return true;
-      if (ring + 1 > kMaxRing) return false;
-      shell(cell, ring + 1);
-      for (const std::uint32_t b : around_) {
-        // A cell whose box lies beyond the k-th distance so far holds none of the k.
-        if (best_.full() && g_.boxDistance2(b, qx, qy, qz) > best_.worst()) continue;
-        const std::size_t n = g_.start[b + 1] - g_.start[b];
-        d2_.resize(std::max(d2_.size(), n));
-        distances2(&g_.x[g_.start[b]], &g_.y[g_.start[b]], &g_.z[g_.start[b]], n, qx, qy, qz,
-                   d2_.data());
-        for (std::size_t j = 0; j < n; ++j) best_.offer(d2_[j]);
+    };
+#pragma omp for schedule(dynamic, 16)
+    for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
+      const auto c = static_cast<std::size_t>(cc);
+      const std::int32_t cx = g.cells.xyz(c)[0], cy = g.cells.xyz(c)[1], cz = g.cells.xyz(c)[2];
+      shell(cx, cy, cz, 0);
+      ring1 = around;
+      shell(cx, cy, cz, 1);
+      ring1.insert(ring1.end(), around.begin(), around.end());
+      block.fill(g, ring1);
+      bd2.resize(block.x.size());
+      for (std::uint32_t q = g.start[c]; q < g.start[c + 1]; ++q) {
+        const float qx = g.x[q], qy = g.y[q], qz = g.z[q];
+        best.clear();
+        // The 3 x 3 x 3 block: its distances in one vector pass, then the nearest kept.
+        distances2(block.x.data(), block.y.data(), block.z.data(), block.x.size(), qx, qy, qz,
+                   bd2.data());
+        for (std::size_t j = 0; j < block.n; ++j) best.offer(bd2[j]);
+        int ring = 1;
+        while (true) {
+          const double margin = blockMargin(g, qx, qy, qz, cx, cy, cz, ring);
+          if (best.full() && static_cast<double>(best.worst()) <= margin * margin) break;
+          if (++ring > kMaxRing) break;
+          shell(cx, cy, cz, ring);
+          for (const std::uint32_t b : around) {
+            // A cell whose box lies beyond the k-th distance so far holds none of the k.
+            if (best.full() && g.boxDistance2(b, qx, qy, qz) > best.worst()) continue;
+            const std::size_t n = g.start[b + 1] - g.start[b];
+            d2.resize(std::max(d2.size(), n));
+            distances2(&g.x[g.start[b]], &g.y[g.start[b]], &g.z[g.start[b]], n, qx, qy, qz,
+                       d2.data());
+            for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
+          }
+        }
+        if (ring > kMaxRing) {
+          my_rest.push_back(g.index[q]);
+          continue;
+        }
+        mean_dist[g.index[q]] = best.meanWithoutFirst();
       }
     }
+#pragma omp critical(upd_outlier_rest)
+    rest.insert(rest.end(), my_rest.begin(), my_rest.end());
   }
-
-  const PointGrid& g_;
-  NearestK best_;
-  std::vector<float> d2_;
-  std::vector<std::uint32_t> around_, ring1_;  // cells of a block, of the 3 x 3 x 3 block
-  BlockPoints block_;                          // the points of ring1_, nearest cells first
-  std::vector<float> bd2_;
-};
+}
 
 // The mean distances of the points `todo` by the k-d tree.
 void kdTreeMeanDistances(const PointCloud& in, int k, const std::vector<std::uint32_t>& todo,
@@ -331,18 +326,7 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
   if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k), g)) {
     rest = finite;
   } else {
-    const std::size_t n_cells = g.start.size() - 1;
-#pragma omp parallel
-    {
-      GridNearest search(g, want);
-      std::vector<std::uint32_t> my_rest;
-#pragma omp for schedule(dynamic, 16)
-      for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
-        search.cell(static_cast<std::size_t>(cc), mean_dist, my_rest);
-      }
-#pragma omp critical(upd_outlier_rest)
-      rest.insert(rest.end(), my_rest.begin(), my_rest.end());
-    }
+    gridMeanDistances(g, want, mean_dist, rest);
   }
   if (!rest.empty()) kdTreeMeanDistances(in, k, rest, mean_dist);
   return mean_dist;
