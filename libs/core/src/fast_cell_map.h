@@ -1,5 +1,7 @@
-// Private to the fast paths: integer lattice keys and an open-addressing hash map from a key
-// to a dense index.
+// Private to libs/core: integer lattice keys, an open-addressing hash map from a key to a dense
+// index, and on it the one way the core bins points into cubic cells (CellGrid, binCells,
+// listByCell), shared by the fast UPD's lattice, the grid normals, the voxel filter and the
+// outlier filter's grid.
 //
 // std::unordered_map allocates a node per entry and chases a pointer per lookup; the fast
 // paths look up a key per point, so they use a flat table with linear probing instead (keys
@@ -9,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -106,5 +109,87 @@ class CellMap {
   int shift_ = 58;
   std::size_t size_ = 0;
 };
+
+/// The occupied cells of an integer lattice: a dense id per cell in order of first sight, and
+/// each cell's coordinates. Coordinates must fit the key (keyFits); find checks it.
+class CellGrid {
+ public:
+  explicit CellGrid(std::size_t expected = 64) : map_(expected) {}
+
+  std::size_t size() const { return map_.size(); }
+  /// Cell coordinates, 3 per cell in id order.
+  const std::vector<std::int32_t>& coords() const { return xyz_; }
+  const std::int32_t* xyz(std::size_t c) const { return &xyz_[3 * c]; }
+  void reserve(std::size_t cells) { xyz_.reserve(3 * cells); }
+
+  /// The id of cell (x, y, z), adding it when new (inserted says so).
+  std::uint32_t insert(std::int32_t x, std::int32_t y, std::int32_t z, bool& inserted) {
+    const std::uint32_t id = map_.findOrInsert(packKey(x, y, z), inserted);
+    if (inserted) xyz_.insert(xyz_.end(), {x, y, z});
+    return id;
+  }
+  std::uint32_t insert(std::int32_t x, std::int32_t y, std::int32_t z) {
+    bool inserted = false;
+    return insert(x, y, z, inserted);
+  }
+  /// The id of cell (x, y, z), or kNoIndex when it is not occupied.
+  std::uint32_t find(std::int64_t x, std::int64_t y, std::int64_t z) const {
+    return keyFits(x, y, z) ? map_.find(packKey(x, y, z)) : kNoIndex;
+  }
+  /// The same for coordinates the caller knows to fit the key (no range test).
+  std::uint32_t findFitting(std::int32_t x, std::int32_t y, std::int32_t z) const {
+    return map_.find(packKey(x, y, z));
+  }
+
+ private:
+  CellMap map_;
+  std::vector<std::int32_t> xyz_;
+};
+
+/// Bins items [begin, end) into grid: coords(i, c) writes item i's cell coordinates to
+/// std::int64_t c[3], or returns false for an item without a cell (cell_of[i] = kNoIndex).
+/// cell_of[i] is then the item's cell id. Returns false, at the first item whose cell lies
+/// beyond the key range, with the items from it on not binned.
+template <class Coords>
+bool binCells(std::size_t begin, std::size_t end, Coords&& coords, CellGrid& grid,
+              std::uint32_t* cell_of) {
+  for (std::size_t i = begin; i < end; ++i) {
+    std::int64_t c[3];
+    if (!coords(i, c)) {
+      cell_of[i] = kNoIndex;
+      continue;
+    }
+    if (!keyFits(c[0], c[1], c[2])) return false;
+    cell_of[i] = grid.insert(static_cast<std::int32_t>(c[0]), static_cast<std::int32_t>(c[1]),
+                             static_cast<std::int32_t>(c[2]));
+  }
+  return true;
+}
+
+/// Items grouped by cell: those of cell c are order[start[c], start[c + 1]), in item order.
+struct CellLists {
+  std::vector<std::uint32_t> start;  ///< n_cells + 1
+  std::vector<std::uint32_t> order;  ///< item indices, grouped by cell
+
+  bool empty(std::size_t c) const { return start[c] == start[c + 1]; }
+};
+
+/// Groups items [0, n_items) by their cell cell(i) in [0, n_cells) (a stable counting sort);
+/// items whose cell is kNoIndex are left out.
+template <class CellOfItem>
+void listByCell(std::size_t n_items, std::size_t n_cells, CellOfItem&& cell, CellLists& out) {
+  out.start.assign(n_cells + 1, 0);
+  for (std::size_t i = 0; i < n_items; ++i) {
+    const std::uint32_t c = cell(i);
+    if (c != kNoIndex) ++out.start[c + 1];
+  }
+  for (std::size_t c = 0; c < n_cells; ++c) out.start[c + 1] += out.start[c];
+  out.order.resize(out.start[n_cells]);
+  std::vector<std::uint32_t> fill(out.start.begin(), out.start.end() - 1);
+  for (std::size_t i = 0; i < n_items; ++i) {
+    const std::uint32_t c = cell(i);
+    if (c != kNoIndex) out.order[fill[c]++] = static_cast<std::uint32_t>(i);
+  }
+}
 
 }  // namespace upd::detail

@@ -1,0 +1,99 @@
+// Private to the fast normals (fast_normals.cpp: the PCA arithmetic and the hash-grid path;
+// fast_normals_organized.cpp: the image-window path): the moments of a neighbourhood, the
+// normal from them, and the vector loop that gathers the moments of the points within a radius.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+
+#include "fast_simd.h"
+#include "upd/core/normals.h"
+
+namespace upd::detail {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+// Coordinate of the invalid pixels in the scanned images: farther than any radius [m].
+constexpr float kFar = 1e18f;
+
+// kScanLanes floats as one GCC vector: the compiler emits AVX-512, AVX2 or SSE code for it in the
+// respective UPD_VECTOR_CLONES version of a function (no intrinsics, no -march).
+constexpr int kScanLanes = 8;
+
+// Moments of a set of points relative to a reference: count, sum q, sum q q^T (upper).
+struct Moments {
+  double n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+};
+
+// The covariance of the moments, scaled to unit trace (a, b, c / d, e / f: its upper triangle),
+// or false when it has no spread.
+bool unitCovariance(const Moments& m, double (&cov)[6]);
+
+// The unoriented PCA normal of a covariance scaled to unit trace (eqs. 4-5) and its curvature,
+// or false for a neighbourhood without a plane (lambda_1 ~ 0, as pcaNormal).
+bool normalFromUnitCovariance(const double (&cov)[6], Eigen::Vector3f& n, float& curvature);
+
+// The same from the moments of a neighbourhood (m.n is the sum of the weights). The caller
+// checks that there are at least 3 points.
+bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature);
+
+// gatedMoments is defined here, static, so that each source calling it gets its own vector
+// clones: the dispatcher GCC emits for a target_clones function must live beside its clones.
+typedef float LaneF __attribute__((vector_size(kScanLanes * sizeof(float))));
+
+inline void loadLanes(LaneF& v, const float* p) { std::memcpy(&v, p, sizeof v); }
+
+// Moments, relative to p, of the points within sqrt(radius2) of p among rows [v0, v1] (every
+// row_step-th) and columns [a0, a1] of the coordinate images (row stride W). Non-finite pixels
+// hold kFar, so they fail the distance test like any far point; the columns read past a1 (a
+// vector at a time) are real points of the cloud or kFar padding, and the ones within the
+// radius are neighbours of p like any other (the window only bounds the ball).
+UPD_VECTOR_CLONES
+static Moments gatedMoments(const float* X, const float* Y, const float* Z, std::size_t W,
+                            std::ptrdiff_t v0, std::ptrdiff_t v1, std::ptrdiff_t a0,
+                            std::ptrdiff_t a1, std::ptrdiff_t row_step, float px, float py,
+                            float pz, float radius2) {
+  const LaneF zero = {}, one = zero + 1.f;
+  LaneF n = zero, sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero,
+        syz = zero, szz = zero;
+  for (std::ptrdiff_t b = v0; b <= v1; b += row_step) {
+    const std::size_t row = static_cast<std::size_t>(b) * W;
+    for (std::ptrdiff_t a = a0; a <= a1; a += kScanLanes) {
+      const std::size_t at = row + static_cast<std::size_t>(a);
+      LaneF x, y, z;
+      loadLanes(x, X + at), loadLanes(y, Y + at), loadLanes(z, Z + at);
+      const LaneF qx = x - px, qy = y - py, qz = z - pz;
+      const LaneF d2 = qx * qx + qy * qy + qz * qz;
+      const LaneF w = d2 <= radius2 ? one : zero;
+      const LaneF cx = w * qx, cy = w * qy, cz = w * qz;
+      n += w, sx += cx, sy += cy, sz += cz;
+      sxx += cx * qx, sxy += cx * qy, sxz += cx * qz, syy += cy * qy, syz += cy * qz,
+          szz += cz * qz;
+    }
+  }
+  const auto total = [](const LaneF& v) {
+    float s[4] = {0, 0, 0, 0};
+    for (int l = 0; l < kScanLanes; ++l) s[l % 4] += v[l];
+    return static_cast<double>((s[0] + s[1]) + (s[2] + s[3]));
+  };
+  Moments m;
+  m.n = total(n), m.x = total(sx), m.y = total(sy), m.z = total(sz);
+  m.xx = total(sxx), m.xy = total(sxy), m.xz = total(sxz);
+  m.yy = total(syy), m.yz = total(syz), m.zz = total(szz);
+  return m;
+}
+
+inline void setUnset(Normals& out, std::size_t i) {
+  out.nx[i] = out.ny[i] = out.nz[i] = out.curvature[i] = kNaN;
+}
+
+inline void setNormal(Normals& out, std::size_t i, const Eigen::Vector3f& n, float curvature) {
+  out.nx[i] = n.x();
+  out.ny[i] = n.y();
+  out.nz[i] = n.z();
+  out.curvature[i] = curvature;
+}
+
+}  // namespace upd::detail

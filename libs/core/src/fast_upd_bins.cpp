@@ -1,0 +1,171 @@
+// The fast UPD's first stage: the points binned into the lattice's cells, with per cell the
+// sums the ball sums read (CellSums), in fixed chunks merged in chunk order. binRange is
+// binCells (fast_cell_map.h) specialized for the lattice: the cell coordinates of a stripe of
+// points in one vector loop, and the sums of a run of points in one cell added at once.
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "fast_upd_internal.h"
+
+namespace upd::detail {
+
+namespace {
+
+// A stripe of points in lattice terms, the first pass of binRange: each point's cell (cx, cy,
+// cz: integers as floats, exact below 2^24; cx = kOutside for a point that is not finite or
+// lies beyond the key range) and its contribution to the CellSums of its cell, in their order
+// (count, normal, position inside the cell, its products), zeros where the normal is invalid.
+constexpr float kOutside = -2.f * kMaxCoord;
+constexpr std::size_t kStripe = 256;
+struct Stripe {
+  float cx[kStripe], cy[kStripe], cz[kStripe];
+  float term[13][kStripe];  // the 13 of CellSums
+};
+
+UPD_VECTOR_CLONES
+void toLattice(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+               const float* __restrict nx, const float* __restrict ny, const float* __restrict nz,
+               const Lattice& lat, std::size_t n, Stripe& __restrict s) {
+  for (std::size_t j = 0; j < n; ++j) {
+    const float gx = lat.gx(x[j]), gy = lat.gy(y[j]), gz = lat.gz(z[j]);
+    // NaN and infinity fail this test too. (& rather than &&, floors as floats, everything
+    // loaded and computed before it is selected: no branch, so the loop vectorizes.)
+    const bool inside =
+        (std::fabs(gx) < kMaxCoord) & (std::fabs(gy) < kMaxCoord) & (std::fabs(gz) < kMaxCoord);
+    const float fx = std::floor(gx), fy = std::floor(gy), fz = std::floor(gz);
+    const float ax = nx[j], ay = ny[j], az = nz[j];
+    const bool valid = ax == ax;
+    const float px = valid ? gx - fx : 0.f, py = valid ? gy - fy : 0.f, pz = valid ? gz - fz : 0.f;
+    s.cx[j] = inside ? fx : kOutside;
+    s.cy[j] = fy, s.cz[j] = fz;
+    auto& t = s.term;
+    t[0][j] = valid ? 1.f : 0.f;
+    t[1][j] = valid ? ax : 0.f, t[2][j] = valid ? ay : 0.f, t[3][j] = valid ? az : 0.f;
+    t[4][j] = px, t[5][j] = py, t[6][j] = pz;
+    t[7][j] = px * px, t[8][j] = px * py, t[9][j] = px * pz, t[10][j] = py * py;
+    t[11][j] = py * pz, t[12][j] = pz * pz;
+  }
+}
+
+// Bins points [begin, end) into b, writing each point's cell (local to b) into cell_of.
+// Consecutive points (image rows, scan lines) mostly share a cell: the sums of such a run are
+// kept in one vector register (a point adds its 13 terms at once) and the hash map is
+// consulted once per change of cell. Returns false when a point lies beyond the lattice's key
+// range (it is left out).
+UPD_VECTOR_CLONES
+bool binRange(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+              std::size_t begin, std::size_t end, Bins& b, std::uint32_t* cell_of) {
+  float lx = kOutside, ly = 0, lz = 0;  // the cell of the run
+  std::uint32_t last = kNoIndex;
+  bool fits = true;
+  float r0 = 0, r1 = 0, r2 = 0, r3 = 0, r4 = 0, r5 = 0, r6 = 0, r7 = 0, r8 = 0, r9 = 0, r10 = 0,
+        r11 = 0, r12 = 0;
+  const auto flush = [&] {
+    if (last != kNoIndex && r0 > 0.f) {
+      b.sums[last].add({r0, r1, r2, r3, r4, r5, r6, r7, r8, r9, r10, r11, r12});
+    }
+    r0 = r1 = r2 = r3 = r4 = r5 = r6 = r7 = r8 = r9 = r10 = r11 = r12 = 0.f;
+  };
+  static thread_local Stripe s;
+  for (std::size_t s0 = begin; s0 < end; s0 += kStripe) {
+    const std::size_t n = std::min(kStripe, end - s0);
+    toLattice(&cloud.x[s0], &cloud.y[s0], &cloud.z[s0], &normals.nx[s0], &normals.ny[s0],
+              &normals.nz[s0], lat, n, s);
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::size_t i = s0 + j;
+      if (s.cx[j] == kOutside) {
+        if (std::isfinite(cloud.x[i]) && std::isfinite(cloud.y[i]) && std::isfinite(cloud.z[i])) {
+          fits = false;
+        }
+        cell_of[i] = kNoIndex;
+        continue;
+      }
+      if (s.cx[j] != lx || s.cy[j] != ly || s.cz[j] != lz) {
+        flush();
+        lx = s.cx[j], ly = s.cy[j], lz = s.cz[j];
+        last = b.cellOf(static_cast<std::int32_t>(lx), static_cast<std::int32_t>(ly),
+                        static_cast<std::int32_t>(lz));
+      }
+      cell_of[i] = last;
+      const auto& t = s.term;
+      r0 += t[0][j], r1 += t[1][j], r2 += t[2][j], r3 += t[3][j], r4 += t[4][j];
+      r5 += t[5][j], r6 += t[6][j], r7 += t[7][j], r8 += t[8][j], r9 += t[9][j];
+      r10 += t[10][j], r11 += t[11][j], r12 += t[12][j];
+    }
+  }
+  flush();
+  return fits;
+}
+
+// Bins the points of every chunk (binRange), then merges the chunks' cells in chunk order;
+// cell_of[i] is then point i's cell in the result.
+Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+               const PointChunks& chunks, double radius_m, std::uint32_t* cell_of) {
+  const auto n_chunks = static_cast<std::ptrdiff_t>(chunks.count);
+  std::vector<Bins> chunk_bins(chunks.count);
+  int all_fit = 1;
+  // Static schedules here and in the later stages: every stage of a frame deals the points out
+  // to the threads in the same contiguous shares, so that a point's data stay in one core's
+  // cache (see copyCloud). Dynamic schedules scattered them, and on a two-vCPU VM a line the
+  // other core has read costs twice as much to write again.
+#pragma omp parallel for schedule(static) reduction(& : all_fit)
+  for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
+    const auto cu = static_cast<std::size_t>(c);
+    all_fit &=
+        binRange(cloud, normals, lat, chunks.begin(cu), chunks.end(cu), chunk_bins[cu], cell_of)
+            ? 1
+            : 0;
+  }
+  if (!all_fit) {
+    throw std::invalid_argument(
+        "UpdParams.radius_m = " + std::to_string(radius_m) +
+        ": the cloud spans more than 2^20 fast-path lattice cells along an axis; use a "
+        "range cut-off, a larger radius or fewer fast_cells_per_radius");
+  }
+  Bins bins = std::move(chunk_bins[0]);
+  std::vector<std::vector<std::uint32_t>> remap(chunks.count);
+  for (std::size_t c = 1; c < chunks.count; ++c) {
+    const Bins& cb = chunk_bins[c];
+    remap[c].resize(cb.sums.size());
+    for (std::size_t j = 0; j < cb.sums.size(); ++j) {
+      const std::int32_t* xyz = cb.grid.xyz(j);
+      const std::uint32_t id = bins.cellOf(xyz[0], xyz[1], xyz[2]);
+      bins.sums[id].add(cb.sums[j]);
+      remap[c][j] = id;
+    }
+  }
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
+    if (c == 0) continue;  // (from 0: the same shares as the binning)
+    const auto cu = static_cast<std::size_t>(c);
+    for (std::size_t i = chunks.begin(cu); i < chunks.end(cu); ++i) {
+      if (cell_of[i] != kNoIndex) cell_of[i] = remap[cu][cell_of[i]];
+    }
+  }
+  return bins;
+}
+
+}  // namespace
+
+Bins binFrame(FastFrame& f) {
+  const double radius_m = f.params.radius_m;
+  Bins bins = binPoints(f.cloud, f.normals, f.lat, f.chunks, radius_m, f.cell_of);
+  // A finer lattice where the points are dense (fast_cells_per_point): the node work grows
+  // with the cells, so it stays a fixed share of the per-point work.
+  if (f.params.fast_cells_per_point > 0) {
+    double valid = 0;
+    for (const CellSums& cs : bins.sums) valid += cs.count;
+    const int finer =
+        finerCellsPerRadius(f.m, bins.sums.size(), valid, f.params.fast_cells_per_point);
+    if (finer > f.m) {
+      f.m = finer;
+      f.lat.inv_cell = static_cast<float>(f.m / radius_m);
+      bins = binPoints(f.cloud, f.normals, f.lat, f.chunks, radius_m, f.cell_of);
+    }
+  }
+  return bins;
+}
+
+}  // namespace upd::detail
