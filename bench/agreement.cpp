@@ -8,12 +8,14 @@
 #include "upd/core/normals.h"
 #include "upd/core/stopwatch.h"
 
+namespace core = upd::core;
+
 namespace upd::bench {
 namespace {
 
 // computeUpd's loop, for the sampled points of ref only.
-void exactUpdAtSamples(const PointCloud& cloud, const KdTree& tree, const Normals& normals,
-                       const UpdParams& params, ExactReference& ref) {
+void exactUpdAtSamples(const core::PointCloud& cloud, const core::KdTree& tree, const core::Normals& normals,
+                       const core::UpdParams& params, ExactReference& ref) {
   const std::size_t n = ref.index.size();
   const auto radius = static_cast<float>(params.radius_m);
 #pragma omp parallel
@@ -42,13 +44,13 @@ void exactUpdAtSamples(const PointCloud& cloud, const KdTree& tree, const Normal
 
 }  // namespace
 
-ExactReference exactReference(const PointCloud& cloud, const PipelineParams& params,
+ExactReference exactReference(const core::PointCloud& cloud, const core::PipelineParams& params,
                               std::size_t max_samples) {
   ExactReference ref;
   const Eigen::Vector3f up = params.unitUp();
-  Stopwatch watch;
-  const KdTree tree(cloud);
-  const Normals normals = computeNormals(cloud, tree, params.normals, up);
+  core::Stopwatch watch;
+  const core::KdTree tree(cloud);
+  const core::Normals normals = core::computeNormals(cloud, tree, params.normals, up);
   ref.normals_ms = watch.elapsedMs();
   std::vector<std::size_t> finite;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
@@ -59,10 +61,10 @@ ExactReference exactReference(const PointCloud& cloud, const PipelineParams& par
       std::max<std::size_t>(1, (finite.size() + max_samples - 1) / max_samples);
   for (std::size_t j = 0; j < finite.size(); j += stride) ref.index.push_back(finite[j]);
   const std::size_t n = ref.index.size();
-  ref.upd = UpdResult::unscored(n);
+  ref.upd = core::UpdResult::unscored(n);
   watch.restart();
   if (stride == 1) {
-    const UpdResult all = computeUpd(cloud, tree, normals, params.upd);
+    const core::UpdResult all = core::computeUpd(cloud, tree, normals, params.upd);
     for (std::size_t q = 0; q < n; ++q) {
       const std::size_t i = ref.index[q];
       ref.upd.rx[q] = all.rx[i], ref.upd.ry[q] = all.ry[i], ref.upd.rz[q] = all.rz[i];
@@ -73,7 +75,7 @@ ExactReference exactReference(const PointCloud& cloud, const PipelineParams& par
   }
   for (std::size_t q = 0; q < n; ++q) ref.upd.invalid += ref.upd.isValid(q) ? 0 : 1;
   ref.upd_ms = watch.elapsedMs();
-  ref.classes = classify(ref.upd, up, params.classify);
+  ref.classes = core::classify(ref.upd, up, params.classify);
   return ref;
 }
 
@@ -91,14 +93,14 @@ json Agreement::toJson() const {
           {"met", met()}};
 }
 
-Agreement agreement(const ExactReference& ref, const UpdResult& fast,
-                    const PipelineParams& params) {
+Agreement agreement(const ExactReference& ref, const core::UpdResult& fast,
+                    const core::PipelineParams& params) {
   Agreement a;
   a.compared = ref.index.size();
   a.finite = ref.finite;
   a.exact_normals_ms = ref.normals_ms;
   a.exact_upd_ms = ref.upd_ms;
-  UpdResult sub;
+  core::UpdResult sub;
   const std::size_t n = ref.index.size();
   sub.rx.resize(n), sub.ry.resize(n), sub.rz.resize(n), sub.zeta.resize(n), sub.k.resize(n);
   for (std::size_t q = 0; q < n; ++q) {
@@ -106,7 +108,7 @@ Agreement agreement(const ExactReference& ref, const UpdResult& fast,
     sub.rx[q] = fast.rx[i], sub.ry[q] = fast.ry[i], sub.rz[q] = fast.rz[i];
     sub.zeta[q] = fast.zeta[i], sub.k[q] = fast.k[i];
   }
-  const Classification cls = classify(sub, params.unitUp(), params.classify);
+  const core::Classification cls = core::classify(sub, params.unitUp(), params.classify);
   double sum = 0, worst = 0;
   std::size_t same = 0;
   for (std::size_t q = 0; q < n; ++q) {

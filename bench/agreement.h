@@ -15,15 +15,15 @@ namespace upd::bench {
 
 struct ExactReference {
   std::vector<std::size_t> index;  // the compared points (all finite points, or a sample)
-  UpdResult upd;                   // exact UPD at those points
-  Classification classes;
+  core::UpdResult upd;                   // exact UPD at those points
+  core::Classification classes;
   double normals_ms = 0, upd_ms = 0;
   std::size_t finite = 0;
 };
 
 /// Exact normals for every point; the exact UPD for every finite point when that is
 /// affordable, else for max_samples evenly spaced finite points.
-ExactReference exactReference(const PointCloud& cloud, const PipelineParams& params,
+ExactReference exactReference(const core::PointCloud& cloud, const core::PipelineParams& params,
                               std::size_t max_samples);
 
 struct Agreement {
@@ -38,7 +38,7 @@ struct Agreement {
 };
 
 /// Compares the UPD of the reference's points in `fast` (any method) with the exact reference.
-Agreement agreement(const ExactReference& ref, const UpdResult& fast,
-                    const PipelineParams& params);
+Agreement agreement(const ExactReference& ref, const core::UpdResult& fast,
+                    const core::PipelineParams& params);
 
 }  // namespace upd::bench

@@ -15,17 +15,17 @@ namespace upd::bench {
 
 /// The pipeline of the frame tables: no pre-processing (every pixel is scored), normals of
 /// 0.05 m, the UPD at d_m.
-PipelineParams frameParams(const Frame& f, double d_m);
+core::PipelineParams frameParams(const Frame& f, double d_m);
 
 /// Each frame on one core and on two, then the peak memory; results gets each frame's last
 /// result (one core) for the agreement table.
 json frameTimingCases(const std::vector<Frame>& frames, const Options& o, Report& report,
-                      std::vector<PipelineResult>& results);
+                      std::vector<core::PipelineResult>& results);
 
 /// The frame pipeline's agreement with the exact path at full resolution, and what the
 /// accuracy settings cost; stored into frame_cases[f]["agreement"] and ["accuracy_settings"].
 void frameAgreementCases(const std::vector<Frame>& frames,
-                         const std::vector<PipelineResult>& results, const Options& o,
+                         const std::vector<core::PipelineResult>& results, const Options& o,
                          Report& report, json& frame_cases);
 
 /// computeNormalsOrganized against PCL's IntegralImageNormalEstimation.
@@ -40,14 +40,14 @@ json growthWithRadiusCases(const Frame& generated, const Options& o, Report& rep
 constexpr double kExactBand = 0.02;
 
 /// Our pipeline at the PCL peer's settings (voxel_m 0: no voxel grid).
-PipelineParams pclSettings(const Eigen::Vector3f& up, double voxel_m, double normal_radius_m,
+core::PipelineParams pclSettings(const Eigen::Vector3f& up, double voxel_m, double normal_radius_m,
                            double d_m);
 
 /// The peer's settings equal to p.
-PeerSettings peerOf(const PipelineParams& p);
+PeerSettings peerOf(const core::PipelineParams& p);
 
 /// Neighbour visits the peer's UPD search would make: its cost, to decide whether to run it.
-double peerCostEstimate(const PointCloud& cloud, const PipelineParams& p);
+double peerCostEstimate(const core::PointCloud& cloud, const core::PipelineParams& p);
 
 /// The Kinect frames voxelized, the LiDAR scan and the corner: ours fast, ours exact, PCL.
 json pclSettingsCases(const std::vector<Frame>& frames, const Options& o, Report& report);

@@ -8,17 +8,19 @@
 #include "cases.h"
 #include "upd/core/fast_normals.h"
 
+namespace core = upd::core;
+
 namespace upd::bench {
 namespace {
 
-json frameTimingCase(const Frame& fr, const Options& o, Report& report, PipelineResult& result) {
+json frameTimingCase(const Frame& fr, const Options& o, Report& report, core::PipelineResult& result) {
   json c = {{"name", fr.name}, {"source", fr.source}};
   if (!fr.available) {
     c["skipped"] = fr.skip_reason;
     std::printf("%-30s skipped: %s\n", fr.name.c_str(), fr.skip_reason.c_str());
     return c;
   }
-  const PipelineParams p = frameParams(fr, 0.5);
+  const core::PipelineParams p = frameParams(fr, 0.5);
   const auto [t1, t2] = timeOneAndTwoCores(fr, p, o.repeats, &result);
   c["points"] = t1.points;
   c["points_scored"] = t1.scored;
@@ -48,13 +50,13 @@ json frameTimingCase(const Frame& fr, const Options& o, Report& report, Pipeline
 // What the labels' agreement costs at full resolution (not a target: the trade-off
 // docs/PERFORMANCE.md discusses): normals per 3 x 3 pixels and exact sums within 0.004 of
 // zeta_min.
-json accuracySettingsCase(const Frame& frame, const PipelineParams& p, const ExactReference& ref,
+json accuracySettingsCase(const Frame& frame, const core::PipelineParams& p, const ExactReference& ref,
                           const Options& o) {
-  PipelineParams accurate = p;
+  core::PipelineParams accurate = p;
   accurate.normals.fast_block_px = 3;
   accurate.upd.fast_exact_band = 0.004;
   omp_set_num_threads(1);
-  PipelineResult ar;
+  core::PipelineResult ar;
   const FrameTiming at = timeFramePipeline(frame, accurate, std::max(3, o.repeats / 3), &ar);
   omp_set_num_threads(2);
   const Agreement aa = agreement(ref, ar.upd, accurate);
@@ -70,9 +72,9 @@ json accuracySettingsCase(const Frame& frame, const PipelineParams& p, const Exa
 }
 
 json radiusCase(const Frame& gen, double dm, const Options& o, Report& report, double& total_ms) {
-  const PipelineParams p = frameParams(gen, dm);
+  const core::PipelineParams p = frameParams(gen, dm);
   omp_set_num_threads(1);
-  PipelineResult r;
+  core::PipelineResult r;
   const FrameTiming t = timeFramePipeline(gen, p, o.repeats, &r);
   total_ms = t.total_ms;
   omp_set_num_threads(2);
@@ -81,7 +83,7 @@ json radiusCase(const Frame& gen, double dm, const Options& o, Report& report, d
   json c = {
       {"d_m", dm}, {"one_core_ms", num(t.total_ms)}, {"stages", t.stages}, {"agreement", a.toJson()}};
   // The peer at its settings on this frame, when it takes less than a few minutes.
-  const PipelineParams ps = pclSettings(gen.up, 0.02, 0.05, dm);
+  const core::PipelineParams ps = pclSettings(gen.up, 0.02, 0.05, dm);
   const double cost = peerCostEstimate(r.cloud, ps);
   double pcl_ms = kNaN;
   if (o.quick) {
@@ -109,8 +111,8 @@ json radiusCase(const Frame& gen, double dm, const Options& o, Report& report, d
 
 }  // namespace
 
-PipelineParams frameParams(const Frame& f, double d_m) {
-  PipelineParams p;
+core::PipelineParams frameParams(const Frame& f, double d_m) {
+  core::PipelineParams p;
   p.up = f.up;
   p.preprocess.disableAll();  // keep the image: every pixel is scored
   p.normals.radius_m = 0.05;
@@ -119,7 +121,7 @@ PipelineParams frameParams(const Frame& f, double d_m) {
 }
 
 json frameTimingCases(const std::vector<Frame>& frames, const Options& o, Report& report,
-                      std::vector<PipelineResult>& results) {
+                      std::vector<core::PipelineResult>& results) {
   printRule();
   std::printf(
       "Frame pipeline, organized 640 x 480, every pixel scored: depth image / organized "
@@ -127,7 +129,7 @@ json frameTimingCases(const std::vector<Frame>& frames, const Options& o, Report
   std::printf("map update: %s\n", mapStageKind());
   printRule();
   json frame_cases = json::array();
-  results.assign(frames.size(), PipelineResult());
+  results.assign(frames.size(), core::PipelineResult());
   for (std::size_t f = 0; f < frames.size(); ++f) {
     frame_cases.push_back(frameTimingCase(frames[f], o, report, results[f]));
   }
@@ -140,14 +142,14 @@ json frameTimingCases(const std::vector<Frame>& frames, const Options& o, Report
 }
 
 void frameAgreementCases(const std::vector<Frame>& frames,
-                         const std::vector<PipelineResult>& results, const Options& o,
+                         const std::vector<core::PipelineResult>& results, const Options& o,
                          Report& report, json& frame_cases) {
   printTitle(
       "Agreement of the frame pipeline with the exact path (same cloud, full "
       "resolution; exact UPD on evenly spaced samples)");
   for (std::size_t f = 0; f < frames.size(); ++f) {
     if (!frames[f].available) continue;
-    const PipelineParams p = frameParams(frames[f], 0.5);
+    const core::PipelineParams p = frameParams(frames[f], 0.5);
     omp_set_num_threads(2);
     const ExactReference ref = exactReference(results[f].cloud, p, o.quick ? 2000 : 12000);
     const Agreement a = agreement(ref, results[f].upd, p);
@@ -174,11 +176,11 @@ json normalsAloneCases(const std::vector<Frame>& frames, const Options& o) {
   for (const Frame& fr : frames) {
     if (!fr.available) continue;
     omp_set_num_threads(1);
-    NormalParams np;
+    core::NormalParams np;
     np.radius_m = 0.05;
     std::size_t valid = 0;
     const double ours = timeMedian(
-        [&] { valid = fr.cloud.size() - computeNormalsOrganized(fr.cloud, np, fr.up).invalid; },
+        [&] { valid = fr.cloud.size() - core::computeNormalsOrganized(fr.cloud, np, fr.up).invalid; },
         o.repeats);
     std::vector<double> pcl_runs;
     std::size_t pcl_valid = 0;

@@ -16,6 +16,8 @@
 #ifdef UPD_BENCH_HAVE_MAPS
 #include "upd/maps/grid_fusion.h"
 #include "upd/maps/traversability_grid.h"
+
+namespace core = upd::core;
 #endif
 
 namespace upd::bench {
@@ -38,9 +40,9 @@ class MapStage {
     grid_.emplace(gp);
 #endif
   }
-  void update(const PipelineResult& r, double time_s) {
+  void update(const core::PipelineResult& r, double time_s) {
     // Into the world frame (upd::transformCloud: vectorized, into the buffers of the last frame).
-    transformCloud(r.cloud, pose_.cast<double>(), world_);
+    core::transformCloud(r.cloud, pose_.cast<double>(), world_);
     const Eigen::Vector3f t = pose_.translation();
 #ifdef UPD_BENCH_HAVE_MAPS
     maps::integrateScan(*grid_, maps::viewPoints(world_, r.classes, &r.upd),
@@ -50,19 +52,19 @@ class MapStage {
     constexpr int kSide = 400;
     counts_.assign(2 * kSide * kSide, 0);
     for (std::size_t i = 0; i < world_.size(); ++i) {
-      const Label l = r.classes.label[i];
-      if (l == Label::Unknown) continue;
+      const core::Label l = r.classes.label[i];
+      if (l == core::Label::Unknown) continue;
       const int cx = static_cast<int>(std::floor((world_.x[i] - t.x()) / 0.05f)) + kSide / 2;
       const int cy = static_cast<int>(std::floor((world_.y[i] - t.y()) / 0.05f)) + kSide / 2;
       if (cx < 0 || cy < 0 || cx >= kSide || cy >= kSide) continue;
-      ++counts_[2 * (cy * kSide + cx) + (l == Label::NonTraversable ? 1 : 0)];
+      ++counts_[2 * (cy * kSide + cx) + (l == core::Label::NonTraversable ? 1 : 0)];
     }
 #endif
   }
 
  private:
   Eigen::Isometry3f pose_;
-  PointCloud world_;
+  core::PointCloud world_;
 #ifdef UPD_BENCH_HAVE_MAPS
   std::optional<maps::TraversabilityGrid> grid_;
   maps::FusionParams fusion_;
@@ -76,20 +78,20 @@ class MapStage {
 // warm, a frame allocates nothing.
 class FrameLoop {
  public:
-  FrameLoop(const Frame& f, const PipelineParams& params)
+  FrameLoop(const Frame& f, const core::PipelineParams& params)
       : f_(f), params_(params), map_(f.pose_world_cloud) {}
 
   // One frame; its timings are kept when record.
   void run(bool record) {
-    const Stopwatch frame;
-    const PointCloud* input = &f_.cloud;
+    const core::Stopwatch frame;
+    const core::PointCloud* input = &f_.cloud;
     if (f_.depth) {
-      depthToCloud(*f_.depth, f_.intrinsics, converted_);
+      core::depthToCloud(*f_.depth, f_.intrinsics, converted_);
       input = &converted_;
     }
     const double t_convert = frame.elapsedMs();
-    runPipeline(*input, params_, r_);
-    const Stopwatch map;
+    core::runPipeline(*input, params_, r_);
+    const core::Stopwatch map;
     map_.update(r_, 0.1 * static_cast<double>(++frames_));
     const double map_time = map.elapsedMs();
     const double t_total = frame.elapsedMs();
@@ -114,14 +116,14 @@ class FrameLoop {
     t.scored = r_.cloud.size() - r_.upd.invalid;
     return t;
   }
-  PipelineResult& result() { return r_; }
+  core::PipelineResult& result() { return r_; }
 
  private:
   const Frame& f_;
-  PipelineParams params_;
+  core::PipelineParams params_;
   MapStage map_;
-  PipelineResult r_;
-  PointCloud converted_;
+  core::PipelineResult r_;
+  core::PointCloud converted_;
   int frames_ = 0;
   std::vector<double> total_, convert_, pre_, normals_, upd_, classify_, map_ms_;
 };
@@ -219,8 +221,8 @@ const char* mapStageKind() {
 #endif
 }
 
-FrameTiming timeFramePipeline(const Frame& f, const PipelineParams& params, int repeats,
-                              PipelineResult* last) {
+FrameTiming timeFramePipeline(const Frame& f, const core::PipelineParams& params, int repeats,
+                              core::PipelineResult* last) {
   FrameLoop loop(f, params);
   for (int run = -1; run < repeats; ++run) {
     std::optional<PinnedToThisCpu> pin;
@@ -232,8 +234,8 @@ FrameTiming timeFramePipeline(const Frame& f, const PipelineParams& params, int 
   return t;
 }
 
-std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const PipelineParams& params,
-                                                       int repeats, PipelineResult* last) {
+std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const core::PipelineParams& params,
+                                                       int repeats, core::PipelineResult* last) {
   FrameLoop one(f, params), two(f, params);
   for (int run = -1; run < repeats; ++run) {
     omp_set_num_threads(1);
@@ -252,7 +254,7 @@ std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const Pip
 double timeMedian(const std::function<void()>& f, int repeats) {
   std::vector<double> v;
   for (int run = -1; run < repeats; ++run) {
-    const Stopwatch watch;
+    const core::Stopwatch watch;
     f();
     if (run >= 0) v.push_back(watch.elapsedMs());
   }

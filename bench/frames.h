@@ -20,9 +20,9 @@ struct Frame {
   std::string name, source;
   bool available = false;
   std::string skip_reason;
-  PointCloud cloud;                 // organized, camera frame
-  std::optional<DepthImage> depth;  // the generated frame starts from its depth image
-  CameraIntrinsics intrinsics;
+  core::PointCloud cloud;                 // organized, camera frame
+  std::optional<core::DepthImage> depth;  // the generated frame starts from its depth image
+  core::CameraIntrinsics intrinsics;
   Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
   Eigen::Isometry3f pose_world_cloud = Eigen::Isometry3f::Identity();
 };
@@ -51,14 +51,14 @@ struct FrameTiming {
 
 /// repeats frames after a warm-up frame, at the current thread count (pinned to one CPU when
 /// that is 1); the last frame's result into *last when given.
-FrameTiming timeFramePipeline(const Frame& f, const PipelineParams& params, int repeats,
-                              PipelineResult* last = nullptr);
+FrameTiming timeFramePipeline(const Frame& f, const core::PipelineParams& params, int repeats,
+                              core::PipelineResult* last = nullptr);
 
 /// The same on one core and on two, frame by frame in turn: on a shared machine whose speed
 /// drifts, both medians then see the same conditions and their ratio is the second core's gain.
-std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const PipelineParams& params,
+std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const core::PipelineParams& params,
                                                        int repeats,
-                                                       PipelineResult* last = nullptr);
+                                                       core::PipelineResult* last = nullptr);
 
 /// Median time of f over repeats runs after one warm-up run [ms].
 double timeMedian(const std::function<void()>& f, int repeats);

@@ -9,6 +9,8 @@
 #include "upd/sim/render.h"
 #include "upd/sim/terrain.h"
 
+namespace core = upd::core;
+
 namespace {
 
 const upd::sim::RenderedScene& frame() {
@@ -17,36 +19,36 @@ const upd::sim::RenderedScene& frame() {
     noise.max_range_m = 5.0;
     return upd::sim::renderScene(upd::sim::makeWorld("mixed").terrain,
                             upd::sim::cameraPoseLookingAt({1.0, 0.3, 0.6}, {4.5, -0.4, 0.0}),
-                            upd::CameraIntrinsics{}, noise, 7);
+                            upd::core::CameraIntrinsics{}, noise, 7);
   }();
   return rs;
 }
 
-const upd::Normals& frameNormals() {
-  static const upd::Normals n = [] {
-    upd::NormalParams p;
+const upd::core::Normals& frameNormals() {
+  static const upd::core::Normals n = [] {
+    upd::core::NormalParams p;
     p.radius_m = 0.05;
-    return upd::computeNormalsOrganized(frame().scene.cloud, p, frame().scene.up);
+    return upd::core::computeNormalsOrganized(frame().scene.cloud, p, frame().scene.up);
   }();
   return n;
 }
 
 void BM_OrganizedNormals(benchmark::State& state) {
-  upd::NormalParams p;
+  upd::core::NormalParams p;
   p.radius_m = 0.05;
   for (auto _ : state) {
     benchmark::DoNotOptimize(
-        upd::computeNormalsOrganized(frame().scene.cloud, p, frame().scene.up));
+        upd::core::computeNormalsOrganized(frame().scene.cloud, p, frame().scene.up));
   }
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().scene.cloud.size()));
 }
 BENCHMARK(BM_OrganizedNormals)->Unit(benchmark::kMillisecond);
 
 void BM_FastUpd(benchmark::State& state) {
-  upd::UpdParams p;
+  upd::core::UpdParams p;
   p.radius_m = static_cast<double>(state.range(0)) / 100.0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(upd::computeUpdFast(frame().scene.cloud, frameNormals(), p));
+    benchmark::DoNotOptimize(upd::core::computeUpdFast(frame().scene.cloud, frameNormals(), p));
   }
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().scene.cloud.size()));
 }
@@ -54,8 +56,8 @@ BENCHMARK(BM_FastUpd)->Arg(25)->Arg(50)->Arg(100)->Arg(200)->Unit(benchmark::kMi
 
 // The exact UPD on a 1-in-16 subsample of the frame (the full frame takes minutes).
 void BM_ExactUpdSubsampled(benchmark::State& state) {
-  upd::PointCloud sub;
-  upd::Normals n;
+  upd::core::PointCloud sub;
+  upd::core::Normals n;
   const auto& c = frame().scene.cloud;
   for (std::size_t i = 0; i < c.size(); i += 16) {
     if (!c.isFinite(i) || !frameNormals().isValid(i)) continue;
@@ -65,10 +67,10 @@ void BM_ExactUpdSubsampled(benchmark::State& state) {
     n.nz.push_back(frameNormals().nz[i]);
     n.curvature.push_back(frameNormals().curvature[i]);
   }
-  const upd::KdTree tree(sub);
-  upd::UpdParams p;
+  const upd::core::KdTree tree(sub);
+  upd::core::UpdParams p;
   p.radius_m = static_cast<double>(state.range(0)) / 100.0;
-  for (auto _ : state) benchmark::DoNotOptimize(upd::computeUpd(sub, tree, n, p));
+  for (auto _ : state) benchmark::DoNotOptimize(upd::core::computeUpd(sub, tree, n, p));
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(sub.size()));
 }
 BENCHMARK(BM_ExactUpdSubsampled)->Arg(25)->Arg(50)->Unit(benchmark::kMillisecond);

@@ -15,11 +15,13 @@
 #include "upd/core/normals.h"
 #include "upd/core/stopwatch.h"
 
+namespace core = upd::core;
+
 namespace upd::bench {
 
 namespace {
 
-pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const PointCloud& in, bool keep_layout) {
+pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const core::PointCloud& in, bool keep_layout) {
   auto out = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   out->points.reserve(in.size());
   for (std::size_t i = 0; i < in.size(); ++i) {
@@ -79,7 +81,7 @@ OrientedNormals peerNormals(const PclCloud::Ptr& scored,
       continue;
     }
     const auto& p = (*scored)[i];
-    out.normal[i] = orientNormal(Eigen::Vector3f(nm.normal_x, nm.normal_y, nm.normal_z),
+    out.normal[i] = core::orientNormal(Eigen::Vector3f(nm.normal_x, nm.normal_y, nm.normal_z),
                                  Eigen::Vector3f(p.x, p.y, p.z), sensor_origin, s.up,
                                  s.vertical_band_rad);
     out.valid[i] = 1;
@@ -88,10 +90,10 @@ OrientedNormals peerNormals(const PclCloud::Ptr& scored,
 }
 
 // The UPD: a second radius search per point (the tree built by NormalEstimation), eqs. 6-8.
-UpdResult peerUpd(const PclCloud& scored, pcl::search::KdTree<pcl::PointXYZ>& tree,
+core::UpdResult peerUpd(const PclCloud& scored, pcl::search::KdTree<pcl::PointXYZ>& tree,
                   const OrientedNormals& normals, const PeerSettings& s) {
   const std::size_t n = scored.size();
-  UpdResult upd;
+  core::UpdResult upd;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   upd.rx.assign(n, nan);
   upd.ry.assign(n, nan);
@@ -125,11 +127,11 @@ UpdResult peerUpd(const PclCloud& scored, pcl::search::KdTree<pcl::PointXYZ>& tr
 
 }  // namespace
 
-PeerResult runPclPipeline(const PointCloud& input, const PeerSettings& s) {
+PeerResult runPclPipeline(const core::PointCloud& input, const PeerSettings& s) {
   const auto cloud = toPcl(input, false);
   PeerResult res;
-  const Stopwatch total;
-  Stopwatch stage;
+  const core::Stopwatch total;
+  core::Stopwatch stage;
   const PclCloud::Ptr scored = voxelGrid(cloud, s);
   res.voxel_ms = stage.elapsedMs();
 
@@ -149,7 +151,7 @@ PeerResult runPclPipeline(const PointCloud& input, const PeerSettings& s) {
   return res;
 }
 
-IntegralPeerResult runPclIntegralNormals(const PointCloud& organized, float max_depth_change_factor,
+IntegralPeerResult runPclIntegralNormals(const core::PointCloud& organized, float max_depth_change_factor,
                                          float normal_smoothing_size) {
   if (!organized.isOrganized()) {
     throw std::invalid_argument("runPclIntegralNormals: the cloud is not organized");
@@ -161,7 +163,7 @@ IntegralPeerResult runPclIntegralNormals(const PointCloud& organized, float max_
   estimator.setNormalSmoothingSize(normal_smoothing_size);
   estimator.setInputCloud(cloud);
   pcl::PointCloud<pcl::Normal> normals;
-  const Stopwatch watch;
+  const core::Stopwatch watch;
   estimator.compute(normals);
   IntegralPeerResult res;
   res.ms = watch.elapsedMs();

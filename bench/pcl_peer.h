@@ -27,14 +27,14 @@ struct PeerSettings {
 
 struct PeerResult {
   double voxel_ms = 0, normals_ms = 0, upd_ms = 0, total_ms = 0;
-  PointCloud cloud;  ///< the cloud PCL scored (after its voxel grid), for comparisons
-  UpdResult upd;     ///< r, zeta and k per point of cloud, as computeUpd defines them
+  core::PointCloud cloud;  ///< the cloud PCL scored (after its voxel grid), for comparisons
+  core::UpdResult upd;     ///< r, zeta and k per point of cloud, as computeUpd defines them
 };
 
 /// Voxel grid (optional), NormalEstimation (KdTreeFLANN radius search, normals oriented by
 /// upd::orientNormal as the UPD needs), then for every point a second radius search summing
 /// the neighbours' normals (eqs. 6-8). Non-finite input points are dropped first (untimed).
-PeerResult runPclPipeline(const PointCloud& input, const PeerSettings& settings);
+PeerResult runPclPipeline(const core::PointCloud& input, const PeerSettings& settings);
 
 struct IntegralPeerResult {
   double ms = 0;          ///< compute() alone
@@ -43,7 +43,7 @@ struct IntegralPeerResult {
 
 /// pcl::IntegralImageNormalEstimation (COVARIANCE_MATRIX, PCL's PCA method) on an organized
 /// cloud, with max_depth_change_factor and normal_smoothing_size as given.
-IntegralPeerResult runPclIntegralNormals(const PointCloud& organized, float max_depth_change_factor,
+IntegralPeerResult runPclIntegralNormals(const core::PointCloud& organized, float max_depth_change_factor,
                                          float normal_smoothing_size);
 
 }  // namespace upd::bench

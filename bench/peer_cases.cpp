@@ -12,6 +12,8 @@
 #include "upd/core/stopwatch.h"
 #include "upd/io/cloud_io.h"
 
+namespace core = upd::core;
+
 namespace upd::bench {
 
 using namespace upd::sim;  // generated worlds, scenes and the depth renderer
@@ -19,18 +21,18 @@ using namespace upd::sim;  // generated worlds, scenes and the depth renderer
 namespace {
 
 // Our exact path, once, single core like the peer, when its neighbour visits are affordable.
-double timeOursExact(const PointCloud& cloud, const PipelineParams& params, double exact_cost,
+double timeOursExact(const core::PointCloud& cloud, const core::PipelineParams& params, double exact_cost,
                      const Options& o) {
   if (exact_cost >= (o.quick ? 3e8 : 3e9)) return kNaN;
-  PipelineParams exact = params;
-  exact.upd.method = UpdMethod::Exact;
-  const Stopwatch watch;
-  const PipelineResult er = runPipeline(cloud, exact);
+  core::PipelineParams exact = params;
+  exact.upd.method = core::UpdMethod::Exact;
+  const core::Stopwatch watch;
+  const core::PipelineResult er = core::runPipeline(cloud, exact);
   return watch.elapsedMs();
 }
 
 // The PCL peer, once, when it takes less than a few minutes; its times into c["pcl"].
-double timePclPeer(const PointCloud& cloud, const PipelineParams& params, double exact_cost,
+double timePclPeer(const core::PointCloud& cloud, const core::PipelineParams& params, double exact_cost,
                    const Options& o, json& c) {
   omp_set_num_threads(1);
   if (o.quick) {
@@ -53,18 +55,18 @@ double timePclPeer(const PointCloud& cloud, const PipelineParams& params, double
 }
 
 // A case with our fast path, our exact path and the PCL peer at identical settings.
-json peerCase(const std::string& name, const std::string& source, const PointCloud& cloud,
-              const PipelineParams& params, const Options& o, int repeats, Report& report,
+json peerCase(const std::string& name, const std::string& source, const core::PointCloud& cloud,
+              const core::PipelineParams& params, const Options& o, int repeats, Report& report,
               bool count_for_speedup_target) {
   json c = {{"name", name},
             {"source", source},
             {"points_in", cloud.size()},
             {"fast_exact_band", params.upd.fast_exact_band}};
   omp_set_num_threads(1);
-  PipelineParams fast = params;
-  fast.upd.method = UpdMethod::Fast;
-  PipelineResult fr;
-  const double ours = timeMedian([&] { fr = runPipeline(cloud, fast); }, repeats);
+  core::PipelineParams fast = params;
+  fast.upd.method = core::UpdMethod::Fast;
+  core::PipelineResult fr;
+  const double ours = timeMedian([&] { fr = core::runPipeline(cloud, fast); }, repeats);
   c["points_scored"] = fr.cloud.size();
   c["ours_fast_ms"] = num(ours);
   c["ours_fast_stages"] = {{"preprocess_ms", fr.timings.preprocess_ms},
@@ -106,8 +108,8 @@ json lidarCase(const Options& o, Report& report) {
     std::printf("lidar fast_gicp: skipped (file not found)\n");
     return {{"name", "lidar fast_gicp d_m 1.0"}, {"skipped", "fast_gicp/251370668.pcd not found"}};
   }
-  const PointCloud lidar = io::readCloud(*path);
-  PipelineParams p = pclSettings(Eigen::Vector3f::UnitZ(), 0.1, 0.5, 1.0);
+  const core::PointCloud lidar = io::readCloud(*path);
+  core::PipelineParams p = pclSettings(Eigen::Vector3f::UnitZ(), 0.1, 0.5, 1.0);
   p.preprocess.range_enabled = true;
   p.preprocess.range_min_m = 1.0;
   p.preprocess.range_max_m = 40.0;
@@ -115,13 +117,13 @@ json lidarCase(const Options& o, Report& report) {
   p.upd.fast_cells_per_radius = 6;
   p.classify.zeta_min = 0.93;
   p.classify.zeta_caution = 0.98;
-  p.classify.max_slope_rad = 20.0 * kDegToRad;
+  p.classify.max_slope_rad = 20.0 * core::kDegToRad;
   p.classify.min_neighbors = 5;
   // The peer has no range filter of its own: it gets the cut cloud.
-  PipelineParams cut = p;
+  core::PipelineParams cut = p;
   cut.preprocess.voxel_enabled = false;
-  const PointCloud in_range = preprocess(lidar, cut.preprocess);
-  PipelineParams rest = p;
+  const core::PointCloud in_range = core::preprocess(lidar, cut.preprocess);
+  core::PipelineParams rest = p;
   rest.preprocess.range_enabled = false;
   return peerCase("lidar fast_gicp d_m 1.0",
                   "../shared/data/fast_gicp/251370668.pcd "
@@ -131,8 +133,8 @@ json lidarCase(const Options& o, Report& report) {
 
 // factor tiles of the rocks tile on a 4-wide grid, 3.05 m apart (the tile is 3 m across): a
 // bigger field of rocks at the same density, so the work per point should stay the same.
-PointCloud rocksField(const Scene& tile, int factor) {
-  PointCloud field;
+core::PointCloud rocksField(const Scene& tile, int factor) {
+  core::PointCloud field;
   field.reserve(tile.cloud.size() * static_cast<std::size_t>(factor));
   for (int t = 0; t < factor; ++t) {
     const float dx = 3.05f * static_cast<float>(t % 4), dy = 3.05f * static_cast<float>(t / 4);
@@ -146,9 +148,9 @@ PointCloud rocksField(const Scene& tile, int factor) {
 
 }  // namespace
 
-PipelineParams pclSettings(const Eigen::Vector3f& up, double voxel_m, double normal_radius_m,
+core::PipelineParams pclSettings(const Eigen::Vector3f& up, double voxel_m, double normal_radius_m,
                            double d_m) {
-  PipelineParams p;
+  core::PipelineParams p;
   p.up = up;
   p.preprocess.disableAll();
   p.preprocess.voxel_enabled = voxel_m > 0;
@@ -162,7 +164,7 @@ PipelineParams pclSettings(const Eigen::Vector3f& up, double voxel_m, double nor
   return p;
 }
 
-PeerSettings peerOf(const PipelineParams& p) {
+PeerSettings peerOf(const core::PipelineParams& p) {
   PeerSettings s;
   s.voxel_enabled = p.preprocess.voxel_enabled;
   s.voxel_m = p.preprocess.voxel_m;
@@ -174,10 +176,10 @@ PeerSettings peerOf(const PipelineParams& p) {
   return s;
 }
 
-double peerCostEstimate(const PointCloud& cloud, const PipelineParams& p) {
-  const PointCloud pre = preprocess(cloud, p.preprocess);
+double peerCostEstimate(const core::PointCloud& cloud, const core::PipelineParams& p) {
+  const core::PointCloud pre = core::preprocess(cloud, p.preprocess);
   if (pre.empty()) return 0;
-  const KdTree tree(pre);
+  const core::KdTree tree(pre);
   std::vector<std::uint32_t> nb;
   double sum = 0;
   const std::size_t step = std::max<std::size_t>(1, pre.size() / 64);
@@ -204,7 +206,7 @@ json pclSettingsCases(const std::vector<Frame>& frames, const Options& o, Report
       peer_cases.push_back({{"name", fr.name + " (voxel 0.02)"}, {"skipped", fr.skip_reason}});
       continue;
     }
-    const PointCloud cloud = fr.depth ? depthToCloud(*fr.depth, fr.intrinsics) : fr.cloud;
+    const core::PointCloud cloud = fr.depth ? core::depthToCloud(*fr.depth, fr.intrinsics) : fr.cloud;
     peer_cases.push_back(peerCase(fr.name + " voxel 0.02", fr.source, cloud,
                                   pclSettings(fr.up, 0.02, 0.05, 0.5), o, o.repeats, report, true));
   }
@@ -228,7 +230,7 @@ json growthWithSizeCases(const Options& o, Report& report) {
   tile_params.noise_m = 0.002;
   const Scene tile = makeScene("rocks", tile_params);
   for (const int factor : {1, 2, 4, 8, 16}) {
-    const PointCloud field = rocksField(tile, factor);
+    const core::PointCloud field = rocksField(tile, factor);
     const int reps = std::max(3, o.repeats / factor);
     json c = peerCase("rocks x" + std::to_string(factor),
                       std::to_string(factor) + " tiles of makeScene(\"rocks\"), 0.02 m grid", field,

@@ -12,6 +12,8 @@
 
 #include "upd/core/stopwatch.h"
 
+namespace core = upd::core;
+
 namespace upd::bench {
 
 double median(std::vector<double> v) {
@@ -40,7 +42,7 @@ double copyBandwidthGBs() {
   std::vector<char> a(n, 1), b(n, 2);
   double best = 0;
   for (int r = 0; r < 5; ++r) {
-    const Stopwatch watch;
+    const core::Stopwatch watch;
     std::memcpy(b.data(), a.data(), n);
     const double s = watch.elapsedMs() / 1e3;
     best = std::max(best, 2.0 * static_cast<double>(n) / s / 1e9);

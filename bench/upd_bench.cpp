@@ -31,6 +31,8 @@
 #include "frames.h"
 #include "report.h"
 
+namespace core = upd::core;
+
 namespace upd::bench {
 namespace {
 
@@ -43,7 +45,7 @@ int run(const Options& o) {
   root["map_stage"] = mapStageKind();
 
   const std::vector<Frame> frames = kinectFrames(o);
-  std::vector<PipelineResult> frame_results;
+  std::vector<core::PipelineResult> frame_results;
   json frame_cases = frameTimingCases(frames, o, report, frame_results);
   if (o.frames_only) {
     root["frames"] = frame_cases;

@@ -28,17 +28,17 @@ struct Agreement {
 
 // The exact UPD (computeUpd's sums) at every stride-th finite point, from exact normals, against
 // the fast UPD at the same points; labels by classify with default parameters.
-inline Agreement agreeWithExact(const PointCloud& cloud, const Normals& exact_normals,
-                                const UpdResult& fast, const UpdParams& p,
+inline Agreement agreeWithExact(const core::PointCloud& cloud, const core::Normals& exact_normals,
+                                const core::UpdResult& fast, const core::UpdParams& p,
                                 const Eigen::Vector3f& up, std::size_t stride) {
-  const KdTree tree(cloud);
+  const core::KdTree tree(cloud);
   std::vector<std::size_t> idx;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (cloud.isFinite(i) && (i % stride) == 0) idx.push_back(i);
   }
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  UpdResult e, f;
-  for (UpdResult* r : {&e, &f}) {
+  core::UpdResult e, f;
+  for (core::UpdResult* r : {&e, &f}) {
     r->rx.assign(idx.size(), nan);
     r->ry = r->rz = r->zeta = r->rx;
     r->k.assign(idx.size(), 0);
@@ -62,8 +62,8 @@ inline Agreement agreeWithExact(const PointCloud& cloud, const Normals& exact_no
     f.rx[q] = fast.rx[i], f.ry[q] = fast.ry[i], f.rz[q] = fast.rz[i];
     f.zeta[q] = fast.zeta[i], f.k[q] = fast.k[i];
   }
-  const Classification ce = classify(e, up, ClassifyParams{});
-  const Classification cf = classify(f, up, ClassifyParams{});
+  const core::Classification ce = core::classify(e, up, core::ClassifyParams{});
+  const core::Classification cf = core::classify(f, up, core::ClassifyParams{});
   Agreement a;
   a.compared = idx.size();
   for (std::size_t q = 0; q < idx.size(); ++q) {

@@ -37,7 +37,7 @@ int runAnalyze(const std::vector<std::string>& argv) {
   if (args.positionals().size() != 1) throw UsageError("expected exactly one INPUT file");
   const std::string input = args.positionals()[0];
 
-  PipelineParams params;
+  core::PipelineParams params;
   if (const auto cfg = args.str("--config")) params = loadRunConfig(*cfg).observer.pipeline;
   if (const auto v = args.number("--radius-m")) params.upd.radius_m = *v;
   if (const auto v = args.number("--normal-radius-m")) params.normals.radius_m = *v;
@@ -50,8 +50,8 @@ int runAnalyze(const std::vector<std::string>& argv) {
   if (const auto v = args.vector3("--up")) params.up = *v;
   params.validate();  // before reading a possibly large file
 
-  const PointCloud cloud = io::readCloud(input);
-  const PipelineResult result = runPipeline(cloud, params);
+  const core::PointCloud cloud = io::readCloud(input);
+  const core::PipelineResult result = core::runPipeline(cloud, params);
   const auto summary = io::summaryJson(result, params, cloud.size());
 
   if (const auto out = args.str("--output")) io::writeScoredPly(*out, result);

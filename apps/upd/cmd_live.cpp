@@ -194,7 +194,7 @@ const nav::FrameEvidence& addFrame(LiveRun& run, const openni2::DepthFrame& raw,
   run.base.readState(s);
   const Eigen::Vector3d xy_yaw(s.pose_world_robot.x_m, s.pose_world_robot.y_m,
                                s.pose_world_robot.yaw_rad);
-  const PointCloud cloud_world = transformCloud(depthToCloud(frame.depth, frame.K),
+  const core::PointCloud cloud_world = core::transformCloud(core::depthToCloud(frame.depth, frame.K),
                                                 sim::bodyPoseFlat(xy_yaw) * run.camera_on_robot);
   const nav::FrameEvidence& ev = run.loop.addFrame(cloud_world, run.base.timeS());
   run.score_ms += ev.score_ms;

@@ -59,10 +59,12 @@ int runNavigate(const std::vector<std::string>& argv) {
   }
   const sim::WorldSpec world = sim::makeWorld(*scenario);  // throws listing the valid names
 
-  const auto config_path =
-      args.str("--config").value_or(nav::defaultConfigDir() + "/dune-kinect.ini");
-  const auto nav_path =
-      args.str("--nav-config").value_or(nav::defaultConfigDir() + "/dune-nav.ini");
+  // The shipped configs are looked up only for the files not given.
+  const auto config_opt = args.str("--config");
+  const auto nav_opt = args.str("--nav-config");
+  const std::string config_path =
+      config_opt ? *config_opt : nav::defaultConfigDir() + "/dune-kinect.ini";
+  const std::string nav_path = nav_opt ? *nav_opt : nav::defaultConfigDir() + "/dune-nav.ini";
   loadRunConfig(config_path);  // the shared robot config, checked strictly as every command does
   nav::NavConfig config = nav::loadNavConfig(config_path, nav_path);
   if (const auto t = args.number("--max-time-s")) {

@@ -43,11 +43,11 @@ struct Printer {
     }
   }
   void angleDeg(const char* key, const double& radians, const char* doc) {
-    (*this)(key, radians * kRadToDeg, doc);
+    (*this)(key, radians * core::kRadToDeg, doc);
   }
   template <class E, std::size_t N>
-  void choice(const char* key, const E& value, const EnumName<E> (&names)[N], const char* doc) {
-    const char* name = enumName(names, value);
+  void choice(const char* key, const E& value, const core::EnumName<E> (&names)[N], const char* doc) {
+    const char* name = core::enumName(names, value);
     (*this)(key, std::string(name != nullptr ? name : "?"), doc);
   }
 };

@@ -15,8 +15,8 @@
 #include "upd/maps/evaluation.h"
 #include "upd/maps/grid_export.h"
 #include "upd/maps/grid_fusion.h"
-#include "upd/mrpt/rawlog_reader.h"
-#include "upd/mrpt/simulated_run.h"
+#include "upd/mrpt_bridge/rawlog_reader.h"
+#include "upd/mrpt_bridge/simulated_run.h"
 
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
@@ -125,8 +125,8 @@ struct Truth {
 Truth loadTruth(const PlaybackOptions& o) {
   Truth t;
   t.path = o.truth_path.value_or("");
-  if (t.path.empty() && fs::exists(mrptbridge::truthMapPath(o.rawlog))) {
-    t.path = mrptbridge::truthMapPath(o.rawlog);
+  if (t.path.empty() && fs::exists(mrpt_bridge::truthMapPath(o.rawlog))) {
+    t.path = mrpt_bridge::truthMapPath(o.rawlog);
   }
   if (!t.path.empty()) t.grid = io::readRosMap(t.path);
   return t;
@@ -218,8 +218,8 @@ class AnnotatedRawlog {
 
   /// The entry's odometry (as an action) and a sensory frame with its observation and the
   /// frame's non-traversable points.
-  void write(const mrptbridge::RawlogEntry& entry, const Eigen::Isometry3d& pose_world_robot,
-             const ScoredFrame& scored);
+  void write(const mrpt_bridge::RawlogEntry& entry, const Eigen::Isometry3d& pose_world_robot,
+             const core::ScoredFrame& scored);
   void commit() {
     out_.close();
     fs::rename(tmp_, path_);
@@ -232,8 +232,8 @@ class AnnotatedRawlog {
   bool committed_ = false;
 };
 
-void AnnotatedRawlog::write(const mrptbridge::RawlogEntry& entry,
-                            const Eigen::Isometry3d& pose_world_robot, const ScoredFrame& scored) {
+void AnnotatedRawlog::write(const mrpt_bridge::RawlogEntry& entry,
+                            const Eigen::Isometry3d& pose_world_robot, const core::ScoredFrame& scored) {
   auto arch = mrpt::serialization::archiveFrom(out_);
   if (entry.odometry_increment) {
     const Eigen::Isometry3d& inc = *entry.odometry_increment;
@@ -250,7 +250,7 @@ void AnnotatedRawlog::write(const mrptbridge::RawlogEntry& entry,
   auto pts = mrpt::maps::CSimplePointsMap::Create();
   const Eigen::Isometry3d robot_world = pose_world_robot.inverse();
   for (std::size_t i = 0; i < scored.size(); ++i) {
-    if (scored.classes.label[i] != Label::NonTraversable) continue;
+    if (scored.classes.label[i] != core::Label::NonTraversable) continue;
     const Eigen::Vector3d p = robot_world * scored.cloud_world.point(i).cast<double>();
     pts->insertPoint(static_cast<float>(p.x()), static_cast<float>(p.y()),
                      static_cast<float>(p.z()));
@@ -265,7 +265,7 @@ void AnnotatedRawlog::write(const mrptbridge::RawlogEntry& entry,
   arch << sf;
 }
 
-void writeFramePly(const fs::path& path, const ScoredFrame& scored) {
+void writeFramePly(const fs::path& path, const core::ScoredFrame& scored) {
   io::ScoredPoints sp;
   const auto& c = scored.cloud_world;
   sp.x = c.x, sp.y = c.y, sp.z = c.z;
@@ -297,7 +297,7 @@ class Progress {
  private:
   bool enabled_;
   std::size_t total_;
-  Stopwatch clock_;
+  core::Stopwatch clock_;
 };
 
 // Sums over the processed frames [ms], reported per frame in summary.json.
@@ -328,15 +328,15 @@ struct Playback {
 };
 
 // Fuses one scored frame into the grid and the tree and adds up its timings.
-void fuseFrame(const RunConfig& config, const mrptbridge::RawlogEntry& entry,
-               const mrptbridge::ObserverResult& res, const Stopwatch& frame_clock,
+void fuseFrame(const RunConfig& config, const mrpt_bridge::RawlogEntry& entry,
+               const mrpt_bridge::ObserverResult& res, const core::Stopwatch& frame_clock,
                Playback& run) {
-  const ScoredFrame& scored = res.scored;
+  const core::ScoredFrame& scored = res.scored;
   const auto view = maps::viewPoints(scored.cloud_world, scored.classes, &scored.upd);
   const double t_s = std::isfinite(entry.timestamp_s) ? entry.timestamp_s
                                                       : static_cast<double>(entry.index);
   const Eigen::Vector2d robot_xy = res.pose_world_robot.translation().head<2>();
-  Stopwatch stage;
+  core::Stopwatch stage;
   maps::integrateScan(run.grid, view, robot_xy, t_s, config.fusion);
   const double grid_ms = stage.elapsedMs();
   stage.restart();
@@ -345,7 +345,7 @@ void fuseFrame(const RunConfig& config, const mrptbridge::RawlogEntry& entry,
   const double octree_ms = stage.elapsedMs();
   const double total_ms = frame_clock.elapsedMs();
 
-  const StageTimings& tm = scored.timings.stages;
+  const core::StageTimings& tm = scored.timings.stages;
   StageSums& s = run.sums;
   s.convert += res.convert_ms;
   s.preprocess += tm.preprocess_ms;
@@ -361,29 +361,29 @@ void fuseFrame(const RunConfig& config, const mrptbridge::RawlogEntry& entry,
 }
 
 // Poses from --poses (a TUM ground truth), else from the rawlog's odometry.
-mrptbridge::RobotPoseTracker poseTracker(const PlaybackOptions& o, const RunConfig& config) {
+mrpt_bridge::RobotPoseTracker poseTracker(const PlaybackOptions& o, const RunConfig& config) {
   if (!o.poses_path) return {};
-  return mrptbridge::RobotPoseTracker(mrptbridge::TumTrajectory::load(*o.poses_path),
+  return mrpt_bridge::RobotPoseTracker(mrpt_bridge::TumTrajectory::load(*o.poses_path),
                                       config.ground_truth);
 }
 
 // Reads every entry, scores the selected ones with a pose and fuses them into the maps.
 void playFrames(const PlaybackOptions& o, const RunConfig& config,
-                mrptbridge::RobotPoseTracker& tracker, Playback& run) {
-  mrptbridge::RawlogReader reader(o.rawlog);  // throws naming the file when missing
+                mrpt_bridge::RobotPoseTracker& tracker, Playback& run) {
+  mrpt_bridge::RawlogReader reader(o.rawlog);  // throws naming the file when missing
   const std::size_t total =
-      (!o.quiet && ::isatty(2)) ? mrptbridge::scanRawlog(o.rawlog).entries : 0;
-  const mrptbridge::UpdObserver observer(config.observer);
+      (!o.quiet && ::isatty(2)) ? mrpt_bridge::scanRawlog(o.rawlog).entries : 0;
+  const mrpt_bridge::UpdObserver observer(config.observer);
   std::optional<AnnotatedRawlog> annotated;
   if (o.output_rawlog) annotated.emplace((o.out_dir / "annotated.rawlog").string());
   Progress progress(!o.quiet, total);
 
-  mrptbridge::RawlogEntry entry;
-  mrptbridge::ObserverResult res;  // reused frame to frame
+  mrpt_bridge::RawlogEntry entry;
+  mrpt_bridge::ObserverResult res;  // reused frame to frame
   while (reader.next(entry)) {
     ++run.read;
     // Every entry updates the pose tracker, so odometry between selected frames is kept.
-    const mrptbridge::RobotPose pose = tracker.update(entry);
+    const mrpt_bridge::RobotPose pose = tracker.update(entry);
     const long idx = static_cast<long>(entry.index);
     if (!o.selected(idx)) {
       ++run.skipped["outside --from/--to/--every"];
@@ -393,7 +393,7 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
       ++run.skipped[pose.missing_reason];
       continue;
     }
-    const Stopwatch frame_clock;
+    const core::Stopwatch frame_clock;
     observer.observe(*entry.observation, pose.pose_world_robot, res);
     if (!res.ok()) {
       ++run.skipped[res.skipped_reason];
@@ -412,7 +412,7 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
   progress.finish();
   if (annotated) annotated->commit();
   for (const auto& [reason, n] : reader.stats().skipped) run.skipped[reason] += n;
-  run.pose_source = mrptbridge::toString(tracker.kind());
+  run.pose_source = mrpt_bridge::toString(tracker.kind());
 }
 
 // Writes every map file into out_dir.
@@ -493,10 +493,10 @@ void printSummary(const PlaybackOptions& o, const json& summary, double toleranc
 }  // namespace
 
 int runPlayback(const std::vector<std::string>& argv) {
-  const Stopwatch wall;
+  const core::Stopwatch wall;
   const PlaybackOptions options = parsePlaybackOptions(argv);
   const RunConfig config = loadRunConfig(options.config_path);
-  mrptbridge::RobotPoseTracker tracker = poseTracker(options, config);
+  mrpt_bridge::RobotPoseTracker tracker = poseTracker(options, config);
   const Truth truth = loadTruth(options);
   fs::create_directories(options.out_dir);
   if (options.ply) fs::create_directories(options.out_dir / "frames");

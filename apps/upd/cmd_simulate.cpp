@@ -5,7 +5,7 @@
 #include "run_config.h"
 
 #include "upd/core/stopwatch.h"
-#include "upd/mrpt/simulated_run.h"
+#include "upd/mrpt_bridge/simulated_run.h"
 #include "upd/sim/terrain.h"
 
 #include <cstdio>
@@ -35,8 +35,8 @@ int runSimulate(const std::vector<std::string>& argv) {
   const int frames = args.integer("--frames").value_or(0);
   if (frames < 0) throw UsageError("option --frames = " + std::to_string(frames) + ": must be >= 0");
   const sim::WorldSpec world = sim::makeWorld(args.str("--world").value_or("mixed"));
-  const Stopwatch watch;
-  const auto s = mrptbridge::simulateRun(world, config.simulation, *out, frames);
+  const core::Stopwatch watch;
+  const auto s = mrpt_bridge::simulateRun(world, config.simulation, *out, frames);
   const double secs = watch.elapsedMs() / 1000.0;
   std::printf("%s: %zu frames over %.1f m (%.0f s of driving) in %.1f s\n  poses: %s\n  truth: %s\n",
               s.rawlog_path.c_str(), s.frames, s.path_length_m, s.duration_s, secs,

@@ -1,12 +1,12 @@
 #include "run_config.h"
 
-#include "upd/mrpt/ini_params.h"
+#include "upd/mrpt_bridge/ini_params.h"
 
 namespace upd::app {
 
 RunConfig loadRunConfig(const std::string& path) {
   RunConfig c;
-  mrptbridge::IniReader ini(path);
+  mrpt_bridge::IniReader ini(path);
   forEachSection(c, [&](const char* name, const char*, auto& params) { ini.read(name, params); });
   ini.checkAllKeysKnown();
   try {

@@ -3,8 +3,8 @@
 #pragma once
 
 #include "upd/core/params.h"
-#include "upd/mrpt/robot_config.h"
-#include "upd/mrpt/upd_observer.h"
+#include "upd/mrpt_bridge/robot_config.h"
+#include "upd/mrpt_bridge/upd_observer.h"
 
 #include <string>
 
@@ -19,7 +19,7 @@ struct EvaluationParams {
   double tolerance_m = 0.5;
 
   void validate() const {
-    requireParam(tolerance_m >= 0, "EvaluationParams", "tolerance_m", tolerance_m, "must be >= 0");
+    core::requireParam(tolerance_m >= 0, "EvaluationParams", "tolerance_m", tolerance_m, "must be >= 0");
   }
   template <class V>
   void visit(V& v) {
@@ -29,18 +29,18 @@ struct EvaluationParams {
 };
 
 struct RunConfig {
-  mrptbridge::ObserverParams observer;  ///< pipeline + how observations become clouds
+  mrpt_bridge::ObserverParams observer;  ///< pipeline + how observations become clouds
   maps::GridParams grid;
   maps::FusionParams fusion;
   maps::OctreeParams octree;
-  mrptbridge::GroundTruthParams ground_truth;
-  mrptbridge::SimulationParams simulation;
+  mrpt_bridge::GroundTruthParams ground_truth;
+  mrpt_bridge::SimulationParams simulation;
   EvaluationParams evaluation;
-  BaselineParams baseline;
+  core::BaselineParams baseline;
 
-  /// Every part of the robot config (mrptbridge::forEachRobotSection's list).
-  mrptbridge::RobotConfigParts parts() {
-    mrptbridge::RobotConfigParts p;
+  /// Every part of the robot config (mrpt_bridge::forEachRobotSection's list).
+  mrpt_bridge::RobotConfigParts parts() {
+    mrpt_bridge::RobotConfigParts p;
     p.pipeline = &observer.pipeline;
     p.baseline = &baseline;
     p.source = &observer.source;
@@ -57,7 +57,7 @@ struct RunConfig {
 /// robot config's list, then the app's own [EvaluationParams].
 template <class F>
 void forEachSection(RunConfig& c, F&& f) {
-  mrptbridge::forEachRobotSection(c.parts(), f);
+  mrpt_bridge::forEachRobotSection(c.parts(), f);
   f("EvaluationParams", "Scoring a map against a ground-truth grid.", c.evaluation);
 }
 

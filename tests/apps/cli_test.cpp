@@ -4,7 +4,7 @@
 #include "run_upd.h"
 #include "test_data.h"
 #include "upd/io/cloud_io.h"
-#include "upd/mrpt/robot_config.h"
+#include "upd/mrpt_bridge/robot_config.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -16,6 +16,8 @@
 #include <memory>
 #include <sys/wait.h>
 #include <utility>
+
+namespace core = upd::core;
 
 namespace upd {
 namespace {
@@ -59,7 +61,7 @@ TEST_F(Cli, EveryGeneratedSceneIsAnalysed) {
     const CmdResult s = runUpd(std::string("scene ") + scene + " --spacing-m 0.03 --noise-m 0.001 " +
                          "--output " + ply);
     ASSERT_EQ(s.exit_code, 0) << s.output;
-    const PointCloud scene_cloud = io::readCloud(ply);
+    const core::PointCloud scene_cloud = io::readCloud(ply);
     const CmdResult a = runUpd("analyze " + ply + " --no-preprocess --output " + path("out.ply") +
                          " --stats-json " + path("out.json"));
     ASSERT_EQ(a.exit_code, 0) << a.output;
@@ -230,14 +232,14 @@ TEST_F(Cli, ParamsIniEnumNamesRoundTrip) {
     text.replace(at, from.size(), to);
   }
   std::ofstream(path("names.ini")) << text;
-  mrptbridge::IniReader reader(path("names.ini"));
-  PipelineParams p;
-  mrptbridge::RobotConfigParts parts;
+  mrpt_bridge::IniReader reader(path("names.ini"));
+  core::PipelineParams p;
+  mrpt_bridge::RobotConfigParts parts;
   parts.pipeline = &p;
-  mrptbridge::readRobotConfig(reader, parts);
-  EXPECT_EQ(p.upd.method, UpdMethod::Exact);
-  EXPECT_EQ(p.normals.weighting, NormalWeighting::Gaussian);
-  EXPECT_DOUBLE_EQ(p.upd.radius_m, UpdParams{}.radius_m);
+  mrpt_bridge::readRobotConfig(reader, parts);
+  EXPECT_EQ(p.upd.method, core::UpdMethod::Exact);
+  EXPECT_EQ(p.normals.weighting, core::NormalWeighting::Gaussian);
+  EXPECT_DOUBLE_EQ(p.upd.radius_m, core::UpdParams{}.radius_m);
   // The docs table shows the names too.
   const CmdResult r = runUpd("params --markdown");
   EXPECT_NE(r.output.find("| `method` | `auto` |"), std::string::npos);

@@ -5,7 +5,7 @@
 #include "temp_dir.h"
 #include "test_data.h"
 #include "upd/maps/traversability_octree.h"
-#include "upd/mrpt/rawlog_reader.h"
+#include "upd/mrpt_bridge/rawlog_reader.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -90,8 +90,8 @@ TEST(Playback, GroundRawlogFloorIsTraversableAtTheRightHeight) {
   EXPECT_EQ(s["grid"]["non_traversable"], 0);  // a flat floor
   EXPECT_TRUE(fs::exists(out / "frames" / "000000.ply"));
   // The annotated rawlog holds the original observation and the UPD point cloud beside it.
-  mrptbridge::RawlogReader reader((out / "annotated.rawlog").string());
-  mrptbridge::RawlogEntry entry;
+  mrpt_bridge::RawlogReader reader((out / "annotated.rawlog").string());
+  mrpt_bridge::RawlogEntry entry;
   std::size_t entries = 0, clouds = 0;
   while (reader.next(entry)) {
     ++entries;

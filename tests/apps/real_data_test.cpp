@@ -15,6 +15,8 @@
 #include <filesystem>
 #include <map>
 
+namespace core = upd::core;
+
 namespace upd {
 namespace {
 
@@ -30,13 +32,13 @@ struct FloorStats {
 // steps are 5 cm there); "obstacles" are points more than 10 cm above it. Open floor: floor
 // points with no obstacle within d_m + the normal radius. Border: floor points within 0.1 m of
 // an obstacle point that stands 10-35 cm above the floor (the foot of a wall or an object).
-FloorStats floorStats(const PipelineResult& r, const PipelineParams& p) {
+FloorStats floorStats(const core::PipelineResult& r, const core::PipelineParams& p) {
   const Eigen::Vector3f up = p.unitUp();
-  const PointCloud& c = r.cloud;
+  const core::PointCloud& c = r.cloud;
   std::map<int, std::size_t> bins;
   for (std::size_t i = 0; i < c.size(); ++i) {
     if (!c.isFinite(i) || !r.normals.isValid(i)) continue;
-    if (r.normals.normal(i).dot(up) < std::cos(15.0 * kDegToRad)) continue;
+    if (r.normals.normal(i).dot(up) < std::cos(15.0 * core::kDegToRad)) continue;
     ++bins[static_cast<int>(std::floor(c.point(i).dot(up) / 0.02))];
   }
   int best = 0;
@@ -45,7 +47,7 @@ FloorStats floorStats(const PipelineResult& r, const PipelineParams& p) {
     if (n > best_n) best = b, best_n = n;
   }
   const double floor_e = (best + 0.5) * 0.02;
-  PointCloud obstacles, feet;
+  core::PointCloud obstacles, feet;
   std::vector<std::size_t> floor;
   for (std::size_t i = 0; i < c.size(); ++i) {
     if (!c.isFinite(i)) continue;
@@ -54,7 +56,7 @@ FloorStats floorStats(const PipelineResult& r, const PipelineParams& p) {
     if (h > 0.10) obstacles.push_back(c.x[i], c.y[i], c.z[i]);
     if (h > 0.10 && h < 0.35) feet.push_back(c.x[i], c.y[i], c.z[i]);
   }
-  const KdTree obstacle_tree(obstacles), feet_tree(feet);
+  const core::KdTree obstacle_tree(obstacles), feet_tree(feet);
   const float clear = static_cast<float>(p.upd.radius_m + p.normals.radius_m);
   FloorStats s;
   std::vector<std::uint32_t> nb;
@@ -63,12 +65,12 @@ FloorStats floorStats(const PipelineResult& r, const PipelineParams& p) {
     obstacle_tree.knnSearch(c.point(i), 1, nb);
     if (nb.empty() || (obstacles.point(nb[0]) - c.point(i)).norm() > clear) {
       ++s.open_floor;
-      s.open_floor_traversable += r.classes.label[i] == Label::Traversable;
+      s.open_floor_traversable += r.classes.label[i] == core::Label::Traversable;
     }
     feet_tree.radiusSearch(c.point(i), 0.1f, nb);
     if (!nb.empty()) {
       ++s.border;
-      s.border_non_traversable += r.classes.label[i] == Label::NonTraversable;
+      s.border_non_traversable += r.classes.label[i] == core::Label::NonTraversable;
     }
   }
   std::printf("floor at %.3f m along up: %zu open-floor points (%.3f traversable), %zu border "
@@ -78,17 +80,17 @@ FloorStats floorStats(const PipelineResult& r, const PipelineParams& p) {
   return s;
 }
 
-PipelineParams kinectParams(const Eigen::Vector3f& up) {
-  PipelineParams p;
+core::PipelineParams kinectParams(const Eigen::Vector3f& up) {
+  core::PipelineParams p;
   p.up = up;
   return p;
 }
 
 TEST(RealData, Office1OpenFloorTraversableBordersNot) {
   UPD_REQUIRE_SHARED_FILE(path, "pcl/office1.pcd");
-  const PointCloud cloud = io::readCloud(path);
-  const PipelineParams p = kinectParams(Eigen::Vector3f(0, -1, 0.01f));  // level camera
-  const PipelineResult r = runPipeline(cloud, p);
+  const core::PointCloud cloud = io::readCloud(path);
+  const core::PipelineParams p = kinectParams(Eigen::Vector3f(0, -1, 0.01f));  // level camera
+  const core::PipelineResult r = core::runPipeline(cloud, p);
   const FloorStats s = floorStats(r, p);
   ASSERT_GT(s.open_floor, 100u);
   ASSERT_GT(s.border, 100u);
@@ -98,10 +100,10 @@ TEST(RealData, Office1OpenFloorTraversableBordersNot) {
 
 TEST(RealData, RegionGrowingOpenFloorTraversableBottlesAndFurnitureBordersNot) {
   UPD_REQUIRE_SHARED_FILE(path, "pcl-data/region_growing_rgb_tutorial.pcd");
-  const PointCloud cloud = io::readCloud(path);
+  const core::PointCloud cloud = io::readCloud(path);
   // The camera looks about 32 deg down: up is the floor normal in the camera frame.
-  const PipelineParams p = kinectParams(Eigen::Vector3f(0.06f, -0.85f, -0.53f));
-  const PipelineResult r = runPipeline(cloud, p);
+  const core::PipelineParams p = kinectParams(Eigen::Vector3f(0.06f, -0.85f, -0.53f));
+  const core::PipelineResult r = core::runPipeline(cloud, p);
   const FloorStats s = floorStats(r, p);
   ASSERT_GT(s.open_floor, 100u);
   ASSERT_GT(s.border, 100u);
@@ -118,7 +120,7 @@ TEST(RealData, EveryOrganizedPcdLoadsAndIsScored) {
   for (const auto& e : std::filesystem::recursive_directory_iterator(dir)) {
     if (e.path().extension() != ".pcd") continue;
     SCOPED_TRACE(e.path().string());
-    PointCloud cloud;
+    core::PointCloud cloud;
     try {
       cloud = io::readCloud(e.path().string());
     } catch (const std::runtime_error& err) {
@@ -134,10 +136,10 @@ TEST(RealData, EveryOrganizedPcdLoadsAndIsScored) {
         {"table_scene_mug_stereo_textured.pcd", {0.02f, -0.84f, -0.55f}},
         {"0000_cloud.pcd", {-1.f, 0.f, 0.f}},  // gravity-aligned, +x down
     };
-    PipelineParams p;
+    core::PipelineParams p;
     const auto up = ups.find(e.path().filename().string());
     if (up != ups.end()) p.up = up->second;
-    const PipelineResult r = runPipeline(cloud, p);
+    const core::PipelineResult r = core::runPipeline(cloud, p);
     const std::size_t valid = r.cloud.size() - r.upd.invalid;
     std::printf("%s: %zu points, %zu scored, %zu traversable, %zu non-traversable\n",
                 e.path().filename().c_str(), cloud.size(), valid, r.classes.traversable,
@@ -158,16 +160,16 @@ TEST(RealData, EveryOrganizedPcdLoadsAndIsScored) {
 // dense frames (fast_cells_per_point) and the normals scan whole windows up to 48 px.
 TEST(RealData, FullResolutionFrameAgreesWithTheExactPath) {
   UPD_REQUIRE_SHARED_FILE(path, "pcl-data/region_growing_rgb_tutorial.pcd");
-  const PointCloud cloud = io::readCloud(path);
-  PipelineParams p;
+  const core::PointCloud cloud = io::readCloud(path);
+  core::PipelineParams p;
   p.up = Eigen::Vector3f(0.06f, -0.85f, -0.53f);
   p.preprocess.disableAll();
   p.normals.radius_m = 0.05;
   p.upd.radius_m = 0.5;
-  const PipelineResult fast = runPipeline(cloud, p);
-  ASSERT_EQ(fast.method, UpdMethod::Fast);
+  const core::PipelineResult fast = core::runPipeline(cloud, p);
+  ASSERT_EQ(fast.method, core::UpdMethod::Fast);
   EXPECT_EQ(fast.fast_cells_per_radius, 8);  // a dense frame: twice fast_cells_per_radius
-  const Normals normals = computeNormals(fast.cloud, KdTree(fast.cloud), p.normals, p.unitUp());
+  const core::Normals normals = core::computeNormals(fast.cloud, core::KdTree(fast.cloud), p.normals, p.unitUp());
   const test::Agreement a =
       test::agreeWithExact(fast.cloud, normals, fast.upd, p.upd, p.unitUp(), 23);
   ASSERT_GT(a.both_valid, 10000u);

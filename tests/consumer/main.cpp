@@ -6,12 +6,14 @@
 #include <cmath>
 #include <cstdio>
 
+namespace core = upd::core;
+
 int main() {
-  upd::PointCloud plane;  // 2 m x 2 m at 2 cm, z = 0
+  upd::core::PointCloud plane;  // 2 m x 2 m at 2 cm, z = 0
   for (int i = 0; i <= 100; ++i) {
     for (int j = 0; j <= 100; ++j) plane.push_back(0.02f * i - 1.f, 0.02f * j - 1.f, 0.f);
   }
-  const upd::PipelineResult res = upd::runPipeline(plane, upd::PipelineParams{});
+  const upd::core::PipelineResult res = upd::core::runPipeline(plane, upd::core::PipelineParams{});
   double zeta_sum = 0;
   std::size_t scored = 0;
   for (std::size_t i = 0; i < res.upd.size(); ++i) {

@@ -13,7 +13,7 @@
 #include <tuple>
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 namespace {
 
 using Cell = std::tuple<std::int64_t, std::int64_t, std::int64_t>;
@@ -123,4 +123,4 @@ TEST(CellBins, EmptyInput) {
 }
 
 }  // namespace
-}  // namespace upd
+}  // namespace upd::core

@@ -21,7 +21,7 @@
 #include "upd/sim/scenes.h"
 #include "upd/sim/terrain.h"
 
-namespace upd {
+namespace upd::core {
 namespace {
 
 using namespace upd::sim;  // generated scenes as test inputs
@@ -404,4 +404,4 @@ TEST(FastPipeline, MethodRuleIsExplicit) {
 }
 
 }  // namespace
-}  // namespace upd
+}  // namespace upd::core

@@ -8,14 +8,16 @@
 #include <cmath>
 #include <stdexcept>
 
+namespace core = upd::core;
+
 namespace {
 
-using upd::FrameScorer;
-using upd::FrameScorerParams;
-using upd::Label;
-using upd::ObstacleDetector;
-using upd::PointCloud;
-using upd::ScoredFrame;
+using upd::core::FrameScorer;
+using upd::core::FrameScorerParams;
+using upd::core::Label;
+using upd::core::ObstacleDetector;
+using upd::core::PointCloud;
+using upd::core::ScoredFrame;
 
 constexpr double kDeg = M_PI / 180.0;
 
@@ -29,8 +31,8 @@ Eigen::Isometry3d pose(double x, double y, double z, double yaw, double pitch = 
 
 // A floor with a 0.3 m step up across it at x = 0.3 m, riser included: traversable and
 // non-traversable points.
-PointCloud floorWithStep() {
-  PointCloud c = upd::test::makePlane(3.0, 0.04);
+core::PointCloud floorWithStep() {
+  core::PointCloud c = upd::test::makePlane(3.0, 0.04);
   const std::size_t floor_points = c.size();
   for (std::size_t i = 0; i < floor_points; ++i) {
     if (c.x[i] > 0.3f) c.z[i] += 0.3f;
@@ -44,20 +46,20 @@ PointCloud floorWithStep() {
 bool sameOrBothNaN(float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); }
 
 TEST(FrameScorer, DetectorNamesParse) {
-  EXPECT_EQ(upd::parseObstacleDetector("upd"), ObstacleDetector::Upd);
-  EXPECT_EQ(upd::parseObstacleDetector("roughness"), ObstacleDetector::Roughness);
-  EXPECT_STREQ(upd::toString(ObstacleDetector::Roughness), "roughness");
-  EXPECT_THROW(upd::parseObstacleDetector("lidar"), std::invalid_argument);
+  EXPECT_EQ(upd::core::parseObstacleDetector("upd"), core::ObstacleDetector::Upd);
+  EXPECT_EQ(upd::core::parseObstacleDetector("roughness"), core::ObstacleDetector::Roughness);
+  EXPECT_STREQ(upd::core::toString(core::ObstacleDetector::Roughness), "roughness");
+  EXPECT_THROW(upd::core::parseObstacleDetector("lidar"), std::invalid_argument);
 }
 
 TEST(FrameScorer, UpMustBeTheWorldsZ) {
-  FrameScorerParams p;
+  core::FrameScorerParams p;
   p.pipeline.up = Eigen::Vector3f(0, 1, 0);
-  EXPECT_THROW(FrameScorer{p}, std::invalid_argument);
+  EXPECT_THROW(core::FrameScorer{p}, std::invalid_argument);
 }
 
 TEST(FrameScorer, EmptyCloudGivesAnEmptyFrame) {
-  const ScoredFrame f = FrameScorer().score(PointCloud{}, pose(1, 2, 0, 0.5));
+  const core::ScoredFrame f = core::FrameScorer().score(core::PointCloud{}, pose(1, 2, 0, 0.5));
   EXPECT_EQ(f.size(), 0u);
   EXPECT_TRUE(f.classes.label.empty());
   EXPECT_TRUE(f.obstacles_world.empty());
@@ -66,13 +68,13 @@ TEST(FrameScorer, EmptyCloudGivesAnEmptyFrame) {
 // A frame loop passes one ScoredFrame: the second frame of the same size allocates no new
 // storage for the results.
 TEST(FrameScorer, SecondFrameOfTheSameSizeReusesTheBuffers) {
-  FrameScorerParams p;
+  core::FrameScorerParams p;
   p.pipeline.preprocess.disableAll();
   p.obstacles_xy = true;
-  const FrameScorer scorer(p);
-  const PointCloud cloud = floorWithStep();
+  const core::FrameScorer scorer(p);
+  const core::PointCloud cloud = floorWithStep();
   for (const Eigen::Isometry3d& t : {pose(3, -2, 0.1, 0.7), Eigen::Isometry3d::Identity()}) {
-    ScoredFrame f;
+    core::ScoredFrame f;
     scorer.score(cloud, t, f);
     ASSERT_EQ(f.size(), cloud.size());
     ASSERT_GT(f.obstacles_world.size(), 0u);
@@ -80,7 +82,7 @@ TEST(FrameScorer, SecondFrameOfTheSameSizeReusesTheBuffers) {
     const float* nx = f.normals_world.nx.data();
     const float* rz = f.upd.rz.data();
     const float* zeta = f.upd.zeta.data();
-    const Label* label = f.classes.label.data();
+    const core::Label* label = f.classes.label.data();
     const float* cost = f.classes.cost.data();
     const auto* obstacles = f.obstacles_world.data();
     scorer.score(cloud, t, f);
@@ -96,14 +98,14 @@ TEST(FrameScorer, SecondFrameOfTheSameSizeReusesTheBuffers) {
 
 // The world output is the cloud-frame scoring (gravity from the pose) moved by the pose.
 TEST(FrameScorer, WorldOutputIsTheCloudFrameScoringMovedByThePose) {
-  const FrameScorerParams p;
+  const core::FrameScorerParams p;
   const Eigen::Isometry3d t = pose(12.0, -3.0, 0.25, 30 * kDeg, 8 * kDeg);
-  const PointCloud cloud = floorWithStep();
-  const ScoredFrame f = FrameScorer(p).score(cloud, t);
+  const core::PointCloud cloud = floorWithStep();
+  const core::ScoredFrame f = core::FrameScorer(p).score(cloud, t);
 
-  upd::PipelineParams in_cloud = p.pipeline;
+  upd::core::PipelineParams in_cloud = p.pipeline;
   in_cloud.up = (t.linear().transpose() * Eigen::Vector3d::UnitZ()).cast<float>();
-  const upd::PipelineResult ref = upd::runPipeline(cloud, in_cloud);
+  const upd::core::PipelineResult ref = upd::core::runPipeline(cloud, in_cloud);
   ASSERT_EQ(f.size(), ref.cloud.size());
   ASSERT_GT(f.size(), 1000u);
   EXPECT_EQ(f.classes.label, ref.classes.label);
@@ -128,20 +130,20 @@ TEST(FrameScorer, WorldOutputIsTheCloudFrameScoringMovedByThePose) {
 
 // Turning the cloud's frame about gravity and moving it far away changes no label.
 TEST(FrameScorer, PoseAboutGravityAndFarAwayChangesNoLabel) {
-  for (const ObstacleDetector d : {ObstacleDetector::Upd, ObstacleDetector::Roughness}) {
-    FrameScorerParams p;
+  for (const core::ObstacleDetector d : {core::ObstacleDetector::Upd, core::ObstacleDetector::Roughness}) {
+    core::FrameScorerParams p;
     p.detector = d;
-    const FrameScorer scorer(p);
-    const PointCloud cloud = floorWithStep();
-    const ScoredFrame a = scorer.score(cloud, Eigen::Isometry3d::Identity());
-    const ScoredFrame b = scorer.score(cloud, pose(5000.0, -7000.0, 40.0, 2.5));
-    ASSERT_EQ(a.size(), b.size()) << upd::toString(d);
-    EXPECT_EQ(a.classes.label, b.classes.label) << upd::toString(d);
-    EXPECT_GT(a.classes.non_traversable, 0u) << upd::toString(d);
+    const core::FrameScorer scorer(p);
+    const core::PointCloud cloud = floorWithStep();
+    const core::ScoredFrame a = scorer.score(cloud, Eigen::Isometry3d::Identity());
+    const core::ScoredFrame b = scorer.score(cloud, pose(5000.0, -7000.0, 40.0, 2.5));
+    ASSERT_EQ(a.size(), b.size()) << upd::core::toString(d);
+    EXPECT_EQ(a.classes.label, b.classes.label) << upd::core::toString(d);
+    EXPECT_GT(a.classes.non_traversable, 0u) << upd::core::toString(d);
   }
 }
 
-double nonTraversableFraction(const ScoredFrame& f) {
+double nonTraversableFraction(const core::ScoredFrame& f) {
   return static_cast<double>(f.classes.non_traversable) / static_cast<double>(f.size());
 }
 
@@ -149,12 +151,12 @@ double nonTraversableFraction(const ScoredFrame& f) {
 // does not.
 TEST(FrameScorer, RoughnessFlagsA20DegRampTheUpdDoesNot) {
   const Eigen::Isometry3d tilt(Eigen::AngleAxisd(20 * kDeg, Eigen::Vector3d::UnitX()));
-  const PointCloud ramp = upd::test::makePlane(4.0, 0.04, tilt);
-  FrameScorerParams p;
-  const ScoredFrame by_upd = FrameScorer(p).score(ramp, Eigen::Isometry3d::Identity());
-  p.detector = ObstacleDetector::Roughness;
+  const core::PointCloud ramp = upd::test::makePlane(4.0, 0.04, tilt);
+  core::FrameScorerParams p;
+  const core::ScoredFrame by_upd = core::FrameScorer(p).score(ramp, Eigen::Isometry3d::Identity());
+  p.detector = core::ObstacleDetector::Roughness;
   p.obstacles_xy = true;
-  const ScoredFrame by_roughness = FrameScorer(p).score(ramp, Eigen::Isometry3d::Identity());
+  const core::ScoredFrame by_roughness = core::FrameScorer(p).score(ramp, Eigen::Isometry3d::Identity());
   EXPECT_LT(nonTraversableFraction(by_upd), 0.05);
   EXPECT_GT(nonTraversableFraction(by_roughness), 0.5);
   EXPECT_EQ(by_roughness.obstacles_world.size(), by_roughness.classes.non_traversable);
@@ -164,10 +166,10 @@ TEST(FrameScorer, RoughnessFlagsA20DegRampTheUpdDoesNot) {
 // The same ramp seen flat from a frame pitched 20 deg: gravity comes from the pose, so the
 // slope is 20 deg and the roughness index flags it too.
 TEST(FrameScorer, GravityComesFromThePose) {
-  const PointCloud flat = upd::test::makePlane(4.0, 0.04);
+  const core::PointCloud flat = upd::test::makePlane(4.0, 0.04);
   const Eigen::Isometry3d pitched = pose(0, 0, 0, 0, 20 * kDeg);
-  FrameScorerParams p;
-  const ScoredFrame f = FrameScorer(p).score(flat, pitched);
+  core::FrameScorerParams p;
+  const core::ScoredFrame f = core::FrameScorer(p).score(flat, pitched);
   std::vector<float> slopes;
   for (const float s : f.classes.slope_rad) {
     if (std::isfinite(s)) slopes.push_back(s);
@@ -175,9 +177,9 @@ TEST(FrameScorer, GravityComesFromThePose) {
   ASSERT_FALSE(slopes.empty());
   std::nth_element(slopes.begin(), slopes.begin() + slopes.size() / 2, slopes.end());
   EXPECT_NEAR(slopes[slopes.size() / 2], 20 * kDeg, 1 * kDeg);
-  p.detector = ObstacleDetector::Roughness;
-  EXPECT_GT(nonTraversableFraction(FrameScorer(p).score(flat, pitched)), 0.5);
-  EXPECT_LT(nonTraversableFraction(FrameScorer(p).score(flat, Eigen::Isometry3d::Identity())),
+  p.detector = core::ObstacleDetector::Roughness;
+  EXPECT_GT(nonTraversableFraction(core::FrameScorer(p).score(flat, pitched)), 0.5);
+  EXPECT_LT(nonTraversableFraction(core::FrameScorer(p).score(flat, Eigen::Isometry3d::Identity())),
             0.05);
 }
 

@@ -6,7 +6,7 @@
 
 #include <algorithm>
 
-namespace upd {
+namespace upd::core {
 namespace {
 
 std::vector<std::uint32_t> bruteRadius(const PointCloud& c, const Eigen::Vector3f& q, float r) {
@@ -87,4 +87,4 @@ TEST(KdTree, DuplicatePointsAndFarFromOrigin) {
 }
 
 }  // namespace
-}  // namespace upd
+}  // namespace upd::core

@@ -13,7 +13,7 @@
 
 #include <cmath>
 
-namespace upd {
+namespace upd::core {
 namespace {
 
 using namespace upd::sim;  // generated scenes as test inputs
@@ -244,4 +244,4 @@ TEST(Upd, RotationAboutUpChangesNothing) {
 }
 
 }  // namespace
-}  // namespace upd
+}  // namespace upd::core

@@ -8,7 +8,7 @@
 
 #include <cmath>
 
-namespace upd {
+namespace upd::core {
 namespace {
 
 using namespace upd::sim;  // generated scenes as test inputs
@@ -208,4 +208,4 @@ INSTANTIATE_TEST_SUITE_P(Scenes, Obstacles,
                          ::testing::Values("step", "stairs", "ditch", "rocks"));
 
 }  // namespace
-}  // namespace upd
+}  // namespace upd::core

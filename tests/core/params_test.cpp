@@ -7,7 +7,7 @@
 #include <cmath>
 #include <iterator>
 
-namespace upd {
+namespace upd::core {
 namespace {
 
 std::string errorOf(const PipelineParams& p) {
@@ -133,4 +133,4 @@ TEST(DegenerateInput, AllNaNOrganizedCloudKeepsLayoutAndCountsEveryPoint) {
 }
 
 }  // namespace
-}  // namespace upd
+}  // namespace upd::core

@@ -11,7 +11,7 @@
 #include "upd/core/preprocess.h"
 #include "upd/sim/scenes.h"
 
-namespace upd {
+namespace upd::core {
 namespace {
 
 using namespace upd::sim;  // generated scenes as test inputs
@@ -224,9 +224,9 @@ TEST(Preprocess, RangeCutIntoReusedBuffersEqualsTheCopyingPath) {
 }
 
 }  // namespace
-}  // namespace upd
+}  // namespace upd::core
 
-namespace upd {
+namespace upd::core {
 namespace {
 
 // transformCloud and rotateVectors equal Eigen's per-point products; NaN stays NaN; the layout,
@@ -268,4 +268,4 @@ TEST(PointCloud, TransformAndRotateEqualEigenPerPoint) {
 }
 
 }  // namespace
-}  // namespace upd
+}  // namespace upd::core

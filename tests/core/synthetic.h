@@ -10,9 +10,9 @@
 namespace upd::test {
 
 /// A square plane z = 0 of side size_m sampled every spacing_m, then rotated and translated.
-inline PointCloud makePlane(double size_m, double spacing_m,
+inline core::PointCloud makePlane(double size_m, double spacing_m,
                             const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity()) {
-  PointCloud c;
+  core::PointCloud c;
   const int n = static_cast<int>(std::lround(size_m / spacing_m)) + 1;
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < n; ++j) {
@@ -27,11 +27,11 @@ inline PointCloud makePlane(double size_m, double spacing_m,
 }
 
 /// Uniform random points in a box with a bumpy surface: irregular density for search tests.
-inline PointCloud makeRandomCloud(std::size_t n, std::uint32_t seed, float extent = 2.f) {
+inline core::PointCloud makeRandomCloud(std::size_t n, std::uint32_t seed, float extent = 2.f) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(-extent, extent);
   std::normal_distribution<float> g(0.f, 0.05f);
-  PointCloud c;
+  core::PointCloud c;
   for (std::size_t i = 0; i < n; ++i) {
     const float x = u(rng), y = u(rng);
     c.push_back(x, y, 0.2f * std::sin(2.f * x) * std::cos(3.f * y) + g(rng));
@@ -39,8 +39,8 @@ inline PointCloud makeRandomCloud(std::size_t n, std::uint32_t seed, float exten
   return c;
 }
 
-inline PointCloud transformed(const PointCloud& in, const Eigen::Isometry3d& T) {
-  PointCloud out = in;
+inline core::PointCloud transformed(const core::PointCloud& in, const Eigen::Isometry3d& T) {
+  core::PointCloud out = in;
   for (std::size_t i = 0; i < in.size(); ++i) {
     if (!in.isFinite(i)) continue;
     const Eigen::Vector3d p = T * in.point(i).cast<double>();

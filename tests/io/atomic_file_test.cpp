@@ -13,6 +13,8 @@
 #include <sstream>
 #include <string>
 
+namespace core = upd::core;
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -94,7 +96,7 @@ TEST(AtomicFile, MissingDirectoryIsNamed) {
       if (k == 0) {
         upd::io::writeFileAtomically(f, [](std::ostream& os) { os << "x"; });
       } else {
-        upd::PointCloud c;
+        upd::core::PointCloud c;
         c.push_back(1, 2, 3);
         upd::io::writePly(f, c);
       }

@@ -16,11 +16,13 @@
 #include <sstream>
 #include <string>
 
+namespace core = upd::core;
+
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using upd::Label;
+using upd::core::Label;
 
 const float kNan = std::numeric_limits<float>::quiet_NaN();
 
@@ -39,8 +41,8 @@ std::size_t sumCounts(const json& h) {
 }
 
 /// A hand-made result: 6 points in the scored cloud, one of them non-finite, two without zeta.
-upd::PipelineResult handMadeResult() {
-  upd::PipelineResult r;
+upd::core::PipelineResult handMadeResult() {
+  upd::core::PipelineResult r;
   r.cloud.push_back(0, 0, 0);
   r.cloud.push_back(1, 0, 0);
   r.cloud.push_back(2, 0, 0);
@@ -51,8 +53,8 @@ upd::PipelineResult handMadeResult() {
   r.upd.rx = r.upd.ry = std::vector<float>(6, 0.f);
   r.upd.rz = {1, 1, 1, 1, kNan, kNan};
   r.upd.invalid = 2;
-  r.classes.label = {Label::Traversable, Label::NonTraversable, Label::NonTraversable,
-                     Label::Traversable, Label::Unknown, Label::Unknown};
+  r.classes.label = {core::Label::Traversable, core::Label::NonTraversable, core::Label::NonTraversable,
+                     core::Label::Traversable, core::Label::Unknown, core::Label::Unknown};
   r.classes.cost = {0.f, 1.f, 1.f, 0.f, kNan, kNan};
   r.preprocess_stats.points_in = 10;
   r.preprocess_stats.non_finite = 4;  // 3 dropped, 1 kept in the scored cloud
@@ -66,8 +68,8 @@ upd::PipelineResult handMadeResult() {
 }
 
 TEST(JsonIo, SummaryHasTheRequiredKeysAndConsistentCounts) {
-  const upd::PipelineResult r = handMadeResult();
-  upd::PipelineParams p;
+  const upd::core::PipelineResult r = handMadeResult();
+  upd::core::PipelineParams p;
   p.upd.radius_m = 0.75;
   const json j = upd::io::summaryJson(r, p, 10);
 
@@ -117,22 +119,22 @@ struct FieldCounter {
   }
   void angleDeg(const char*, double&, const char*) { ++n; }
   template <class E, std::size_t N>
-  void choice(const char*, E&, const upd::EnumName<E> (&)[N], const char*) {
+  void choice(const char*, E&, const upd::core::EnumName<E> (&)[N], const char*) {
     ++n;
   }
 };
 
 TEST(JsonIo, ParamsUseIniKeysAndDegrees) {
-  upd::PipelineParams p;
+  upd::core::PipelineParams p;
   p.up = Eigen::Vector3f(0, -1, 0);
-  p.classify.max_slope_rad = 30.0 * upd::kDegToRad;
+  p.classify.max_slope_rad = 30.0 * upd::core::kDegToRad;
   p.preprocess.voxel_m = 0.05;
   const json j = upd::io::paramsJson(p);
   EXPECT_EQ(j["up"], json::array({0.0, -1.0, 0.0}));
   EXPECT_NEAR(j["classify"]["max_slope_deg"].get<double>(), 30.0, 1e-9);
   EXPECT_FALSE(j["classify"].contains("max_slope_rad"));
   EXPECT_NEAR(j["normals"]["vertical_band_deg"].get<double>(),
-              upd::NormalParams{}.vertical_band_rad * upd::kRadToDeg, 1e-9);
+              upd::core::NormalParams{}.vertical_band_rad * upd::core::kRadToDeg, 1e-9);
   EXPECT_DOUBLE_EQ(j["preprocess"]["voxel_m"].get<double>(), 0.05);
   EXPECT_EQ(j["preprocess"]["voxel_enabled"], true);
   EXPECT_EQ(j["upd"]["min_neighbors"], p.upd.min_neighbors);
@@ -142,7 +144,7 @@ TEST(JsonIo, ParamsUseIniKeysAndDegrees) {
   // Vector fields print as their float value, not its double expansion.
   EXPECT_EQ(j["preprocess"]["box_min_m"], json::array({-10.0, -10.0, -10.0}));
   // Every field of every struct is there: count them against the structs' own visit().
-  upd::PipelineParams q = p;
+  upd::core::PipelineParams q = p;
   FieldCounter pre, nor, up, cla;
   q.preprocess.visit(pre);
   q.normals.visit(nor);
@@ -155,8 +157,8 @@ TEST(JsonIo, ParamsUseIniKeysAndDegrees) {
 }
 
 TEST(JsonIo, EmptyResultHasNullStatisticsAndNoNan) {
-  const upd::PipelineResult r;
-  const upd::PipelineParams p;
+  const upd::core::PipelineResult r;
+  const upd::core::PipelineParams p;
   const json j = upd::io::summaryJson(r, p, 0);
   EXPECT_EQ(j["points_scored"], 0);
   EXPECT_EQ(j["points_invalid"], 0);
@@ -168,9 +170,9 @@ TEST(JsonIo, EmptyResultHasNullStatisticsAndNoNan) {
 }
 
 TEST(JsonIo, NonFiniteNumbersBecomeNull) {
-  upd::PipelineResult r = handMadeResult();
+  upd::core::PipelineResult r = handMadeResult();
   r.timings.total_ms = std::numeric_limits<double>::infinity();
-  upd::PipelineParams p;
+  upd::core::PipelineParams p;
   p.upd.radius_m = std::numeric_limits<double>::quiet_NaN();  // invalid, but must not leak
   const json j = upd::io::summaryJson(r, p, 10);
   EXPECT_TRUE(j["timing_ms"]["total"].is_null());
@@ -190,7 +192,7 @@ TEST(JsonIo, HistogramEdgesAndClamping) {
 TEST(JsonIo, SummaryOfARealPipelineRun) {
   // A 1 m x 1 m floor with a 0.2 m step (and its riser) in the middle, plus one NaN point
   // kept (no pre-processing) so it is scored as invalid and counted.
-  upd::PointCloud cloud;
+  upd::core::PointCloud cloud;
   std::mt19937 rng(3);
   std::normal_distribution<float> noise(0.f, 0.001f);
   for (int i = 0; i < 40; ++i) {
@@ -207,10 +209,10 @@ TEST(JsonIo, SummaryOfARealPipelineRun) {
     }
   }
   cloud.push_back(kNan, kNan, kNan);
-  upd::PipelineParams p;
+  upd::core::PipelineParams p;
   p.preprocess.disableAll();
   p.upd.radius_m = 0.2;
-  const upd::PipelineResult r = upd::runPipeline(cloud, p);
+  const upd::core::PipelineResult r = upd::core::runPipeline(cloud, p);
   const json j = upd::io::summaryJson(r, p, cloud.size());
   EXPECT_EQ(j["points_in"], cloud.size());
   const std::size_t scored = j["points_scored"];
@@ -231,17 +233,17 @@ TEST(JsonIo, SummaryOfARealPipelineRun) {
   EXPECT_EQ(j["lattice_cells_per_radius"], r.fast_cells_per_radius);
   EXPECT_GE(r.fast_cells_per_radius, p.upd.fast_cells_per_radius);
   // With the band, the points near zeta_min that got the exact sums are counted.
-  upd::PipelineParams banded = p;
+  upd::core::PipelineParams banded = p;
   banded.upd.fast_exact_band = 0.05;
-  const upd::PipelineResult rb = upd::runPipeline(cloud, banded);
+  const upd::core::PipelineResult rb = upd::core::runPipeline(cloud, banded);
   const json jb = upd::io::summaryJson(rb, banded, cloud.size());
   std::size_t near = 0;
   for (const float z : r.upd.zeta) near += std::abs(z - banded.classify.zeta_min) < 0.05 ? 1 : 0;
   EXPECT_GT(near, 0u);
   EXPECT_EQ(jb["exact_band"]["points"], near);
   EXPECT_EQ(jb["exact_band"]["band"], 0.05);
-  p.upd.method = upd::UpdMethod::Exact;
-  const json exact = upd::io::summaryJson(upd::runPipeline(cloud, p), p, cloud.size());
+  p.upd.method = upd::core::UpdMethod::Exact;
+  const json exact = upd::io::summaryJson(upd::core::runPipeline(cloud, p), p, cloud.size());
   EXPECT_EQ(exact["method"], "exact");
   EXPECT_EQ(exact["normals_method"], "exact (k-d tree)");
   EXPECT_FALSE(exact.contains("exact_band"));

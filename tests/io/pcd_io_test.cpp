@@ -17,10 +17,12 @@
 #include <sstream>
 #include <string>
 
+namespace core = upd::core;
+
 namespace {
 
 namespace fs = std::filesystem;
-using upd::PointCloud;
+using upd::core::PointCloud;
 
 using upd::test::TempDir;
 
@@ -40,7 +42,7 @@ std::string errorOf(const std::string& path) {
   return "";
 }
 
-bool anyColour(const PointCloud& c) {
+bool anyColour(const core::PointCloud& c) {
   for (std::size_t i = 0; i < c.size(); ++i) {
     if (c.r[i] != 0 || c.g[i] != 0 || c.b[i] != 0) return true;
   }
@@ -49,7 +51,7 @@ bool anyColour(const PointCloud& c) {
 
 TEST(PcdShared, Office1OrganizedWithColour) {
   UPD_REQUIRE_SHARED_FILE(f, "pcl/office1.pcd");
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   EXPECT_TRUE(c.isOrganized());
   EXPECT_EQ(c.width, 640u);
   EXPECT_EQ(c.height, 480u);
@@ -71,7 +73,7 @@ TEST(PcdShared, Office1OrganizedWithColour) {
 
 TEST(PcdShared, RegionGrowingTutorial) {
   UPD_REQUIRE_SHARED_FILE(f, "pcl-data/region_growing_rgb_tutorial.pcd");
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   EXPECT_TRUE(c.isOrganized());
   EXPECT_EQ(c.width, 640u);
   EXPECT_EQ(c.height, 480u);
@@ -82,7 +84,7 @@ TEST(PcdShared, RegionGrowingTutorial) {
 
 TEST(PcdShared, TableSceneMugRgba) {
   UPD_REQUIRE_SHARED_FILE(f, "pcl/table_scene_mug_stereo_textured.pcd");
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   EXPECT_TRUE(c.isOrganized());
   EXPECT_EQ(c.size(), 640u * 480u);
   EXPECT_EQ(c.countFinite(), 209280u);
@@ -92,7 +94,7 @@ TEST(PcdShared, TableSceneMugRgba) {
 
 TEST(PcdShared, StairPerceptionBinaryRgba) {
   UPD_REQUIRE_SHARED_FILE(f, "stair-perception/0000_cloud.pcd");
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   EXPECT_TRUE(c.isOrganized());
   EXPECT_EQ(c.width, 512u);
   EXPECT_EQ(c.height, 424u);
@@ -103,7 +105,7 @@ TEST(PcdShared, StairPerceptionBinaryRgba) {
 
 TEST(PcdShared, FastGicpLidarWithIntensity) {
   UPD_REQUIRE_SHARED_FILE(f, "fast_gicp/251370668.pcd");
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   EXPECT_FALSE(c.isOrganized());
   EXPECT_EQ(c.size(), 69088u);
   EXPECT_EQ(c.width, 69088u);
@@ -118,7 +120,7 @@ TEST(PcdShared, FastGicpLidarWithIntensity) {
 
 TEST(PcdShared, Samp11Terrain) {
   UPD_REQUIRE_SHARED_FILE(f, "pcl-data/samp11-utm.pcd");
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   EXPECT_EQ(c.size(), 38010u);
   EXPECT_EQ(c.countFinite(), 38010u);
   EXPECT_FALSE(c.hasColor());
@@ -197,7 +199,7 @@ TEST(PcdIo, AsciiPcdWithViewpointAndDoubleCoordinates) {
              "0.5 1.5 2.5 9\n"
              "nan nan nan 0\n"
              "-1 -2 -3 4\n");
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   ASSERT_EQ(c.size(), 3u);
   EXPECT_FALSE(c.hasColor());
   EXPECT_EQ(c.x[0], 0.5f);
@@ -233,7 +235,7 @@ TEST(PcdIo, DamagedAsciiPcdFailsInsteadOfReadingZero) {
 
 TEST(PcdIo, WriteReadRoundTripOrganizedWithColour) {
   TempDir dir;
-  PointCloud c;
+  core::PointCloud c;
   c.resizeOrganized(4, 3);
   c.r.assign(12, 0);
   c.g.assign(12, 0);
@@ -250,7 +252,7 @@ TEST(PcdIo, WriteReadRoundTripOrganizedWithColour) {
   c.sensor_origin = Eigen::Vector3f(0.5f, -1.f, 2.f);
   const std::string f = dir.file("round.pcd");
   upd::io::writePcd(f, c);
-  const PointCloud back = upd::io::readCloud(f);
+  const core::PointCloud back = upd::io::readCloud(f);
   ASSERT_EQ(back.size(), 12u);
   EXPECT_EQ(back.width, 4u);
   EXPECT_EQ(back.height, 3u);
@@ -269,11 +271,11 @@ TEST(PcdIo, WriteReadRoundTripOrganizedWithColour) {
     EXPECT_EQ(back.b[i], c.b[i]);
   }
 
-  PointCloud plain;
+  core::PointCloud plain;
   plain.push_back(1, 2, 3);
   plain.push_back(4, 5, 6);
   upd::io::writePcd(f, plain);  // overwrites atomically
-  const PointCloud p = upd::io::readPcd(f);
+  const core::PointCloud p = upd::io::readPcd(f);
   ASSERT_EQ(p.size(), 2u);
   EXPECT_FALSE(p.hasColor());
   EXPECT_FALSE(p.isOrganized());

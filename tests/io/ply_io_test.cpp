@@ -17,11 +17,13 @@
 #include <string>
 #include <vector>
 
+namespace core = upd::core;
+
 namespace {
 
 namespace fs = std::filesystem;
-using upd::Label;
-using upd::PointCloud;
+using upd::core::Label;
+using upd::core::PointCloud;
 
 /// A fresh directory per test, removed afterwards.
 using upd::test::TempDir;
@@ -54,11 +56,11 @@ T loadLittleEndian(const std::string& bytes, std::size_t at) {
   return v;
 }
 
-PointCloud randomCloud(std::size_t n, bool color, std::uint32_t seed) {
+core::PointCloud randomCloud(std::size_t n, bool color, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> coord(-50.f, 50.f);
   std::uniform_int_distribution<int> byte(0, 255);
-  PointCloud c;
+  core::PointCloud c;
   for (std::size_t i = 0; i < n; ++i) {
     if (color) {
       c.push_back(coord(rng), coord(rng), coord(rng), static_cast<std::uint8_t>(byte(rng)),
@@ -85,7 +87,7 @@ std::vector<std::string> headerLines(const std::string& bytes, std::size_t* body
   return lines;
 }
 
-void expectSameCloud(const PointCloud& a, const PointCloud& b) {
+void expectSameCloud(const core::PointCloud& a, const core::PointCloud& b) {
   ASSERT_EQ(a.size(), b.size());
   ASSERT_EQ(a.hasColor(), b.hasColor());
   for (std::size_t i = 0; i < a.size(); ++i) {
@@ -115,10 +117,10 @@ void expectErrorContaining(Fn fn, const std::vector<std::string>& parts) {
 
 TEST(PlyIo, BinaryRoundTripWithoutColour) {
   TempDir dir;
-  const PointCloud c = randomCloud(100000, false, 1);  // more than one writer/reader chunk
+  const core::PointCloud c = randomCloud(100000, false, 1);  // more than one writer/reader chunk
   const std::string f = dir.file("plain.ply");
   upd::io::writePly(f, c);
-  const PointCloud back = upd::io::readPly(f);
+  const core::PointCloud back = upd::io::readPly(f);
   expectSameCloud(c, back);
   EXPECT_FALSE(back.isOrganized());
   EXPECT_EQ(back.width, c.size());
@@ -127,9 +129,9 @@ TEST(PlyIo, BinaryRoundTripWithoutColour) {
 
 TEST(PlyIo, BinaryRoundTripWithColourAndLabels) {
   TempDir dir;
-  const PointCloud c = randomCloud(777, true, 2);
-  std::vector<Label> labels(c.size());
-  for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = static_cast<Label>(i % 3);
+  const core::PointCloud c = randomCloud(777, true, 2);
+  std::vector<core::Label> labels(c.size());
+  for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = static_cast<core::Label>(i % 3);
   const std::string f = dir.file("labelled.PLY");  // upper-case extension dispatches too
   upd::io::writePly(f, c, &labels);
 
@@ -152,14 +154,14 @@ TEST(PlyIo, BinaryRoundTripWithColourAndLabels) {
 
 TEST(PlyIo, NanPointsAreKeptUnlessDropped) {
   TempDir dir;
-  PointCloud c;
+  core::PointCloud c;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   c.push_back(1, 2, 3);
   c.push_back(nan, nan, nan);
   c.push_back(4, 5, 6);
   const std::string kept = dir.file("kept.ply");
   upd::io::writePly(kept, c);
-  const PointCloud a = upd::io::readPly(kept);
+  const core::PointCloud a = upd::io::readPly(kept);
   ASSERT_EQ(a.size(), 3u);
   EXPECT_TRUE(std::isnan(a.x[1]));
 
@@ -168,7 +170,7 @@ TEST(PlyIo, NanPointsAreKeptUnlessDropped) {
   opt.comments = {"made by a test\nwith a newline"};
   const std::string dropped = dir.file("dropped.ply");
   upd::io::writePly(dropped, c, nullptr, opt);
-  const PointCloud b = upd::io::readPly(dropped);
+  const core::PointCloud b = upd::io::readPly(dropped);
   ASSERT_EQ(b.size(), 2u);
   EXPECT_EQ(b.x[1], 4.f);
   const auto h = headerLines(readBytes(dropped));
@@ -177,8 +179,8 @@ TEST(PlyIo, NanPointsAreKeptUnlessDropped) {
 
 TEST(PlyIo, WritePlyRejectsWrongLabelCount) {
   TempDir dir;
-  const PointCloud c = randomCloud(5, false, 3);
-  const std::vector<Label> labels(4, Label::Traversable);
+  const core::PointCloud c = randomCloud(5, false, 3);
+  const std::vector<core::Label> labels(4, core::Label::Traversable);
   EXPECT_THROW(upd::io::writePly(dir.file("x.ply"), c, &labels), std::invalid_argument);
   EXPECT_FALSE(fs::exists(dir.file("x.ply")));
 }
@@ -212,7 +214,7 @@ TEST(PlyIo, ReadsHandWrittenAsciiWithOtherElementsAndLists) {
              "1 2 -8 3 0 0 0 0\n"
              "-0.5 0.125 9 1e-3 255 128 1 1 9\n"
              "3 0 1 2\n");
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   ASSERT_EQ(c.size(), 3u);
   ASSERT_TRUE(c.hasColor());
   EXPECT_FLOAT_EQ(c.x[0], 0.25f);
@@ -300,7 +302,7 @@ TEST(PlyIo, ReadsHandWrittenBigEndian) {
   TempDir dir;
   const std::string f = dir.file("be.ply");
   writeBytes(f, bigEndianPly());
-  const PointCloud c = upd::io::readPly(f);
+  const core::PointCloud c = upd::io::readPly(f);
   ASSERT_EQ(c.size(), 2u);
   ASSERT_TRUE(c.hasColor());
   EXPECT_EQ(c.x[0], 1.5f);
@@ -343,7 +345,7 @@ TEST(PlyIo, VertexElementWithListPropertyLittleEndian) {
   }
   const std::string f = dir.file("vlist.ply");
   writeBytes(f, s);
-  const PointCloud c = upd::io::readPly(f);
+  const core::PointCloud c = upd::io::readPly(f);
   ASSERT_EQ(c.size(), 3u);
   EXPECT_FALSE(c.hasColor());
   for (int i = 0; i < 3; ++i) {
@@ -394,19 +396,19 @@ TEST(PlyIo, MalformedHeadersFailCleanly) {
 TEST(PlyIo, EmptyCloudRoundTrips) {
   TempDir dir;
   const std::string f = dir.file("empty.ply");
-  upd::io::writePly(f, PointCloud{});
+  upd::io::writePly(f, core::PointCloud{});
   EXPECT_TRUE(upd::io::readPly(f).empty());
 }
 
 TEST(ScoredPly, HeaderListsExactlyThePropertiesInOrder) {
   TempDir dir;
-  const PointCloud c = randomCloud(4, true, 5);
+  const core::PointCloud c = randomCloud(4, true, 5);
   const std::vector<float> nx = {0, 0, 0, 0}, ny = {0, 0, 0, 0}, nz = {1, 1, 1, 1};
   const std::vector<float> rx = {0.1f, 0.2f, 0.3f, 0.4f}, ry = {0, 0, 0, 0},
                            rz = {3, 3, 3, std::numeric_limits<float>::quiet_NaN()};
   const std::vector<float> zeta = {1.f, 0.99f, 0.8f, std::numeric_limits<float>::quiet_NaN()};
-  const std::vector<Label> label = {Label::Traversable, Label::Traversable, Label::NonTraversable,
-                                    Label::Unknown};
+  const std::vector<core::Label> label = {core::Label::Traversable, core::Label::Traversable, core::Label::NonTraversable,
+                                    core::Label::Unknown};
   const std::vector<float> cost = {0.f, 0.5f, 1.f, std::numeric_limits<float>::quiet_NaN()};
   upd::io::ScoredPoints p;
   p.x = c.x;
@@ -488,7 +490,7 @@ TEST(ScoredPly, HeaderListsExactlyThePropertiesInOrder) {
 
 TEST(ScoredPly, AbsentViewsAreNanAndUnknownAndNoColour) {
   TempDir dir;
-  const PointCloud c = randomCloud(3, false, 6);
+  const core::PointCloud c = randomCloud(3, false, 6);
   upd::io::ScoredPoints p;
   p.x = c.x;
   p.y = c.y;
@@ -504,12 +506,12 @@ TEST(ScoredPly, AbsentViewsAreNanAndUnknownAndNoColour) {
   ASSERT_EQ(bytes.size(), body + 3 * stride);
   EXPECT_TRUE(std::isnan(loadLittleEndian<float>(bytes, body + 12)));  // nx
   EXPECT_TRUE(std::isnan(loadLittleEndian<float>(bytes, body + 36)));  // zeta
-  EXPECT_EQ(static_cast<unsigned char>(bytes[body + 40]), static_cast<unsigned>(Label::Unknown));
+  EXPECT_EQ(static_cast<unsigned char>(bytes[body + 40]), static_cast<unsigned>(core::Label::Unknown));
 }
 
 TEST(ScoredPly, InconsistentSizesAreRejectedNamingTheField) {
   TempDir dir;
-  const PointCloud c = randomCloud(3, true, 7);
+  const core::PointCloud c = randomCloud(3, true, 7);
   const std::vector<float> zeta(2, 1.f);
   upd::io::ScoredPoints p;
   p.x = c.x;
@@ -530,7 +532,7 @@ TEST(ScoredPly, InconsistentSizesAreRejectedNamingTheField) {
 
 TEST(ScoredPly, FromPipelineResult) {
   TempDir dir;
-  upd::PipelineResult r;
+  upd::core::PipelineResult r;
   r.cloud = randomCloud(5, false, 8);
   r.normals.nx.assign(5, 0.f);
   r.normals.ny.assign(5, 0.f);
@@ -539,7 +541,7 @@ TEST(ScoredPly, FromPipelineResult) {
   r.upd.ry.assign(5, 0.f);
   r.upd.rz.assign(5, 5.f);
   r.upd.zeta.assign(5, 1.f);
-  r.classes.label.assign(5, Label::NonTraversable);
+  r.classes.label.assign(5, core::Label::NonTraversable);
   r.classes.cost.assign(5, 1.f);
   const std::string f = dir.file("result.ply");
   upd::io::writeScoredPly(f, r);
@@ -550,7 +552,7 @@ TEST(ScoredPly, FromPipelineResult) {
   ASSERT_EQ(bytes.size(), body + 5 * 45);
   EXPECT_EQ(loadLittleEndian<float>(bytes, body + 32), 5.f);  // rz
   EXPECT_EQ(static_cast<unsigned char>(bytes[body + 40]),
-            static_cast<unsigned>(Label::NonTraversable));
+            static_cast<unsigned>(core::Label::NonTraversable));
   expectSameCloud(r.cloud, upd::io::readPly(f));
 }
 

@@ -10,6 +10,8 @@
 #include <iterator>
 #include <string>
 
+namespace core = upd::core;
+
 namespace upd::io {
 namespace {
 
@@ -25,8 +27,8 @@ RosMap sample() {
   m.width = 3;
   m.height = 2;
   // Bottom row (iy = 0) then the top row.
-  m.labels = {Label::Traversable,    Label::NonTraversable, Label::Unknown,
-              Label::NonTraversable, Label::Traversable,    Label::Traversable};
+  m.labels = {core::Label::Traversable,    core::Label::NonTraversable, core::Label::Unknown,
+              core::Label::NonTraversable, core::Label::Traversable,    core::Label::Traversable};
   return m;
 }
 
@@ -59,12 +61,12 @@ TEST(RosMap, RoundTripAndLabelsOfWorldPositions) {
   EXPECT_DOUBLE_EQ(r.resolution_m, 0.05);
   EXPECT_TRUE(r.origin_xy.isApprox(m.origin_xy));
   EXPECT_EQ(r.labels, m.labels);
-  EXPECT_EQ(r.labelAt(-0.97, 2.02), Label::Traversable);     // cell (0, 0)
-  EXPECT_EQ(r.labelAt(-0.93, 2.02), Label::NonTraversable);  // cell (1, 0)
-  EXPECT_EQ(r.labelAt(-0.88, 2.07), Label::Traversable);     // cell (2, 1)
-  EXPECT_EQ(r.labelAt(-1.01, 2.02), Label::Unknown);         // outside
-  EXPECT_EQ(r.labelAt(-0.97, 2.11), Label::Unknown);
-  for (Label l : {Label::Traversable, Label::NonTraversable, Label::Unknown}) {
+  EXPECT_EQ(r.labelAt(-0.97, 2.02), core::Label::Traversable);     // cell (0, 0)
+  EXPECT_EQ(r.labelAt(-0.93, 2.02), core::Label::NonTraversable);  // cell (1, 0)
+  EXPECT_EQ(r.labelAt(-0.88, 2.07), core::Label::Traversable);     // cell (2, 1)
+  EXPECT_EQ(r.labelAt(-1.01, 2.02), core::Label::Unknown);         // outside
+  EXPECT_EQ(r.labelAt(-0.97, 2.11), core::Label::Unknown);
+  for (core::Label l : {core::Label::Traversable, core::Label::NonTraversable, core::Label::Unknown}) {
     EXPECT_EQ(labelOfRosPixel(rosPixelOf(l)), l);
   }
 }

@@ -14,10 +14,12 @@
 #include <random>
 #include <string>
 
+namespace core = upd::core;
+
 namespace {
 
 namespace fs = std::filesystem;
-using upd::PointCloud;
+using upd::core::PointCloud;
 
 using upd::test::TempDir;
 
@@ -46,7 +48,7 @@ TEST(XyzIo, CommentsCommasBlankLinesAndHeader) {
             "-7.5e-1,+8,nan\n"
             "   # indented comment\n"
             "9 10 11");  // no final newline
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   ASSERT_EQ(c.size(), 4u);
   EXPECT_FALSE(c.hasColor());
   EXPECT_EQ(c.x[0], 1.f);
@@ -64,7 +66,7 @@ TEST(XyzIo, ColourColumns) {
   TempDir dir;
   const std::string f = dir.file("colour.TXT");
   writeText(f, "0 0 0 255 128 0\n1,1,1,1,2,3\n");
-  const PointCloud c = upd::io::readCloud(f);
+  const core::PointCloud c = upd::io::readCloud(f);
   ASSERT_EQ(c.size(), 2u);
   ASSERT_TRUE(c.hasColor());
   EXPECT_EQ(c.r[0], 255);
@@ -112,7 +114,7 @@ TEST(XyzIo, WriteReadRoundTripIsExact) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> coord(-1e4f, 1e4f);
   for (const bool colour : {false, true}) {
-    PointCloud c;
+    core::PointCloud c;
     for (int i = 0; i < 2000; ++i) {
       if (colour) {
         c.push_back(coord(rng), coord(rng), coord(rng) * 1e-6f, static_cast<std::uint8_t>(i),
@@ -124,7 +126,7 @@ TEST(XyzIo, WriteReadRoundTripIsExact) {
     c.x[5] = std::numeric_limits<float>::quiet_NaN();
     const std::string f = dir.file(colour ? "c.xyz" : "p.xyz");
     upd::io::writeXyz(f, c);
-    const PointCloud back = upd::io::readXyz(f);
+    const core::PointCloud back = upd::io::readXyz(f);
     ASSERT_EQ(back.size(), c.size());
     ASSERT_EQ(back.hasColor(), colour);
     for (std::size_t i = 0; i < c.size(); ++i) {

@@ -7,9 +7,11 @@
 #include <functional>
 #include <stdexcept>
 
+namespace core = upd::core;
+
 namespace {
 
-using upd::Label;
+using upd::core::Label;
 using upd::maps::evaluateGrid;
 using upd::maps::GridParams;
 using upd::maps::MapEvaluation;
@@ -29,17 +31,17 @@ TraversabilityGrid makeGrid() {
 }
 
 // Marks cell (cx, cy) observed with the given label.
-void observe(TraversabilityGrid& grid, int cx, int cy, Label label) {
+void observe(TraversabilityGrid& grid, int cx, int cy, core::Label label) {
   upd::maps::GridCell& c = grid.at(cx, cy);
   c.hits = 5;
-  c.logodds_nontrav = label == Label::NonTraversable ? 2.f : -2.f;
+  c.logodds_nontrav = label == core::Label::NonTraversable ? 2.f : -2.f;
 }
 
 // Every cell observed: NonTraversable where nontrav(cx, cy), else Traversable.
 void observeAll(TraversabilityGrid& grid, const std::function<bool(int, int)>& nontrav) {
   for (int cy = 0; cy < grid.sizeY(); ++cy) {
     for (int cx = 0; cx < grid.sizeX(); ++cx) {
-      observe(grid, cx, cy, nontrav(cx, cy) ? Label::NonTraversable : Label::Traversable);
+      observe(grid, cx, cy, nontrav(cx, cy) ? core::Label::NonTraversable : core::Label::Traversable);
     }
   }
 }
@@ -48,8 +50,8 @@ void observeAll(TraversabilityGrid& grid, const std::function<bool(int, int)>& n
 TruthLabelAt wallTruth(const TraversabilityGrid& grid) {
   return [&grid](double x, double y) {
     int cx = 0, cy = 0;
-    if (!grid.cellIndex(x, y, cx, cy)) return Label::Unknown;
-    return cx == 10 ? Label::NonTraversable : Label::Traversable;
+    if (!grid.cellIndex(x, y, cx, cy)) return core::Label::Unknown;
+    return cx == 10 ? core::Label::NonTraversable : core::Label::Traversable;
   };
 }
 
@@ -103,12 +105,12 @@ TEST(EvaluateGrid, UnobservedCellsAndCellsOutsideTheTruthAreNotScored) {
   EXPECT_TRUE(std::isnan(empty.precision()));
   EXPECT_TRUE(std::isnan(empty.recall()));
 
-  for (int cy = 0; cy < 4; ++cy) observe(grid, 10, cy, Label::NonTraversable);
-  observe(grid, 3, 3, Label::NonTraversable);
+  for (int cy = 0; cy < 4; ++cy) observe(grid, 10, cy, core::Label::NonTraversable);
+  observe(grid, 3, 3, core::Label::NonTraversable);
   const TruthLabelAt left_half_unknown = [&grid](double x, double y) {
     int cx = 0, cy = 0;
     grid.cellIndex(x, y, cx, cy);
-    return cx < 5 ? Label::Unknown : wallTruth(grid)(x, y);
+    return cx < 5 ? core::Label::Unknown : wallTruth(grid)(x, y);
   };
   const MapEvaluation e = evaluateGrid(grid, left_half_unknown, 0.0);
   EXPECT_EQ(e.map_non_traversable, 4u);  // not the cell at (3, 3): no truth there

@@ -1,5 +1,5 @@
 // The grid's outputs: ROS map_server PGM + YAML, colour PNG with legend, and atomic writes (the
-// MRPT occupancy grid is tested with the bridge: tests/mrpt/occupancy_grid_test.cpp).
+// MRPT occupancy grid is tested with the bridge: tests/mrpt_bridge/occupancy_grid_test.cpp).
 #include "maps/frames.h"
 #include "upd/maps/grid_export.h"
 #include "upd/maps/grid_fusion.h"
@@ -17,33 +17,17 @@
 #include <stdexcept>
 #include <string>
 
-using upd::Label;
-using upd::maps::FusionParams;
+
 using upd::maps::GridParams;
 using upd::maps::TraversabilityGrid;
-using upd::test::Frame;
+using upd::test::kFreeX;
+using upd::test::kFreeY;
+using upd::test::kObsX;
+using upd::test::kObsY;
+using upd::test::twoCellGrid;
 using upd::test::TempDir;
 
 namespace {
-
-// An 8 m square window of 0.1 m cells centred at (1, -2), so x in [-3, 5) and y in [-6, 2),
-// with an obstacle cell at (2.35, -1.25), a traversable cell at (0.55, -3.05), nothing else.
-constexpr double kObsX = 2.35, kObsY = -1.25, kFreeX = 0.55, kFreeY = -3.05;
-
-TraversabilityGrid makeGrid() {
-  GridParams gp;
-  gp.cell_size_m = 0.1;
-  gp.extent_m = 8.0;
-  gp.follow_robot = false;
-  gp.center_x_m = 1.0;
-  gp.center_y_m = -2.0;
-  TraversabilityGrid g(gp);
-  Frame f;
-  f.fillCell(kObsX - 0.05, kObsY - 0.05, 0.1, 10, Label::NonTraversable);
-  f.fillCell(kFreeX - 0.05, kFreeY - 0.05, 0.1, 10, Label::Traversable);
-  for (int k = 0; k < 3; ++k) upd::maps::integrateScan(g, f.view(), {1, -2}, k, FusionParams{});
-  return g;
-}
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -98,7 +82,7 @@ bool noTemporaryFiles(const TempDir& dir) {
 }  // namespace
 
 TEST(RosMap, PgmAndYamlFollowMapServerFormatAndOrientation) {
-  const TraversabilityGrid g = makeGrid();
+  const TraversabilityGrid g = twoCellGrid();
   TempDir dir("rosmap");
   upd::maps::writeRosMap(g, dir.file("trav"));
   ASSERT_TRUE(std::filesystem::exists(dir.file("trav.pgm")));
@@ -149,7 +133,7 @@ TEST(RosMap, PgmAndYamlFollowMapServerFormatAndOrientation) {
 }
 
 TEST(ColourPng, ReadableWithColoursAndLegend) {
-  const TraversabilityGrid g = makeGrid();
+  const TraversabilityGrid g = twoCellGrid();
   TempDir dir("png");
   const std::string path = dir.file("trav.png");
   const auto layout = upd::maps::writeColourPng(g, path);
@@ -229,7 +213,7 @@ TEST(ColourScale, GreenYellowRedGrey) {
 }
 
 TEST(GridExport, WritingIntoAMissingDirectoryFailsNamingThePath) {
-  const TraversabilityGrid g = makeGrid();
+  const TraversabilityGrid g = twoCellGrid();
   TempDir dir("missing");
   const std::string missing = dir.file("no_such_dir");
   auto expectFailure = [&](auto&& write, const std::string& target) {
@@ -248,7 +232,7 @@ TEST(GridExport, WritingIntoAMissingDirectoryFailsNamingThePath) {
 }
 
 TEST(GridExport, RewritingReplacesTheFileAtomically) {
-  TraversabilityGrid g = makeGrid();
+  TraversabilityGrid g = twoCellGrid();
   TempDir dir("rewrite");
   upd::maps::writeRosMap(g, dir.file("m"));
   const std::string first = slurp(dir.file("m.pgm"));

@@ -12,7 +12,9 @@
 #include <string>
 #include <utility>
 
-using upd::Label;
+namespace core = upd::core;
+
+using upd::core::Label;
 using upd::maps::FusionParams;
 using upd::maps::GridParams;
 using upd::maps::integrateScan;
@@ -33,7 +35,7 @@ GridParams smallGrid(bool follow = false) {
 constexpr double kCell = 0.1;
 double centre(int i) { return (i + 0.5) * kCell; }
 
-Frame cellFrame(int i, int j, Label l, int n = 20) {
+Frame cellFrame(int i, int j, core::Label l, int n = 20) {
   Frame f;
   f.fillCell(i * kCell, j * kCell, kCell, n, l);
   return f;
@@ -47,7 +49,7 @@ void integrate(TraversabilityGrid& g, const Frame& f, double t = 0.0) {
 
 TEST(GridFusion, RepeatedEvidenceSharpens) {
   TraversabilityGrid g(smallGrid());
-  const Frame rock = cellFrame(12, -7, Label::NonTraversable);
+  const Frame rock = cellFrame(12, -7, core::Label::NonTraversable);
   integrate(g, rock);
   const float p1 = upd::maps::probabilityNonTraversable(g, centre(12), centre(-7));
   for (int k = 0; k < 4; ++k) integrate(g, rock);
@@ -56,23 +58,23 @@ TEST(GridFusion, RepeatedEvidenceSharpens) {
   EXPECT_GT(p5, p1);
   EXPECT_NEAR(p1, 1.0 / (1.0 + std::exp(-0.85)), 1e-5);
   EXPECT_NEAR(p5, 1.0 / (1.0 + std::exp(-3.5)), 1e-5);  // clamped at logodds_max
-  EXPECT_EQ(upd::maps::cellLabel(g, centre(12), centre(-7)), Label::NonTraversable);
+  EXPECT_EQ(upd::maps::cellLabel(g, centre(12), centre(-7)), core::Label::NonTraversable);
 
   // The same for traversable evidence, towards 0.
-  const Frame ground = cellFrame(3, 3, Label::Traversable);
+  const Frame ground = cellFrame(3, 3, core::Label::Traversable);
   integrate(g, ground);
   const float q1 = upd::maps::probabilityNonTraversable(g, centre(3), centre(3));
   for (int k = 0; k < 4; ++k) integrate(g, ground);
   const float q5 = upd::maps::probabilityNonTraversable(g, centre(3), centre(3));
   EXPECT_LT(q1, 0.5f);
   EXPECT_LT(q5, q1);
-  EXPECT_EQ(upd::maps::cellLabel(g, centre(3), centre(3)), Label::Traversable);
+  EXPECT_EQ(upd::maps::cellLabel(g, centre(3), centre(3)), core::Label::Traversable);
 }
 
 TEST(GridFusion, OneUpdatePerCellPerFrameWhateverThePointCount) {
   TraversabilityGrid dense(smallGrid()), sparse(smallGrid());
-  integrate(dense, cellFrame(0, 0, Label::NonTraversable, 1000));
-  integrate(sparse, cellFrame(0, 0, Label::NonTraversable, 1));
+  integrate(dense, cellFrame(0, 0, core::Label::NonTraversable, 1000));
+  integrate(sparse, cellFrame(0, 0, core::Label::NonTraversable, 1));
   EXPECT_FLOAT_EQ(upd::maps::probabilityNonTraversable(dense, centre(0), centre(0)),
                   upd::maps::probabilityNonTraversable(sparse, centre(0), centre(0)));
   EXPECT_EQ(dense.cellAt(centre(0), centre(0))->hits, 1000u);
@@ -80,47 +82,47 @@ TEST(GridFusion, OneUpdatePerCellPerFrameWhateverThePointCount) {
 
 TEST(GridFusion, ObstaclePersistsWhenUnobservedAndSurvivesOneContradiction) {
   TraversabilityGrid g(smallGrid());
-  const Frame rock = cellFrame(5, 5, Label::NonTraversable);
+  const Frame rock = cellFrame(5, 5, core::Label::NonTraversable);
   for (int k = 0; k < 5; ++k) integrate(g, rock, k);
   const float seen = upd::maps::probabilityNonTraversable(g, centre(5), centre(5));
   const auto before = *g.cellAt(centre(5), centre(5));
 
   // Frames that observe only other cells leave it untouched.
-  for (int k = 0; k < 10; ++k) integrate(g, cellFrame(-20 + k, 8, Label::Traversable), 10 + k);
+  for (int k = 0; k < 10; ++k) integrate(g, cellFrame(-20 + k, 8, core::Label::Traversable), 10 + k);
   EXPECT_FLOAT_EQ(upd::maps::probabilityNonTraversable(g, centre(5), centre(5)), seen);
   EXPECT_EQ(g.cellAt(centre(5), centre(5))->hits, before.hits);
   EXPECT_EQ(g.cellAt(centre(5), centre(5))->last_seen_s, before.last_seen_s);
 
   // One frame that sees it traversable lowers it, but it stays non-traversable.
-  integrate(g, cellFrame(5, 5, Label::Traversable), 30);
+  integrate(g, cellFrame(5, 5, core::Label::Traversable), 30);
   const float after = upd::maps::probabilityNonTraversable(g, centre(5), centre(5));
   EXPECT_LT(after, seen);
-  EXPECT_EQ(upd::maps::cellLabel(g, centre(5), centre(5)), Label::NonTraversable);
+  EXPECT_EQ(upd::maps::cellLabel(g, centre(5), centre(5)), core::Label::NonTraversable);
 }
 
 TEST(GridFusion, FalseAlarmFades) {
   TraversabilityGrid g(smallGrid());
-  integrate(g, cellFrame(-3, 4, Label::NonTraversable));
-  EXPECT_EQ(upd::maps::cellLabel(g, centre(-3), centre(4)), Label::NonTraversable);
+  integrate(g, cellFrame(-3, 4, core::Label::NonTraversable));
+  EXPECT_EQ(upd::maps::cellLabel(g, centre(-3), centre(4)), core::Label::NonTraversable);
   int frames = 0;
   while (upd::maps::probabilityNonTraversable(g, centre(-3), centre(4)) >= 0.5f && frames < 20) {
-    integrate(g, cellFrame(-3, 4, Label::Traversable));
+    integrate(g, cellFrame(-3, 4, core::Label::Traversable));
     ++frames;
   }
   EXPECT_EQ(frames, 3);  // 0.85 - 3 * 0.4 < 0
-  EXPECT_EQ(upd::maps::cellLabel(g, centre(-3), centre(4)), Label::Traversable);
+  EXPECT_EQ(upd::maps::cellLabel(g, centre(-3), centre(4)), core::Label::Traversable);
   // The clamp keeps a long-traversable cell revisable: 14 frames later, 5 hits flip it back.
-  for (int k = 0; k < 14; ++k) integrate(g, cellFrame(-3, 4, Label::Traversable));
+  for (int k = 0; k < 14; ++k) integrate(g, cellFrame(-3, 4, core::Label::Traversable));
   EXPECT_FLOAT_EQ(g.cellAt(centre(-3), centre(4))->logodds_nontrav, -2.0f);
-  for (int k = 0; k < 5; ++k) integrate(g, cellFrame(-3, 4, Label::NonTraversable));
-  EXPECT_EQ(upd::maps::cellLabel(g, centre(-3), centre(4)), Label::NonTraversable);
+  for (int k = 0; k < 5; ++k) integrate(g, cellFrame(-3, 4, core::Label::NonTraversable));
+  EXPECT_EQ(upd::maps::cellLabel(g, centre(-3), centre(4)), core::Label::NonTraversable);
 }
 
 TEST(GridFusion, UnseenCellsStayUnknown) {
   TraversabilityGrid g(smallGrid());
-  integrate(g, cellFrame(1, 1, Label::NonTraversable));
+  integrate(g, cellFrame(1, 1, core::Label::NonTraversable));
   Frame unknown_only;
-  unknown_only.fillCell(2 * kCell, 2 * kCell, kCell, 30, Label::Unknown);
+  unknown_only.fillCell(2 * kCell, 2 * kCell, kCell, 30, core::Label::Unknown);
   const auto stats = integrateScan(g, unknown_only.view(), {0, 0}, 0, FusionParams{});
   EXPECT_EQ(stats.points_unknown, 30u);
   EXPECT_EQ(stats.cells_updated, 0u);
@@ -129,13 +131,13 @@ TEST(GridFusion, UnseenCellsStayUnknown) {
            {centre(2), centre(2)}, {centre(-40), centre(33)}, {4.95, -4.95}}) {
     EXPECT_TRUE(std::isnan(upd::maps::probabilityNonTraversable(g, x, y)));
     EXPECT_FALSE(upd::maps::isKnown(g, x, y));
-    EXPECT_EQ(upd::maps::cellLabel(g, x, y), Label::Unknown);
+    EXPECT_EQ(upd::maps::cellLabel(g, x, y), core::Label::Unknown);
     EXPECT_TRUE(std::isnan(g.cellAt(x, y)->zeta_min));
     EXPECT_EQ(g.cellAt(x, y)->hits, 0u);
   }
   // Outside the window: unknown too, and no cell.
   EXPECT_EQ(g.cellAt(100.0, 0.0), nullptr);
-  EXPECT_EQ(upd::maps::cellLabel(g, 100.0, 0.0), Label::Unknown);
+  EXPECT_EQ(upd::maps::cellLabel(g, 100.0, 0.0), core::Label::Unknown);
   EXPECT_TRUE(std::isnan(upd::maps::probabilityNonTraversable(g, NAN, 0.0)));
 
   const auto s = upd::maps::computeStats(g);
@@ -149,15 +151,15 @@ TEST(GridFusion, FractionRuleDecidesHitOrMiss) {
   FusionParams fp;  // nontrav_fraction 0.25
   TraversabilityGrid g(smallGrid());
   Frame f;
-  f.fillCell(0, 0, kCell, 2, Label::NonTraversable);  // 2 of 10: miss
-  f.fillCell(0, 0, kCell, 8, Label::Traversable);
-  f.fillCell(kCell, 0, kCell, 3, Label::NonTraversable);  // 3 of 12: exactly 0.25, hit
-  f.fillCell(kCell, 0, kCell, 9, Label::Traversable);
+  f.fillCell(0, 0, kCell, 2, core::Label::NonTraversable);  // 2 of 10: miss
+  f.fillCell(0, 0, kCell, 8, core::Label::Traversable);
+  f.fillCell(kCell, 0, kCell, 3, core::Label::NonTraversable);  // 3 of 12: exactly 0.25, hit
+  f.fillCell(kCell, 0, kCell, 9, core::Label::Traversable);
   const auto stats = integrateScan(g, f.view(), {0, 0}, 1.0, fp);
   EXPECT_EQ(stats.cells_updated, 2u);
   EXPECT_EQ(stats.cells_hit, 1u);
-  EXPECT_EQ(upd::maps::cellLabel(g, centre(0), centre(0)), Label::Traversable);
-  EXPECT_EQ(upd::maps::cellLabel(g, centre(1), centre(0)), Label::NonTraversable);
+  EXPECT_EQ(upd::maps::cellLabel(g, centre(0), centre(0)), core::Label::Traversable);
+  EXPECT_EQ(upd::maps::cellLabel(g, centre(1), centre(0)), core::Label::NonTraversable);
 
   EXPECT_DOUBLE_EQ(upd::maps::frameLogOddsUpdate(3, 7, fp), fp.logodds_hit);
   EXPECT_DOUBLE_EQ(upd::maps::frameLogOddsUpdate(2, 8, fp), fp.logodds_miss);
@@ -169,12 +171,12 @@ TEST(GridFusion, FractionRuleDecidesHitOrMiss) {
 TEST(GridFusion, LayersHoldMinMeanMaxHitsAndTime) {
   TraversabilityGrid g(smallGrid());
   Frame a;
-  a.add(0.01f, 0.01f, 0.10f, Label::Traversable, 0.99f, 0.10f, 0.2f);
-  a.add(0.02f, 0.02f, 0.30f, Label::NonTraversable, 0.90f, 0.30f, 1.0f);
+  a.add(0.01f, 0.01f, 0.10f, core::Label::Traversable, 0.99f, 0.10f, 0.2f);
+  a.add(0.02f, 0.02f, 0.30f, core::Label::NonTraversable, 0.90f, 0.30f, 1.0f);
   integrateScan(g, a.view(), {0, 0}, 5.0, FusionParams{});
   Frame b;
-  b.add(0.05f, 0.05f, 0.20f, Label::Traversable, 0.97f, 0.20f, NAN);
-  b.add(0.06f, 0.06f, 0.20f, Label::Unknown, 0.10f, 1.0f, 1.0f);  // ignored entirely
+  b.add(0.05f, 0.05f, 0.20f, core::Label::Traversable, 0.97f, 0.20f, NAN);
+  b.add(0.06f, 0.06f, 0.20f, core::Label::Unknown, 0.10f, 1.0f, 1.0f);  // ignored entirely
   integrateScan(g, b.view(), {0, 0}, 7.5, FusionParams{});
   const auto* c = g.cellAt(0.05, 0.05);
   ASSERT_NE(c, nullptr);
@@ -201,19 +203,19 @@ TEST(GridFusion, LayersHoldMinMeanMaxHitsAndTime) {
 TEST(GridFusion, InvalidAndOutsidePointsAreCountedNotUsed) {
   TraversabilityGrid g(smallGrid());
   Frame f;
-  f.add(NAN, 0.f, 0.f, Label::NonTraversable);
-  f.add(0.f, INFINITY, 0.f, Label::NonTraversable);
-  f.add(0.f, 0.f, NAN, Label::NonTraversable);
-  f.add(50.f, 0.f, 0.f, Label::NonTraversable);    // outside the fixed 10 m window
-  f.add(-5.01f, 0.f, 0.f, Label::NonTraversable);  // just outside the lower edge
-  f.add(-4.99f, 0.f, 0.f, Label::NonTraversable);  // just inside
+  f.add(NAN, 0.f, 0.f, core::Label::NonTraversable);
+  f.add(0.f, INFINITY, 0.f, core::Label::NonTraversable);
+  f.add(0.f, 0.f, NAN, core::Label::NonTraversable);
+  f.add(50.f, 0.f, 0.f, core::Label::NonTraversable);    // outside the fixed 10 m window
+  f.add(-5.01f, 0.f, 0.f, core::Label::NonTraversable);  // just outside the lower edge
+  f.add(-4.99f, 0.f, 0.f, core::Label::NonTraversable);  // just inside
   const auto s = integrateScan(g, f.view(), {0, 0}, 0, FusionParams{});
   EXPECT_EQ(s.points_invalid, 3u);
   EXPECT_EQ(s.points_outside, 2u);
   EXPECT_EQ(s.points_used, 1u);
   EXPECT_EQ(s.cells_updated, 1u);
   EXPECT_EQ(upd::maps::computeStats(g).known, 1u);
-  EXPECT_EQ(upd::maps::cellLabel(g, -4.99, 0.0), Label::NonTraversable);
+  EXPECT_EQ(upd::maps::cellLabel(g, -4.99, 0.0), core::Label::NonTraversable);
 }
 
 TEST(GridFusion, WindowFollowsTheRobotWithBoundedMemory) {
@@ -234,7 +236,7 @@ TEST(GridFusion, WindowFollowsTheRobotWithBoundedMemory) {
       for (int v = 0; v < 20; ++v) {
         f.add(static_cast<float>(d + 1.0 + 0.2 * u + 0.1),
               static_cast<float>(d - 2.0 + 0.2 * v + 0.1), 0.f,
-              (u + v) % 9 == 0 ? Label::NonTraversable : Label::Traversable);
+              (u + v) % 9 == 0 ? core::Label::NonTraversable : core::Label::Traversable);
       }
     }
     const auto s = integrateScan(g, f.view(), {d, d}, step, FusionParams{});
@@ -256,7 +258,7 @@ TEST(GridFusion, RecentringKeepsCellsAtTheirWorldPosition) {
   GridParams gp = smallGrid(true);
   TraversabilityGrid g(gp);
   Frame rock;
-  rock.fillCell(3.0, 1.0, kCell, 10, Label::NonTraversable);
+  rock.fillCell(3.0, 1.0, kCell, 10, core::Label::NonTraversable);
   for (int k = 0; k < 3; ++k) integrateScan(g, rock.view(), {0, 0}, k, FusionParams{});
   const float p = upd::maps::probabilityNonTraversable(g, 3.05, 1.05);
   const auto before = *g.cellAt(3.05, 1.05);
@@ -286,7 +288,7 @@ TEST(GridFusion, SameResultFarFromTheOrigin) {
       // Keep points 1/4 cell away from cell edges so float rounding far out cannot move them.
       const float px = std::floor(pos(rng) / 0.1f) * 0.1f + 0.05f;
       const float py = std::floor(pos(rng) / 0.1f) * 0.1f + 0.05f;
-      const Label l = (k % 5 == 0) ? Label::NonTraversable : Label::Traversable;
+      const core::Label l = (k % 5 == 0) ? core::Label::NonTraversable : core::Label::Traversable;
       a.add(px, py, 0.f, l);
       b.add(static_cast<float>(px + offset), static_cast<float>(py + offset), 0.f, l);
     }
@@ -319,13 +321,13 @@ TEST(GridFusion, AgreesWithBruteForcePerCellFusion) {
     for (int k = 0; k < 500; ++k) {
       const float px = pos(rng), py = pos(rng);
       const int r = lab(rng);
-      const Label l =
-          r == 0 ? Label::NonTraversable : (r == 4 ? Label::Unknown : Label::Traversable);
+      const core::Label l =
+          r == 0 ? core::Label::NonTraversable : (r == 4 ? core::Label::Unknown : core::Label::Traversable);
       f.add(px, py, 0.f, l);
-      if (l == Label::Unknown) continue;
+      if (l == core::Label::Unknown) continue;
       auto& c =
           counts[{static_cast<int>(std::floor(px / 0.1)), static_cast<int>(std::floor(py / 0.1))}];
-      (l == Label::NonTraversable ? c.first : c.second)++;
+      (l == core::Label::NonTraversable ? c.first : c.second)++;
     }
     integrateScan(g, f.view(), {0, 0}, frame, fp);
     for (const auto& [cell, c] : counts) {
@@ -355,7 +357,7 @@ TEST(GridFusion, ParametersAreValidatedWithTheFieldName) {
   FusionParams fp;
   fp.logodds_miss = 0.3;
   TraversabilityGrid g(smallGrid());
-  Frame f = cellFrame(0, 0, Label::Traversable);
+  Frame f = cellFrame(0, 0, core::Label::Traversable);
   EXPECT_THROW(integrateScan(g, f.view(), {0, 0}, 0, fp), std::invalid_argument);
   upd::maps::PointsWorld bad = f.view();
   bad.label = nullptr;
@@ -364,14 +366,14 @@ TEST(GridFusion, ParametersAreValidatedWithTheFieldName) {
 }
 
 TEST(GridFusion, ViewsPipelineArraysWithoutCopying) {
-  upd::PointCloud cloud;
+  upd::core::PointCloud cloud;
   cloud.push_back(0.05f, 0.05f, 0.f);
   cloud.push_back(0.15f, 0.05f, 0.f);
-  upd::Classification cls;
-  cls.label = {Label::NonTraversable, Label::Traversable};
+  upd::core::Classification cls;
+  cls.label = {core::Label::NonTraversable, core::Label::Traversable};
   cls.cost = {1.f, 0.f};
   cls.slope_rad = {0.5f, 0.f};
-  upd::UpdResult upd_res;
+  upd::core::UpdResult upd_res;
   upd_res.zeta = {0.8f, 1.f};
   const auto v = upd::maps::viewPoints(cloud, cls, &upd_res);
   EXPECT_EQ(v.x, cloud.x.data());
@@ -379,7 +381,7 @@ TEST(GridFusion, ViewsPipelineArraysWithoutCopying) {
   EXPECT_EQ(v.zeta, upd_res.zeta.data());
   TraversabilityGrid g(smallGrid());
   integrateScan(g, v, {0, 0}, 0, FusionParams{});
-  EXPECT_EQ(upd::maps::cellLabel(g, 0.05, 0.05), Label::NonTraversable);
+  EXPECT_EQ(upd::maps::cellLabel(g, 0.05, 0.05), core::Label::NonTraversable);
   EXPECT_FLOAT_EQ(g.cellAt(0.05, 0.05)->zeta_min, 0.8f);
   cls.label.pop_back();
   EXPECT_THROW(upd::maps::viewPoints(cloud, cls), std::invalid_argument);

@@ -26,7 +26,9 @@
 #include <string>
 #include <tuple>
 
-using upd::Label;
+namespace core = upd::core;
+
+using upd::core::Label;
 using upd::maps::FusionParams;
 using upd::maps::OctreeParams;
 using upd::maps::TraversabilityOcTree;
@@ -58,15 +60,15 @@ Frame scene() {
   Frame f;
   for (int i = 10; i < 40; ++i) {
     for (int j = -10; j < 10; ++j) {
-      f.add((i + 0.5f) * 0.1f, (j + 0.5f) * 0.1f, 0.05f, Label::Traversable, 1.0f, 0.0f, 0.1f);
+      f.add((i + 0.5f) * 0.1f, (j + 0.5f) * 0.1f, 0.05f, core::Label::Traversable, 1.0f, 0.0f, 0.1f);
     }
   }
   for (int j = -2; j < 2; ++j) {
     for (int k = 1; k < 6; ++k) {
-      f.add(3.05f, (j + 0.5f) * 0.1f, (k + 0.5f) * 0.1f, Label::NonTraversable, 0.8f, 1.2f, 1.0f);
+      f.add(3.05f, (j + 0.5f) * 0.1f, (k + 0.5f) * 0.1f, core::Label::NonTraversable, 0.8f, 1.2f, 1.0f);
     }
   }
-  f.add(2.55f, 1.55f, 0.05f, Label::Unknown, NAN, NAN, NAN);  // beside the ground: occupancy only
+  f.add(2.55f, 1.55f, 0.05f, core::Label::Unknown, NAN, NAN, NAN);  // beside the ground: occupancy only
   return f;
 }
 
@@ -180,13 +182,13 @@ TEST(TraversabilityOctree, InsertIsTheSameOnOneThreadAndTwoAcrossChunks) {
     for (int col = 0; col < 250; ++col) {
       const float u = 0.004f * static_cast<float>(col), v = 0.01f * static_cast<float>(row);
       if ((row * 250 + col) % 211 == 5) {
-        f.add(kNan, kNan, kNan, Label::Unknown);
+        f.add(kNan, kNan, kNan, core::Label::Unknown);
         continue;
       }
       const bool wall = v > 1.6f;
-      const Label l = (row + col) % 13 == 0  ? Label::Unknown
-                      : wall || col % 5 == 0 ? Label::NonTraversable
-                                             : Label::Traversable;
+      const core::Label l = (row + col) % 13 == 0  ? core::Label::Unknown
+                      : wall || col % 5 == 0 ? core::Label::NonTraversable
+                                             : core::Label::Traversable;
       f.add(wall ? 1.6f + 0.001f * col : 0.4f + v, -0.5f + u, wall ? v - 1.6f : 0.01f, l,
             0.9f + 0.0003f * col, 0.01f * row, 0.001f * (row + col));
     }
@@ -230,14 +232,14 @@ TEST(TraversabilityOctree, DiscretizedInsertMatchesOctomapsOwnAndCountsEveryPoin
     for (int j = -8; j < 8; ++j) {
       for (int k = 0; k < 9; ++k) {
         f.add((i + 0.1f + 0.1f * (k % 3)) * 0.1f, (j + 0.15f + 0.3f * (k / 3)) * 0.1f,
-              0.02f + 0.005f * k, k == 4 ? Label::NonTraversable : Label::Traversable, 1.0f, 0.0f,
+              0.02f + 0.005f * k, k == 4 ? core::Label::NonTraversable : core::Label::Traversable, 1.0f, 0.0f,
               0.1f);
       }
     }
   }
   for (int j = -3; j < 3; ++j) {
     for (int k = 1; k < 6; ++k) {
-      f.add(3.07f, (j + 0.4f) * 0.1f, (k + 0.6f) * 0.1f, Label::NonTraversable, 0.8f, 1.2f, 1.0f);
+      f.add(3.07f, (j + 0.4f) * 0.1f, (k + 0.6f) * 0.1f, core::Label::NonTraversable, 0.8f, 1.2f, 1.0f);
     }
   }
   for (const bool discretize : {true, false}) {
@@ -408,7 +410,7 @@ TEST(TraversabilityOctree, UpdateBoxFollowsTheRobotAndBoundsMemory) {
     for (int u = 0; u < 20; ++u) {
       for (int v = 0; v < 11; ++v) {
         f.add(static_cast<float>(x + 1.1 + 0.2 * u), static_cast<float>(-1.1 + 0.2 * v), 0.1f,
-              (u * 11 + v) % 13 == 0 ? Label::NonTraversable : Label::Traversable);
+              (u * 11 + v) % 13 == 0 ? core::Label::NonTraversable : core::Label::Traversable);
       }
     }
     const auto s = upd::maps::insertScan(tree, f.view(), {x, 0.0, 0.5}, p, FusionParams{});
@@ -445,8 +447,8 @@ TEST(TraversabilityOctree, FixedBoxKeepsTheTreeInside) {
   p.height_m = 2.0;
   TraversabilityOcTree tree(p);
   Frame f;
-  f.add(1.05f, 0.05f, 0.05f, Label::NonTraversable);
-  f.add(5.05f, 0.05f, 0.05f, Label::NonTraversable);  // outside the box
+  f.add(1.05f, 0.05f, 0.05f, core::Label::NonTraversable);
+  f.add(5.05f, 0.05f, 0.05f, core::Label::NonTraversable);  // outside the box
   upd::maps::insertScan(tree, f.view(), {0.0, 0.0, 0.5}, p, FusionParams{});
   ASSERT_NE(tree.search(1.05, 0.05, 0.05), nullptr);
   EXPECT_TRUE(tree.search(1.05, 0.05, 0.05)->hasTraversability());

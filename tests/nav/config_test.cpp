@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+namespace core = upd::core;
+
 namespace upd::nav {
 namespace {
 
@@ -36,7 +38,7 @@ TEST(NavShippedConfig, LoadsWithTheDuneValues) {
   EXPECT_DOUBLE_EQ(c.body.length_m, 0.7);
   EXPECT_DOUBLE_EQ(c.body.width_m, 0.45);
   EXPECT_EQ(c.camera.image_downscale, 4);
-  EXPECT_NEAR(c.camera.pitch_rad, 22.0 * kDegToRad, 1e-12);
+  EXPECT_NEAR(c.camera.pitch_rad, 22.0 * core::kDegToRad, 1e-12);
   EXPECT_EQ(fs::path(c.ptg_ini).filename(), "ptg-dune.ini");
   EXPECT_TRUE(fs::exists(c.ptg_ini));
   EXPECT_FALSE(c.ptg_cache_dir.empty());

@@ -12,6 +12,8 @@
 #include <cmath>
 #include <random>
 
+namespace core = upd::core;
+
 namespace upd::nav {
 namespace {
 
@@ -26,17 +28,17 @@ maps::TraversabilityGrid gridWith(const std::vector<Eigen::Vector2d>& nontrav_wo
   gp.follow_robot = false;
   maps::TraversabilityGrid grid(gp);
   std::vector<float> x, y, z;
-  std::vector<Label> label;
+  std::vector<core::Label> label;
   for (const auto& p : nontrav_world) {
     x.push_back(static_cast<float>(p.x()));
     y.push_back(static_cast<float>(p.y()));
     z.push_back(0.2f);
-    label.push_back(Label::NonTraversable);
+    label.push_back(core::Label::NonTraversable);
   }
   x.push_back(-2.05f);
   y.push_back(-2.05f);
   z.push_back(0.f);
-  label.push_back(Label::Traversable);
+  label.push_back(core::Label::Traversable);
   maps::PointsWorld view;
   view.x = x.data();
   view.y = y.data();

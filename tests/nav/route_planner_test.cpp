@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+namespace core = upd::core;
+
 namespace upd::nav {
 namespace {
 
@@ -24,13 +26,13 @@ class NavRouteMap : public ::testing::Test {
   template <class Pred>
   void paint(Pred pred) {
     std::vector<float> x, y, z;
-    std::vector<Label> l;
+    std::vector<core::Label> l;
     for (double cx = -4.95; cx < 5.0; cx += 0.1) {
       for (double cy = -4.95; cy < 5.0; cy += 0.1) {
         x.push_back(static_cast<float>(cx));
         y.push_back(static_cast<float>(cy));
         z.push_back(0.f);
-        l.push_back(pred(cx, cy) ? Label::NonTraversable : Label::Traversable);
+        l.push_back(pred(cx, cy) ? core::Label::NonTraversable : core::Label::Traversable);
       }
     }
     maps::PointsWorld v;

@@ -10,6 +10,8 @@
 
 #include <filesystem>
 
+namespace core = upd::core;
+
 namespace upd::nav {
 namespace {
 
@@ -27,7 +29,7 @@ class NavScenario : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(cache_); }
 
-  ScenarioResult run(const std::string& name, ObstacleDetector d = ObstacleDetector::Upd) {
+  ScenarioResult run(const std::string& name, core::ObstacleDetector d = core::ObstacleDetector::Upd) {
     const ScenarioResult r = runScenario(sim::makeWorld(name), name, config_, d);
     RecordProperty("sim_time_s", std::to_string(r.sim_time_s));
     RecordProperty("min_clearance_m", std::to_string(r.min_clearance_m));
@@ -62,7 +64,7 @@ TEST_F(NavScenario, RampIsClimbed) {
   // The goal is on the platform: the robot ends up there, and the UPD mapped the ramp's body
   // as traversable.
   EXPECT_GT(r.trajectory.back().z_m, 0.25);
-  EXPECT_EQ(maps::cellLabel(r.grid, 8.0, -1.4), Label::Traversable);
+  EXPECT_EQ(maps::cellLabel(r.grid, 8.0, -1.4), core::Label::Traversable);
 }
 
 TEST_F(NavScenario, Ditch) { expectReachedSafely(run("ditch")); }
@@ -84,11 +86,11 @@ TEST_F(NavScenario, RoughnessIndexBlocksTheRamp) {
   // The paper's failure: the roughness index reads the smooth 20 deg ramp as an obstacle, and
   // the ramp is the only way onto the platform. 100 s is three times what the UPD needs.
   config_.loop.max_time_s = 100.0;
-  const ScenarioResult r = run("ramp", ObstacleDetector::Roughness);
+  const ScenarioResult r = run("ramp", core::ObstacleDetector::Roughness);
   EXPECT_FALSE(r.reached);
   EXPECT_NE(r.end, RunEnd::GoalReached);
   EXPECT_LT(r.trajectory.back().z_m, 0.1);  // never got onto the platform
-  EXPECT_EQ(maps::cellLabel(r.grid, 8.0, -1.4), Label::NonTraversable);
+  EXPECT_EQ(maps::cellLabel(r.grid, 8.0, -1.4), core::Label::NonTraversable);
   EXPECT_EQ(r.collision_steps, 0);
 }
 

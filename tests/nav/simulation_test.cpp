@@ -8,6 +8,8 @@
 
 #include <cmath>
 
+namespace core = upd::core;
+
 namespace upd::nav {
 namespace {
 
@@ -30,7 +32,7 @@ TEST(NavMissingGround, TheDitchIsFoundAndFlatGroundIsNot) {
   const CameraMountParams mount = navCamera();
   DepthNoise noise;
   // Facing the ditch (x 4.7..5.3) from 2.2 m before it.
-  const PointCloud seen = renderCameraWorld(
+  const core::PointCloud seen = renderCameraWorld(
       ditch.terrain, bodyPoseOnTerrain(ditch.terrain, {2.5, -1.0, 0.0}, RobotBodyParams{}), mount,
       noise, 3);
   const auto gaps = findGroundGaps(seen, 0.0, NegativeObstacleParams{});
@@ -47,7 +49,7 @@ TEST(NavMissingGround, TheDitchIsFoundAndFlatGroundIsNot) {
     }
   }
   const sim::Terrain flat({0, -4}, {10, 4});
-  const PointCloud plain = renderCameraWorld(flat, bodyPoseFlat({2.5, -1.0, 0.0}), mount, noise, 3);
+  const core::PointCloud plain = renderCameraWorld(flat, bodyPoseFlat({2.5, -1.0, 0.0}), mount, noise, 3);
   EXPECT_TRUE(findGroundGaps(plain, 0.0, NegativeObstacleParams{}).empty());
 }
 
@@ -55,7 +57,7 @@ TEST(NavMissingGround, TheShadowBehindAPlatformIsNotAGap) {
   // From the ground the platform's top hides the ground behind it, which lies lower than the top
   // but not lower than the robot: a positive obstacle's shadow, not missing ground.
   const sim::WorldSpec ramp = sim::makeWorld("ramp");
-  const PointCloud seen = renderCameraWorld(
+  const core::PointCloud seen = renderCameraWorld(
       ramp.terrain, bodyPoseOnTerrain(ramp.terrain, {3.5, 0.5, 0.0}, RobotBodyParams{}),
       navCamera(), DepthNoise{}, 5);
   EXPECT_TRUE(findGroundGaps(seen, 0.0, NegativeObstacleParams{}).empty());

@@ -9,9 +9,11 @@
 #include <stdexcept>
 #include <string>
 
+namespace core = upd::core;
+
 namespace {
 
-using upd::Label;
+using upd::core::Label;
 
 upd::sim::DepthNoise noiseFree() {
   upd::sim::DepthNoise n;
@@ -35,7 +37,7 @@ upd::sim::Terrain wallWorld(double distance_m) {
   return t;
 }
 
-Eigen::Vector3d pixelRay(const upd::CameraIntrinsics& K, int u, int v) {
+Eigen::Vector3d pixelRay(const upd::core::CameraIntrinsics& K, int u, int v) {
   return {(u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0};
 }
 
@@ -54,10 +56,10 @@ TEST(CameraPose, LooksAtTheTargetWithRowsDown) {
 }
 
 TEST(RenderDepth, FlatGroundMatchesTheRayPlaneIntersection) {
-  const upd::CameraIntrinsics K;
+  const upd::core::CameraIntrinsics K;
   const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 1.0}, {3, 0.5, 0});
   const upd::sim::DepthNoise noise = noiseFree();
-  const upd::DepthImage img = upd::sim::renderDepth(flatWorld(), pose, K, noise, 1);
+  const upd::core::DepthImage img = upd::sim::renderDepth(flatWorld(), pose, K, noise, 1);
   ASSERT_EQ(img.width, K.width);
   ASSERT_EQ(img.height, K.height);
   std::size_t valid = 0, sky = 0;
@@ -81,16 +83,16 @@ TEST(RenderDepth, FlatGroundMatchesTheRayPlaneIntersection) {
 }
 
 TEST(RenderDepth, SkyPixelsAreInvalid) {
-  const upd::CameraIntrinsics K;
+  const upd::core::CameraIntrinsics K;
   const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 1.0}, {3, 0, 3.0});
-  const upd::DepthImage img = upd::sim::renderDepth(flatWorld(), pose, K, upd::sim::DepthNoise{}, 1);
+  const upd::core::DepthImage img = upd::sim::renderDepth(flatWorld(), pose, K, upd::sim::DepthNoise{}, 1);
   for (float d : img.depth_m) ASSERT_EQ(d, 0.f);
 }
 
 TEST(RenderDepth, VerticalWallAppearsAtItsDistance) {
-  const upd::CameraIntrinsics K;
+  const upd::core::CameraIntrinsics K;
   const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 1.0}, {1, 0, 1.0});
-  const upd::DepthImage img = upd::sim::renderDepth(wallWorld(3.0), pose, K, noiseFree(), 1);
+  const upd::core::DepthImage img = upd::sim::renderDepth(wallWorld(3.0), pose, K, noiseFree(), 1);
   // Looking straight at a wall perpendicular to the optical axis every pixel has z = 3 (the
   // bottom rows reach z = 0 at 1 / 0.456 = 2.19 m: they see the ground first).
   std::size_t on_wall = 0;
@@ -109,12 +111,12 @@ TEST(RenderDepth, VerticalWallAppearsAtItsDistance) {
 }
 
 TEST(RenderDepth, NoiseSigmaGrowsWithTheSquareOfDepth) {
-  const upd::CameraIntrinsics K;
+  const upd::core::CameraIntrinsics K;
   const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 2.5}, {1, 0, 2.5});
   for (double z : {2.0, 4.0}) {
     SCOPED_TRACE(z);
     upd::sim::DepthNoise noise;  // Kinect defaults: 1.2e-3 z^2, millimetre steps
-    const upd::DepthImage img = upd::sim::renderDepth(wallWorld(z), pose, K, noise, 7);
+    const upd::core::DepthImage img = upd::sim::renderDepth(wallWorld(z), pose, K, noise, 7);
     double sum = 0, sum2 = 0;
     std::size_t n = 0;
     for (float d : img.depth_m) {
@@ -134,12 +136,12 @@ TEST(RenderDepth, NoiseSigmaGrowsWithTheSquareOfDepth) {
 }
 
 TEST(RenderDepth, SameSeedSameImageOtherSeedOther) {
-  const upd::CameraIntrinsics K;
+  const upd::core::CameraIntrinsics K;
   const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 1.0}, {3, 0, 0});
   const upd::sim::WorldSpec w = upd::sim::makeWorld("mixed");
-  const upd::DepthImage a = upd::sim::renderDepth(w.terrain, pose, K, upd::sim::DepthNoise{}, 3);
-  const upd::DepthImage b = upd::sim::renderDepth(w.terrain, pose, K, upd::sim::DepthNoise{}, 3);
-  const upd::DepthImage c = upd::sim::renderDepth(w.terrain, pose, K, upd::sim::DepthNoise{}, 4);
+  const upd::core::DepthImage a = upd::sim::renderDepth(w.terrain, pose, K, upd::sim::DepthNoise{}, 3);
+  const upd::core::DepthImage b = upd::sim::renderDepth(w.terrain, pose, K, upd::sim::DepthNoise{}, 3);
+  const upd::core::DepthImage c = upd::sim::renderDepth(w.terrain, pose, K, upd::sim::DepthNoise{}, 4);
   EXPECT_EQ(a.depth_m, b.depth_m);
   std::size_t differ = 0;
   for (std::size_t i = 0; i < a.depth_m.size(); ++i) differ += a.depth_m[i] != c.depth_m[i];
@@ -147,14 +149,14 @@ TEST(RenderDepth, SameSeedSameImageOtherSeedOther) {
 }
 
 TEST(RenderDepth, RangeLimitsInvalidateDepth) {
-  const upd::CameraIntrinsics K;
+  const upd::core::CameraIntrinsics K;
   const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({0, 0, 2.5}, {1, 0, 2.5});
   // Nearer than min_range_m: the wall fills the image.
-  const upd::DepthImage near = upd::sim::renderDepth(wallWorld(0.3), pose, K, noiseFree(), 1);
+  const upd::core::DepthImage near = upd::sim::renderDepth(wallWorld(0.3), pose, K, noiseFree(), 1);
   for (float d : near.depth_m) ASSERT_EQ(d, 0.f);
   // Beyond max_range_m: the upper half sees only the wall (the lower half sees the ground
   // within 5.5 m).
-  const upd::DepthImage far = upd::sim::renderDepth(wallWorld(9.0), pose, K, noiseFree(), 1);
+  const upd::core::DepthImage far = upd::sim::renderDepth(wallWorld(9.0), pose, K, noiseFree(), 1);
   for (int v = 0; v < K.height; ++v) {
     for (int u = 0; u < K.width; ++u) {
       const double ground_s = (v - K.cy) > 0 ? 2.5 / ((v - K.cy) / K.fy) : 1e9;
@@ -170,7 +172,7 @@ TEST(RenderDepth, BadParametersThrowNamingTheField) {
   upd::sim::DepthNoise n;
   n.max_range_m = 0.1;  // below min_range_m
   try {
-    upd::sim::renderDepth(flatWorld(), Eigen::Isometry3d::Identity(), upd::CameraIntrinsics{}, n, 1);
+    upd::sim::renderDepth(flatWorld(), Eigen::Isometry3d::Identity(), upd::core::CameraIntrinsics{}, n, 1);
     FAIL() << "nothing thrown";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("DepthNoise.max_range_m"), std::string::npos) << e.what();
@@ -197,11 +199,11 @@ bool onSurface(const upd::sim::Terrain& t, const Eigen::Vector3d& p, double tol_
 
 TEST(RenderScene, OrganizedCloudLandsOnTheTerrainWithTruth) {
   const upd::sim::WorldSpec w = upd::sim::makeWorld("mixed");
-  const upd::CameraIntrinsics K;
+  const upd::core::CameraIntrinsics K;
   // Looking from the start along the ramp, platform, ditch and step side of the world.
   const Eigen::Isometry3d pose = upd::sim::cameraPoseLookingAt({1.5, 0.0, 1.2}, {6.0, -2.0, 0.0});
   const upd::sim::RenderedScene r = upd::sim::renderScene(w.terrain, pose, K, noiseFree(), 1, "mixed");
-  const upd::PointCloud& c = r.scene.cloud;
+  const upd::core::PointCloud& c = r.scene.cloud;
   ASSERT_TRUE(c.isOrganized());
   ASSERT_EQ(c.width, static_cast<std::size_t>(K.width));
   ASSERT_EQ(c.height, static_cast<std::size_t>(K.height));
@@ -213,7 +215,7 @@ TEST(RenderScene, OrganizedCloudLandsOnTheTerrainWithTruth) {
   std::size_t valid = 0, faces = 0, trav = 0, non_trav = 0, agree = 0;
   for (std::size_t i = 0; i < c.size(); ++i) {
     if (!c.isFinite(i)) {
-      ASSERT_EQ(r.scene.truth[i], Label::Unknown);
+      ASSERT_EQ(r.scene.truth[i], core::Label::Unknown);
       ASSERT_EQ(r.depth.depth_m[i], 0.f);
       continue;
     }
@@ -222,8 +224,8 @@ TEST(RenderScene, OrganizedCloudLandsOnTheTerrainWithTruth) {
     // Float coordinates at up to 8 m: a few micrometres.
     ASSERT_TRUE(onSurface(w.terrain, p, 1e-4)) << p.transpose();
     faces += std::abs(p.z() - w.terrain.heightAt(p.x(), p.y())) > 1e-4 ? 1 : 0;
-    trav += r.scene.truth[i] == Label::Traversable;
-    non_trav += r.scene.truth[i] == Label::NonTraversable;
+    trav += r.scene.truth[i] == core::Label::Traversable;
+    non_trav += r.scene.truth[i] == core::Label::NonTraversable;
     agree += r.scene.truth[i] == w.terrain.truthAt(p.x(), p.y());
   }
   EXPECT_GT(valid, c.size() / 2);

@@ -7,6 +7,8 @@
 
 #include <cmath>
 
+namespace core = upd::core;
+
 namespace upd::sim {
 namespace {
 
@@ -14,7 +16,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 TEST(SimCameraMount, OpticalAxisLooksForwardAndDown) {
   CameraMountParams m;
-  m.pitch_rad = 30.0 * kDegToRad;
+  m.pitch_rad = 30.0 * core::kDegToRad;
   const Eigen::Isometry3d T = cameraOnRobot(m);
   const Eigen::Vector3d z_optical = T.linear().col(2);  // optical axis in the robot frame
   EXPECT_NEAR(z_optical.x(), std::cos(m.pitch_rad), 1e-12);
@@ -31,7 +33,7 @@ TEST(SimCameraMount, MountFrameThenOpticalAxesIsTheCamera) {
   m.left_m = -0.05;
   m.height_m = 0.6;
   for (double pitch_deg : {-30.0, 0.0, 22.0, 45.0}) {
-    m.pitch_rad = pitch_deg * kDegToRad;
+    m.pitch_rad = pitch_deg * core::kDegToRad;
     Eigen::Isometry3d optical = Eigen::Isometry3d::Identity();
     optical.linear() = opticalInMount();
     EXPECT_TRUE((mountOnRobot(m) * optical).isApprox(cameraOnRobot(m), 1e-12)) << pitch_deg;
@@ -44,11 +46,11 @@ TEST(SimCameraMount, MountFrameThenOpticalAxesIsTheCamera) {
 TEST(SimCameraMount, SimulatedIntrinsicsScaleTheKinect) {
   CameraMountParams m;
   EXPECT_EQ(m.image_downscale, 1);  // the Kinect itself by default
-  const CameraIntrinsics kinect = simulatedIntrinsics(m);
+  const core::CameraIntrinsics kinect = simulatedIntrinsics(m);
   EXPECT_EQ(kinect.width, 640);
-  EXPECT_EQ(kinect.cx, CameraIntrinsics{}.cx);
+  EXPECT_EQ(kinect.cx, core::CameraIntrinsics{}.cx);
   m.image_downscale = 4;
-  const CameraIntrinsics K = simulatedIntrinsics(m);
+  const core::CameraIntrinsics K = simulatedIntrinsics(m);
   EXPECT_EQ(K.width, 160);
   EXPECT_EQ(K.height, 120);
   EXPECT_NEAR(K.fx, 525.0 / 4, 1e-12);
@@ -88,21 +90,21 @@ Terrain tiltedPlane(double slope_rad) {
 }
 
 TEST(SimBodyPose, OnTheRampTheNoseIsUp) {
-  const Terrain t = tiltedPlane(20.0 * kDegToRad);
+  const Terrain t = tiltedPlane(20.0 * core::kDegToRad);
   const Eigen::Isometry3d T = bodyPoseOnTerrain(t, {1.5, 0.0, 0.0}, RobotBodyParams{});
   const Eigen::Vector3d forward = T.linear().col(0);
-  EXPECT_NEAR(std::atan2(forward.z(), forward.x()), 20.0 * kDegToRad, 1e-6);
-  EXPECT_NEAR(T.translation().z(), 1.5 * std::tan(20.0 * kDegToRad), 1e-6);
+  EXPECT_NEAR(std::atan2(forward.z(), forward.x()), 20.0 * core::kDegToRad, 1e-6);
+  EXPECT_NEAR(T.translation().z(), 1.5 * std::tan(20.0 * core::kDegToRad), 1e-6);
   // Facing -y the robot's left is +x, uphill: it rolls with its left side up, not pitched.
   const Eigen::Isometry3d S = bodyPoseOnTerrain(t, {1.5, 0.0, -kPi / 2}, RobotBodyParams{});
-  EXPECT_NEAR(std::asin(S.linear().col(1).z()), 20.0 * kDegToRad, 1e-6);
+  EXPECT_NEAR(std::asin(S.linear().col(1).z()), 20.0 * core::kDegToRad, 1e-6);
   EXPECT_NEAR(S.linear().col(0).z(), 0.0, 1e-9);
 }
 
 TEST(SimBodyPose, OnATiltedPlanePitchAndRollAreTheSlopeAlongAndAcrossTheHeading) {
   for (double slope_deg : {5.0, 15.0, 25.0}) {
-    const double tan_slope = std::tan(slope_deg * kDegToRad);
-    const Terrain t = tiltedPlane(slope_deg * kDegToRad);
+    const double tan_slope = std::tan(slope_deg * core::kDegToRad);
+    const Terrain t = tiltedPlane(slope_deg * core::kDegToRad);
     for (int k = 0; k < 16; ++k) {
       const double yaw = -kPi + k * kPi / 8;
       const Eigen::Isometry3d T = bodyPoseOnTerrain(t, {2.0, 0.3, yaw}, RobotBodyParams{});

@@ -13,9 +13,11 @@
 #include <string>
 #include <vector>
 
+namespace core = upd::core;
+
 namespace {
 
-using upd::Label;
+using upd::core::Label;
 namespace sg = upd::sim::scene_geometry;
 
 std::string thrownMessage(const std::function<void()>& fn) {
@@ -27,9 +29,9 @@ std::string thrownMessage(const std::function<void()>& fn) {
   return "(nothing thrown)";
 }
 
-std::size_t countLabel(const std::vector<Label>& labels, Label l) {
+std::size_t countLabel(const std::vector<core::Label>& labels, core::Label l) {
   std::size_t n = 0;
-  for (Label x : labels) n += x == l ? 1 : 0;
+  for (core::Label x : labels) n += x == l ? 1 : 0;
   return n;
 }
 
@@ -72,7 +74,7 @@ TEST(CornerScene, TruthIsTheEdgeBandAndTheWall) {
   for (std::size_t i = 0; i < s.cloud.size(); ++i) {
     const bool wall = s.cloud.z[i] > 0.f;
     const bool band = s.cloud.x[i] <= sg::kCornerEdgeBand_m + 1e-6;
-    const Label expected = (wall || band) ? Label::NonTraversable : Label::Traversable;
+    const core::Label expected = (wall || band) ? core::Label::NonTraversable : core::Label::Traversable;
     ASSERT_EQ(s.truth[i], expected) << s.cloud.point(i).transpose();
   }
 }
@@ -89,9 +91,9 @@ TEST(Scenes, EveryNamedSceneHasBothLabelsAndNoUnknown) {
     EXPECT_EQ(s.name, name);
     ASSERT_EQ(s.truth.size(), s.cloud.size());
     EXPECT_EQ(s.cloud.countFinite(), s.cloud.size());
-    EXPECT_GT(countLabel(s.truth, Label::Traversable), s.cloud.size() / 4);
-    EXPECT_GT(countLabel(s.truth, Label::NonTraversable), 100u);
-    EXPECT_EQ(countLabel(s.truth, Label::Unknown), 0u);
+    EXPECT_GT(countLabel(s.truth, core::Label::Traversable), s.cloud.size() / 4);
+    EXPECT_GT(countLabel(s.truth, core::Label::NonTraversable), 100u);
+    EXPECT_EQ(countLabel(s.truth, core::Label::Unknown), 0u);
   }
 }
 
@@ -114,16 +116,16 @@ TEST(StepScene, HeightsTruthAndRiser) {
     const bool on_face = z > 1e-6f && z < sg::kStepHeight_m - 1e-6;
     if (on_face) {
       ASSERT_NEAR(x, 0.f, 1e-6f);
-      ASSERT_EQ(s.truth[i], Label::NonTraversable);
+      ASSERT_EQ(s.truth[i], core::Label::NonTraversable);
       ++riser;
       continue;
     }
     ASSERT_NEAR(z, x < 0 ? 0.f : sg::kStepHeight_m, 1e-6) << x;
     if (std::abs(x) > 0.06f) {
-      ASSERT_EQ(s.truth[i], Label::Traversable) << x;
+      ASSERT_EQ(s.truth[i], core::Label::Traversable) << x;
     }
     if (std::abs(x) < 0.04f) {
-      ASSERT_EQ(s.truth[i], Label::NonTraversable) << x;
+      ASSERT_EQ(s.truth[i], core::Label::NonTraversable) << x;
     }
   }
   // 301 columns along y (|y| <= 1.5) of 14 points (z = 0.01 .. 0.14).
@@ -139,20 +141,20 @@ TEST(RampScene, BodyFootAndGroundAreTraversableSidesAreNot) {
     const bool inside_width = std::abs(y) < 0.5 * sg::kRampWidth_m - 0.1;
     if (x > 0.2 && x < sg::kRampLength_m - 0.2 && inside_width) {
       ASSERT_NEAR(z, x * tan_slope, 1e-5);
-      ASSERT_EQ(s.truth[i], Label::Traversable) << x << " " << y;
+      ASSERT_EQ(s.truth[i], core::Label::Traversable) << x << " " << y;
       ++body;
     } else if (std::abs(x) <= 0.02 && inside_width) {
       ASSERT_NEAR(z, std::max(0.0, x * tan_slope), 1e-5);
-      ASSERT_EQ(s.truth[i], Label::Traversable) << "lower border " << x << " " << y;
+      ASSERT_EQ(s.truth[i], core::Label::Traversable) << "lower border " << x << " " << y;
       ++foot;
     } else if (x < -0.6) {
       ASSERT_EQ(z, 0.f);
-      ASSERT_EQ(s.truth[i], Label::Traversable);
+      ASSERT_EQ(s.truth[i], core::Label::Traversable);
       ++ground;
     } else if (x > 0.5 && x < sg::kRampLength_m && std::abs(y) > 0.5 * sg::kRampWidth_m &&
                std::abs(y) < 0.5 * sg::kRampWidth_m + 0.04) {
       // The side of the ramp stands > 0.18 m tall here.
-      ASSERT_EQ(s.truth[i], Label::NonTraversable) << x << " " << y;
+      ASSERT_EQ(s.truth[i], core::Label::NonTraversable) << x << " " << y;
       ++side;
     }
   }
@@ -170,7 +172,7 @@ TEST(StairsScene, TreadMiddlesTraversableRiserBandsNot) {
     const double x = s.cloud.x[i], y = s.cloud.y[i], z = s.cloud.z[i];
     if (std::abs(z - t.heightAt(x, y)) > 1e-6) {  // a riser point
       ++faces;
-      ASSERT_EQ(s.truth[i], Label::NonTraversable);
+      ASSERT_EQ(s.truth[i], core::Label::NonTraversable);
       continue;
     }
     double riser_dist = 1e9;
@@ -178,10 +180,10 @@ TEST(StairsScene, TreadMiddlesTraversableRiserBandsNot) {
       riser_dist = std::min(riser_dist, std::abs(x - k * sg::kStairsRun_m));
     }
     if (riser_dist < 0.04) {
-      ASSERT_EQ(s.truth[i], Label::NonTraversable) << x;
+      ASSERT_EQ(s.truth[i], core::Label::NonTraversable) << x;
     }
     if (riser_dist > 0.06) {
-      ASSERT_EQ(s.truth[i], Label::Traversable) << x;
+      ASSERT_EQ(s.truth[i], core::Label::Traversable) << x;
       if (x > 0 && x < sg::kStairsSteps * sg::kStairsRun_m) ++treads;
     }
     const int step =
@@ -207,10 +209,10 @@ TEST(DitchScene, DitchAndRimsAreNonTraversable) {
       ASSERT_EQ(z, 0.f);
     }
     if (std::abs(x) <= half + 0.049) {
-      ASSERT_EQ(s.truth[i], Label::NonTraversable) << x;
+      ASSERT_EQ(s.truth[i], core::Label::NonTraversable) << x;
     }
     if (std::abs(x) >= half + 0.051) {
-      ASSERT_EQ(s.truth[i], Label::Traversable) << x;
+      ASSERT_EQ(s.truth[i], core::Label::Traversable) << x;
     }
   }
   EXPECT_EQ(walls, 2u * 301u * 29u);  // two walls, z = -0.29 .. -0.01
@@ -221,10 +223,10 @@ TEST(RocksScene, RocksAreNonTraversablePebblesAndGroundAreNot) {
   const upd::sim::Terrain t = upd::sim::makeSceneTerrain("rocks");
   ASSERT_FALSE(t.rocks().empty());
   for (const upd::sim::Rock& r : t.rocks()) {
-    const Label at_top = t.truthAt(r.center_xy.x(), r.center_xy.y());
+    const core::Label at_top = t.truthAt(r.center_xy.x(), r.center_xy.y());
     EXPECT_NEAR(t.heightAt(r.center_xy.x(), r.center_xy.y()), r.height_m, 0.03);
     EXPECT_EQ(at_top,
-              r.height_m > t.truthParams().max_step_m ? Label::NonTraversable : Label::Traversable)
+              r.height_m > t.truthParams().max_step_m ? core::Label::NonTraversable : core::Label::Traversable)
         << r.center_xy.transpose();
   }
   // Rough ground: the height varies by millimetres away from the rocks, and stays traversable.
@@ -238,7 +240,7 @@ TEST(RocksScene, RocksAreNonTraversablePebblesAndGroundAreNot) {
     if (near_rock) continue;
     min_z = std::min(min_z, static_cast<double>(s.cloud.z[i]));
     max_z = std::max(max_z, static_cast<double>(s.cloud.z[i]));
-    ASSERT_EQ(s.truth[i], Label::Traversable) << p.transpose();
+    ASSERT_EQ(s.truth[i], core::Label::Traversable) << p.transpose();
   }
   EXPECT_GT(max_z - min_z, 0.01);
   EXPECT_LT(max_z - min_z, 0.05);
@@ -316,7 +318,7 @@ TEST(Terrain, PrimitivesHaveTheirHeights) {
   box.length_m = 1.0;
   box.width_m = 0.4;
   box.height_m = 0.2;
-  box.yaw_rad = 90.0 * upd::kDegToRad;  // long along y
+  box.yaw_rad = 90.0 * upd::core::kDegToRad;  // long along y
   upd::sim::Stairs st;
   st.start_xy = {-3.0, 0.0};
   st.steps = 2;
@@ -367,30 +369,30 @@ TEST(Terrain, TruthRuleOnPrimitives) {
   ramp.height_m = 0.4;
   upd::sim::Ramp steep = ramp;
   steep.start_xy = {-1.0, 0.0};
-  steep.slope_rad = 35.0 * upd::kDegToRad;
+  steep.slope_rad = 35.0 * upd::core::kDegToRad;
   t.add(low).add(wall).add(ramp).add(steep);
 
-  EXPECT_EQ(t.truthAt(0.0, 4.5), Label::Traversable);
-  EXPECT_EQ(t.truthAt(6.0, 0.0), Label::Unknown);
-  EXPECT_EQ(t.truthAt(-2.5, 3.0), Label::Traversable);     // edge of the 3 cm step
-  EXPECT_EQ(t.truthAt(3.0, 3.0), Label::NonTraversable);   // wall top
-  EXPECT_EQ(t.truthAt(3.0, 3.19), Label::NonTraversable);  // wall band
-  EXPECT_EQ(t.truthAt(3.0, 3.21), Label::Traversable);
-  EXPECT_EQ(t.truthAt(-0.5, -3.0), Label::Traversable);   // ramp body
-  EXPECT_EQ(t.truthAt(-1.0, -3.0), Label::Traversable);   // its foot
-  EXPECT_EQ(t.truthAt(-1.04, -3.0), Label::Traversable);  // ground before the foot
+  EXPECT_EQ(t.truthAt(0.0, 4.5), core::Label::Traversable);
+  EXPECT_EQ(t.truthAt(6.0, 0.0), core::Label::Unknown);
+  EXPECT_EQ(t.truthAt(-2.5, 3.0), core::Label::Traversable);     // edge of the 3 cm step
+  EXPECT_EQ(t.truthAt(3.0, 3.0), core::Label::NonTraversable);   // wall top
+  EXPECT_EQ(t.truthAt(3.0, 3.19), core::Label::NonTraversable);  // wall band
+  EXPECT_EQ(t.truthAt(3.0, 3.21), core::Label::Traversable);
+  EXPECT_EQ(t.truthAt(-0.5, -3.0), core::Label::Traversable);   // ramp body
+  EXPECT_EQ(t.truthAt(-1.0, -3.0), core::Label::Traversable);   // its foot
+  EXPECT_EQ(t.truthAt(-1.04, -3.0), core::Label::Traversable);  // ground before the foot
   // The ramp's sides: lower than max_step near the foot, taller further up.
-  const double tan20 = std::tan(20.0 * upd::kDegToRad);
-  EXPECT_EQ(t.truthAt(-1.0 + 0.03 / tan20, -2.49), Label::Traversable);
-  EXPECT_EQ(t.truthAt(-1.0 + 0.10 / tan20, -2.49), Label::NonTraversable);
-  EXPECT_EQ(t.truthAt(-1.0 + 0.10 / tan20, -2.46), Label::NonTraversable);  // ground side
-  EXPECT_EQ(t.truthAt(-1.0 + 0.10 / tan20, -2.44), Label::Traversable);
+  const double tan20 = std::tan(20.0 * upd::core::kDegToRad);
+  EXPECT_EQ(t.truthAt(-1.0 + 0.03 / tan20, -2.49), core::Label::Traversable);
+  EXPECT_EQ(t.truthAt(-1.0 + 0.10 / tan20, -2.49), core::Label::NonTraversable);
+  EXPECT_EQ(t.truthAt(-1.0 + 0.10 / tan20, -2.46), core::Label::NonTraversable);  // ground side
+  EXPECT_EQ(t.truthAt(-1.0 + 0.10 / tan20, -2.44), core::Label::Traversable);
   // The top end of a ramp without a platform is a drop.
   const double top_x = -1.0 + ramp.slopeLength();
-  EXPECT_EQ(t.truthAt(top_x + 0.03, -3.0), Label::NonTraversable);
-  EXPECT_EQ(t.truthAt(top_x + 0.07, -3.0), Label::Traversable);
-  EXPECT_EQ(t.truthAt(-0.5, 0.0), Label::NonTraversable);  // 35 deg body
-  EXPECT_NEAR(t.slopeAt(-0.5, 0.0), 35.0 * upd::kDegToRad, 1e-6);
+  EXPECT_EQ(t.truthAt(top_x + 0.03, -3.0), core::Label::NonTraversable);
+  EXPECT_EQ(t.truthAt(top_x + 0.07, -3.0), core::Label::Traversable);
+  EXPECT_EQ(t.truthAt(-0.5, 0.0), core::Label::NonTraversable);  // 35 deg body
+  EXPECT_NEAR(t.slopeAt(-0.5, 0.0), 35.0 * upd::core::kDegToRad, 1e-6);
 }
 
 TEST(Terrain, SampleSurfaceLabelsFacePointsNonTraversable) {
@@ -407,7 +409,7 @@ TEST(Terrain, SampleSurfaceLabelsFacePointsNonTraversable) {
   // Four sides of 51 columns; the corner columns are sampled once: 4 * 50 columns of 9 points.
   EXPECT_EQ(s.cloud.size() - s.surface_points, 4u * 50u * 9u);
   for (std::size_t i = s.surface_points; i < s.cloud.size(); ++i) {
-    ASSERT_EQ(s.truth[i], Label::NonTraversable);
+    ASSERT_EQ(s.truth[i], core::Label::NonTraversable);
     ASSERT_NEAR(std::max(std::abs(s.cloud.x[i]), std::abs(s.cloud.y[i])), 0.5f, 1e-6f);
   }
   EXPECT_THROW(t.sampleSurface(0.0), std::invalid_argument);
@@ -447,7 +449,7 @@ class Reach {
     for (int j = 0; j < ny_; ++j) {
       for (int i = 0; i < nx_; ++i) {
         const Eigen::Vector2d p = center(i, j);
-        ok[idx(i, j)] = t.truthAt(p.x(), p.y()) == Label::Traversable;
+        ok[idx(i, j)] = t.truthAt(p.x(), p.y()) == core::Label::Traversable;
       }
     }
     const int r = static_cast<int>(std::ceil(clearance_m / cell_m));
@@ -503,7 +505,7 @@ class Reach {
     const int n = static_cast<int>((to - from).norm() / (0.5 * cell_)) + 1;
     for (int k = 0; k <= n; ++k) {
       const Eigen::Vector2d p = from + (to - from) * (static_cast<double>(k) / n);
-      if (t_.truthAt(p.x(), p.y()) != Label::Traversable) return false;
+      if (t_.truthAt(p.x(), p.y()) != core::Label::Traversable) return false;
     }
     return true;
   }
@@ -542,8 +544,8 @@ TEST(Worlds, NamesStartsAndGoals) {
     const upd::sim::Terrain& t = w.terrain;
     EXPECT_TRUE(t.contains(w.start_xy_yaw.x(), w.start_xy_yaw.y()));
     EXPECT_TRUE(t.contains(w.goal_xy.x(), w.goal_xy.y()));
-    EXPECT_EQ(t.truthAt(w.start_xy_yaw.x(), w.start_xy_yaw.y()), Label::Traversable);
-    EXPECT_EQ(t.truthAt(w.goal_xy.x(), w.goal_xy.y()), Label::Traversable);
+    EXPECT_EQ(t.truthAt(w.start_xy_yaw.x(), w.start_xy_yaw.y()), core::Label::Traversable);
+    EXPECT_EQ(t.truthAt(w.goal_xy.x(), w.goal_xy.y()), core::Label::Traversable);
   }
   const std::string msg = thrownMessage([] { upd::sim::makeWorld("moon"); });
   for (const std::string& name : names) EXPECT_NE(msg.find(name), std::string::npos) << msg;
@@ -564,7 +566,7 @@ TEST(Worlds, MixedWorldHasItsFeatures) {
   EXPECT_NEAR((t.maxXY() - t.minXY()).x(), 12.0, 1e-9);
   EXPECT_NEAR((t.maxXY() - t.minXY()).y(), 8.0, 1e-9);
   ASSERT_EQ(t.ramps().size(), 1u);
-  EXPECT_NEAR(t.ramps()[0].slope_rad, 20.0 * upd::kDegToRad, 1e-12);
+  EXPECT_NEAR(t.ramps()[0].slope_rad, 20.0 * upd::core::kDegToRad, 1e-12);
   EXPECT_GE(t.rocks().size(), 3u);
   bool step = false, platform = false;
   for (const upd::sim::Box& b : t.boxes()) {
@@ -576,7 +578,7 @@ TEST(Worlds, MixedWorldHasItsFeatures) {
   ASSERT_EQ(t.ditches().size(), 1u);
   EXPECT_NEAR(t.ditches()[0].width_m, 0.6, 1e-12);
   const upd::sim::Ditch& d = t.ditches()[0];
-  EXPECT_EQ(t.truthAt(d.center_xy.x(), d.center_xy.y()), Label::NonTraversable);
+  EXPECT_EQ(t.truthAt(d.center_xy.x(), d.center_xy.y()), core::Label::NonTraversable);
   EXPECT_NEAR(t.heightAt(d.center_xy.x(), d.center_xy.y()), -d.depth_m, 1e-12);
   // Climbing the ramp reaches the platform top.
   const upd::sim::Ramp& r = t.ramps()[0];
@@ -585,11 +587,11 @@ TEST(Worlds, MixedWorldHasItsFeatures) {
   const Eigen::Vector2d top = r.start_xy + (r.slopeLength() + 0.5) * dir;
   EXPECT_NEAR(t.heightAt(mid.x(), mid.y()), 0.15, 1e-9);
   EXPECT_NEAR(t.heightAt(top.x(), top.y()), 0.3, 1e-9);
-  EXPECT_EQ(t.truthAt(mid.x(), mid.y()), Label::Traversable);
-  EXPECT_EQ(t.truthAt(top.x(), top.y()), Label::Traversable);
+  EXPECT_EQ(t.truthAt(mid.x(), mid.y()), core::Label::Traversable);
+  EXPECT_EQ(t.truthAt(top.x(), top.y()), core::Label::Traversable);
   for (const upd::sim::Rock& rock : t.rocks()) {
-    const Label l = t.truthAt(rock.center_xy.x(), rock.center_xy.y());
-    EXPECT_EQ(l, rock.height_m > 0.05 ? Label::NonTraversable : Label::Traversable);
+    const core::Label l = t.truthAt(rock.center_xy.x(), rock.center_xy.y());
+    EXPECT_EQ(l, rock.height_m > 0.05 ? core::Label::NonTraversable : core::Label::Traversable);
   }
 }
 
@@ -599,8 +601,8 @@ TEST(Worlds, RampWorldPlatformIsReachedOnlyByTheRamp) {
   EXPECT_NEAR(t.heightAt(w.goal_xy.x(), w.goal_xy.y()), 0.3, 1e-9);  // goal on the platform
   ASSERT_EQ(t.ramps().size(), 1u);
   const upd::sim::Ramp& r = t.ramps()[0];
-  EXPECT_NEAR(r.slope_rad, 20.0 * upd::kDegToRad, 1e-12);
-  ASSERT_NEAR(r.yaw_rad, 90.0 * upd::kDegToRad, 1e-12);  // climbs +y: the block below uses it
+  EXPECT_NEAR(r.slope_rad, 20.0 * upd::core::kDegToRad, 1e-12);
+  ASSERT_NEAR(r.yaw_rad, 90.0 * upd::core::kDegToRad, 1e-12);  // climbs +y: the block below uses it
   Reach reach(t, kRobotRadius_m);
   ASSERT_TRUE(reach.reachable(w.start_xy_yaw.head<2>(), w.goal_xy));
   EXPECT_FALSE(reach.lineIsFree(w.start_xy_yaw.head<2>(), w.goal_xy));

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+namespace core = upd::core;
+
 namespace upd::sim {
 namespace {
 
@@ -24,7 +26,7 @@ TEST(SimTruthRaster, CellsHoldTheTruthAtTheirCentres) {
       const Eigen::Vector2d c = truth.cellCenter(ix, iy);
       EXPECT_NEAR(c.x(), (ix + 0.5) * 0.1, 1e-12);
       ASSERT_EQ(truth.at(ix, iy), world.terrain.truthAt(c.x(), c.y()));
-      non_traversable += truth.at(ix, iy) == Label::NonTraversable;
+      non_traversable += truth.at(ix, iy) == core::Label::NonTraversable;
     }
   }
   EXPECT_GT(non_traversable, 100u);

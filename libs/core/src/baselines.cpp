@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-namespace upd {
+namespace upd::core {
 
 void BaselineParams::validate() const {
   requireParam(std::isfinite(radius_m) && radius_m > 0, "BaselineParams", "radius_m", radius_m,
@@ -72,4 +72,4 @@ BaselineResult computeBaselines(const PointCloud& cloud, const KdTree& tree,
   return out;
 }
 
-}  // namespace upd
+}  // namespace upd::core

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace upd {
+namespace upd::core {
 
 void CameraIntrinsics::validate() const {
   requireParam(width > 0, "CameraIntrinsics", "width", width, "must be > 0");
@@ -54,4 +54,4 @@ void depthToCloud(const DepthImage& depth, const CameraIntrinsics& K, PointCloud
   }
 }
 
-}  // namespace upd
+}  // namespace upd::core

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-namespace upd {
+namespace upd::core {
 
 void ClassifyParams::validate() const {
   requireParam(zeta_min >= 0.0 && zeta_min <= 1.0, "ClassifyParams", "zeta_min", zeta_min,
@@ -129,4 +129,4 @@ const char* toString(Label l) {
   return "invalid";
 }
 
-}  // namespace upd
+}  // namespace upd::core

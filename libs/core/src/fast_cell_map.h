@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace upd::detail {
+namespace upd::core::detail {
 
 constexpr std::uint32_t kNoIndex = 0xffffffffu;
 constexpr std::int64_t kKeyBias = std::int64_t(1) << 20;  ///< coordinates in [-2^20, 2^20)
@@ -192,4 +192,4 @@ void listByCell(std::size_t n_items, std::size_t n_cells, CellOfItem&& cell, Cel
   }
 }
 
-}  // namespace upd::detail
+}  // namespace upd::core::detail

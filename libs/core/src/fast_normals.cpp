@@ -15,7 +15,7 @@
 #include "fast_normals_internal.h"
 #include "upd/core/fast_normals.h"
 
-namespace upd::detail {
+namespace upd::core::detail {
 
 // The covariance of the moments, scaled to unit trace (a, b, c / d, e / f: its upper triangle),
 // or false when it has no spread.
@@ -125,9 +125,9 @@ bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature) {
   return unitCovariance(m, cov) && normalFromUnitCovariance(cov, n, curvature);
 }
 
-}  // namespace upd::detail
+}  // namespace upd::core::detail
 
-namespace upd {
+namespace upd::core {
 
 namespace {
 
@@ -268,4 +268,4 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
   return out;
 }
 
-}  // namespace upd
+}  // namespace upd::core

@@ -12,7 +12,7 @@
 #include "fast_simd.h"
 #include "upd/core/normals.h"
 
-namespace upd::detail {
+namespace upd::core::detail {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 // Coordinate of the invalid pixels in the scanned images: farther than any radius [m].
@@ -96,4 +96,4 @@ inline void setNormal(Normals& out, std::size_t i, const Eigen::Vector3f& n, flo
   out.curvature[i] = curvature;
 }
 
-}  // namespace upd::detail
+}  // namespace upd::core::detail

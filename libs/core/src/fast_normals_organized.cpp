@@ -13,7 +13,7 @@
 #include "upd/core/fast_normals.h"
 #include "upd/core/openmp.h"
 
-namespace upd {
+namespace upd::core {
 
 namespace {
 
@@ -583,4 +583,4 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   out.invalid = pixelNormals(pass, scan, out);
 }
 
-}  // namespace upd
+}  // namespace upd::core

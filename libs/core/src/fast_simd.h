@@ -9,7 +9,7 @@
 
 #include "upd/core/vector_clones.h"
 
-namespace upd::detail {
+namespace upd::core::detail {
 
 /// Lanes of the fixed-width inner loops (a multiple of every vector width used).
 constexpr int kLanes = 16;
@@ -42,4 +42,4 @@ inline float rsqrtNewton(float x) {
   return y;
 }
 
-}  // namespace upd::detail
+}  // namespace upd::core::detail

@@ -9,7 +9,7 @@
 
 #include "fast_upd_internal.h"
 
-namespace upd {
+namespace upd::core {
 
 namespace {
 
@@ -106,4 +106,4 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   }
 }
 
-}  // namespace upd
+}  // namespace upd::core

@@ -9,7 +9,7 @@
 
 #include "fast_upd_internal.h"
 
-namespace upd::detail {
+namespace upd::core::detail {
 
 namespace {
 
@@ -168,4 +168,4 @@ Bins binFrame(FastFrame& f) {
   return bins;
 }
 
-}  // namespace upd::detail
+}  // namespace upd::core::detail

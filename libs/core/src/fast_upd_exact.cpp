@@ -7,7 +7,7 @@
 
 #include "fast_upd_internal.h"
 
-namespace upd::detail {
+namespace upd::core::detail {
 
 namespace {
 
@@ -292,4 +292,4 @@ std::size_t scoreExactBand(const FastFrame& f, const LatticeIndex& index, const 
   return all.size();
 }
 
-}  // namespace upd::detail
+}  // namespace upd::core::detail

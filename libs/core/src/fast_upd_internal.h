@@ -20,7 +20,7 @@
 #include "fast_simd.h"
 #include "upd/core/fast_upd.h"
 
-namespace upd::detail {
+namespace upd::core::detail {
 
 // Per-cell sums over the points with a valid normal. Positions are relative to the cell's
 // lower corner in cell units (in [0, 1)), so float keeps them exact enough anywhere.
@@ -213,4 +213,4 @@ std::size_t scoreExactBand(const FastFrame& f, const LatticeIndex& index, const 
                            double zeta_threshold, CellPoints& pts, UpdResult& out,
                            std::size_t& invalid);
 
-}  // namespace upd::detail
+}  // namespace upd::core::detail

@@ -8,7 +8,7 @@
 
 #include "fast_upd_internal.h"
 
-namespace upd::detail {
+namespace upd::core::detail {
 
 namespace {
 
@@ -159,4 +159,4 @@ std::size_t interpolateFrame(const FastFrame& f, const Bins& bins, FastUpdBuffer
   return invalid;
 }
 
-}  // namespace upd::detail
+}  // namespace upd::core::detail

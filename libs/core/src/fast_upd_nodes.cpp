@@ -7,7 +7,7 @@
 
 #include "fast_upd_internal.h"
 
-namespace upd::detail {
+namespace upd::core::detail {
 
 namespace {
 
@@ -402,4 +402,4 @@ std::size_t scoreRefinedCells(const FastFrame& f, const LatticeIndex& index, con
   return invalid;
 }
 
-}  // namespace upd::detail
+}  // namespace upd::core::detail

@@ -8,7 +8,7 @@
 #include <limits>
 #include <stdexcept>
 
-namespace upd {
+namespace upd::core {
 
 const char* toString(ObstacleDetector detector) {
   return detector == ObstacleDetector::Upd ? "upd" : "roughness";
@@ -158,4 +158,4 @@ ScoredFrame FrameScorer::score(const PointCloud& cloud,
   return out;
 }
 
-}  // namespace upd
+}  // namespace upd::core

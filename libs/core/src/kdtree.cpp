@@ -4,7 +4,7 @@
 #include <limits>
 #include <stdexcept>
 
-namespace upd {
+namespace upd::core {
 
 KdTree::KdTree(const PointCloud& cloud, int leaf_size) : cloud_(cloud), leaf_size_(leaf_size) {
   if (leaf_size < 1) throw std::invalid_argument("KdTree leaf_size must be >= 1");
@@ -158,4 +158,4 @@ void KdTree::knnSearch(const Eigen::Vector3f& q_world, int k, std::vector<std::u
   }
 }
 
-}  // namespace upd
+}  // namespace upd::core

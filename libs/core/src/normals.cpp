@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-namespace upd {
+namespace upd::core {
 
 void NormalParams::validate() const {
   requireParam(std::isfinite(radius_m) && radius_m > 0, "NormalParams", "radius_m", radius_m,
@@ -117,4 +117,4 @@ Normals computeNormals(const PointCloud& cloud, const KdTree& tree, const Normal
   return out;
 }
 
-}  // namespace upd
+}  // namespace upd::core

@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-namespace upd {
+namespace upd::core {
 
 void PipelineParams::validate() const {
   requireParam(up.allFinite() && up.norm() > 1e-6f, "PipelineParams", "up", up,
@@ -82,4 +82,4 @@ void runPipeline(const PointCloud& input, const PipelineParams& params, Pipeline
   res.timings.total_ms = total.elapsedMs();
 }
 
-}  // namespace upd
+}  // namespace upd::core

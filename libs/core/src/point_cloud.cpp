@@ -5,7 +5,7 @@
 
 #include "upd/core/openmp.h"
 
-namespace upd {
+namespace upd::core {
 
 namespace {
 // out = r * p + t for n points. The rotation and translation are plain local floats (firstprivate
@@ -91,4 +91,4 @@ void rotateVectors(const Eigen::Matrix3f& rotation, std::size_t n, const float* 
   applyTransform(rotation, Eigen::Vector3f::Zero(), n, x, y, z, out_x, out_y, out_z);
 }
 
-}  // namespace upd
+}  // namespace upd::core

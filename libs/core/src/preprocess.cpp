@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-namespace upd {
+namespace upd::core {
 
 void PreprocessParams::validate() const {
   requireParam(std::isfinite(range_min_m) && range_min_m >= 0, "PreprocessParams", "range_min_m",
@@ -261,4 +261,4 @@ void preprocess(const PointCloud& in, const PreprocessParams& p, PointCloud& out
   if (stats) *stats = st;
 }
 
-}  // namespace upd
+}  // namespace upd::core

@@ -13,7 +13,7 @@
 #include "upd/core/kdtree.h"
 #include "upd/core/preprocess.h"
 
-namespace upd {
+namespace upd::core {
 
 namespace {
 
@@ -332,4 +332,4 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
   return mean_dist;
 }
 
-}  // namespace upd
+}  // namespace upd::core

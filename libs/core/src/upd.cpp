@@ -4,7 +4,7 @@
 #include <limits>
 #include <stdexcept>
 
-namespace upd {
+namespace upd::core {
 
 void UpdParams::validate() const {
   requireParam(std::isfinite(radius_m) && radius_m > 0, "UpdParams", "radius_m", radius_m,
@@ -78,4 +78,4 @@ UpdResult computeUpd(const PointCloud& cloud, const KdTree& tree, const Normals&
   return out;
 }
 
-}  // namespace upd
+}  // namespace upd::core

@@ -30,7 +30,7 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
-PointCloud readCloud(const std::string& path) {
+core::PointCloud readCloud(const std::string& path) {
   const std::string ext = lowerExtension(path);
   if (ext == ".pcd") return readPcd(path);
   if (ext == ".ply") return readPly(path);

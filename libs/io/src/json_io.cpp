@@ -49,12 +49,12 @@ struct JsonParamVisitor {
     out[key] = v;
   }
   void angleDeg(const char* key, double& radians, const char* /*doc*/) {
-    out[key] = doubleValue(radians * kRadToDeg);
+    out[key] = doubleValue(radians * core::kRadToDeg);
   }
   /// Enums by their ini name, so the params can be copied back into an ini file.
   template <class E, std::size_t N>
-  void choice(const char* key, E& value, const EnumName<E> (&names)[N], const char* /*doc*/) {
-    const char* name = enumName(names, value);
+  void choice(const char* key, E& value, const core::EnumName<E> (&names)[N], const char* /*doc*/) {
+    const char* name = core::enumName(names, value);
     out[key] = name != nullptr ? json(name) : json(static_cast<int>(value));
   }
 };
@@ -88,7 +88,7 @@ json histogramJson(const std::vector<float>& values, double lo, double hi, int b
   return json{{"edges", edges}, {"counts", counts}};
 }
 
-json paramsJson(const PipelineParams& params) {
+json paramsJson(const core::PipelineParams& params) {
   json j = json::object();
   j["up"] = json::array(
       {floatValue(params.up.x()), floatValue(params.up.y()), floatValue(params.up.z())});
@@ -126,7 +126,7 @@ json zetaJson(const std::vector<float>& zeta, std::size_t& scored) {
 
 /// Non-finite input points that pre-processing dropped. PreprocessStats.non_finite counts the
 /// non-finite input points; those still in the scored cloud are already among the unscored.
-std::size_t droppedNonFinite(const PipelineResult& result) {
+std::size_t droppedNonFinite(const core::PipelineResult& result) {
   std::size_t kept_non_finite = 0;
   for (std::size_t i = 0; i < result.cloud.size(); ++i) {
     kept_non_finite += result.cloud.isFinite(i) ? 0 : 1;
@@ -135,13 +135,13 @@ std::size_t droppedNonFinite(const PipelineResult& result) {
   return non_finite > kept_non_finite ? non_finite - kept_non_finite : 0;
 }
 
-json labelsJson(const std::vector<Label>& labels) {
+json labelsJson(const std::vector<core::Label>& labels) {
   std::size_t traversable = 0, non_traversable = 0, unknown = 0;
-  for (Label l : labels) {
+  for (core::Label l : labels) {
     switch (l) {
-      case Label::Traversable: ++traversable; break;
-      case Label::NonTraversable: ++non_traversable; break;
-      case Label::Unknown: ++unknown; break;
+      case core::Label::Traversable: ++traversable; break;
+      case core::Label::NonTraversable: ++non_traversable; break;
+      case core::Label::Unknown: ++unknown; break;
     }
   }
   return {{"traversable", traversable},
@@ -150,12 +150,12 @@ json labelsJson(const std::vector<Label>& labels) {
 }
 
 /// Which path scored the cloud (UpdParams::method auto lets the pipeline choose), into j.
-void addMethod(json& j, const PipelineResult& result, const PipelineParams& params) {
-  j["method"] = result.method == UpdMethod::Fast ? "fast" : "exact";
-  j["normals_method"] = result.method == UpdMethod::Exact ? "exact (k-d tree)"
+void addMethod(json& j, const core::PipelineResult& result, const core::PipelineParams& params) {
+  j["method"] = result.method == core::UpdMethod::Fast ? "fast" : "exact";
+  j["normals_method"] = result.method == core::UpdMethod::Exact ? "exact (k-d tree)"
                         : result.organized_normals        ? "organized window scans"
                                                           : "hash grid";
-  if (result.method == UpdMethod::Fast) {
+  if (result.method == core::UpdMethod::Fast) {
     // The points near zeta_min that got the exact sums (UpdParams::fast_exact_band).
     j["exact_band"] = {{"band", doubleValue(params.upd.fast_exact_band)},
                        {"zeta_min", doubleValue(params.classify.zeta_min)},
@@ -165,13 +165,13 @@ void addMethod(json& j, const PipelineResult& result, const PipelineParams& para
   }
 }
 
-json timingJson(const StageTimings& t) {
+json timingJson(const core::StageTimings& t) {
   return {{"preprocess", doubleValue(t.preprocess_ms)}, {"index", doubleValue(t.index_ms)},
           {"normals", doubleValue(t.normals_ms)},       {"upd", doubleValue(t.upd_ms)},
           {"classify", doubleValue(t.classify_ms)},     {"total", doubleValue(t.total_ms)}};
 }
 
-json preprocessJson(const PreprocessStats& s) {
+json preprocessJson(const core::PreprocessStats& s) {
   return {{"points_in", s.points_in},
           {"non_finite", s.non_finite},
           {"range_removed", s.range_removed},
@@ -182,7 +182,7 @@ json preprocessJson(const PreprocessStats& s) {
 
 }  // namespace
 
-json summaryJson(const PipelineResult& result, const PipelineParams& params,
+json summaryJson(const core::PipelineResult& result, const core::PipelineParams& params,
                  std::size_t points_in) {
   std::size_t scored = 0;
   json z = zetaJson(result.upd.zeta, scored);

@@ -198,7 +198,7 @@ void checkPcdFile(const std::string& path, pcl::PCDReader& reader) {
 }
 
 // The cloud of a read blob: x, y, z (any numeric type) and the packed colour when there is one.
-PointCloud cloudFromBlob(const std::string& path, const pcl::PCLPointCloud2& blob) {
+core::PointCloud cloudFromBlob(const std::string& path, const pcl::PCLPointCloud2& blob) {
   const std::size_t n = std::size_t{blob.width} * blob.height;
   // The body may carry different field offsets than the header said (PCL re-derives them);
   // look them up again.
@@ -214,7 +214,7 @@ PointCloud cloudFromBlob(const std::string& path, const pcl::PCLPointCloud2& blo
   if (!fc) fc = findField(blob, "rgba");
   if (fc && pcl::getFieldSize(fc->datatype) != 4) fc = nullptr;
 
-  PointCloud cloud;
+  core::PointCloud cloud;
   cloud.x.resize(n);
   cloud.y.resize(n);
   cloud.z.resize(n);
@@ -249,7 +249,7 @@ PointCloud cloudFromBlob(const std::string& path, const pcl::PCLPointCloud2& blo
 
 }  // namespace
 
-PointCloud readPcd(const std::string& path) {
+core::PointCloud readPcd(const std::string& path) {
   detail::requireReadableFile(path);
   const QuietPclConsole quiet;
   pcl::PCDReader reader;
@@ -270,12 +270,12 @@ PointCloud readPcd(const std::string& path) {
     throw fileError(path, "corrupt or truncated PCD data (" + std::to_string(n) +
                               " points declared)");
   }
-  PointCloud cloud = cloudFromBlob(path, blob);
+  core::PointCloud cloud = cloudFromBlob(path, blob);
   cloud.sensor_origin = origin.head<3>();
   return cloud;
 }
 
-void writePcd(const std::string& path, const PointCloud& cloud) {
+void writePcd(const std::string& path, const core::PointCloud& cloud) {
   const std::size_t n = cloud.size();
   if (cloud.y.size() != n || cloud.z.size() != n) {
     throw std::invalid_argument("writePcd: x, y, z of the cloud differ in size");

@@ -222,7 +222,7 @@ struct VertexLayout {
 
 // Appends one vertex whose property values (in the element's order) are v.
 void appendVertex(const std::vector<double>& v, const PlyElement& e, const VertexLayout& lay,
-                  bool color, PointCloud& cloud) {
+                  bool color, core::PointCloud& cloud) {
   cloud.x.push_back(static_cast<float>(v[lay.x]));
   cloud.y.push_back(static_cast<float>(v[lay.y]));
   cloud.z.push_back(static_cast<float>(v[lay.z]));
@@ -233,7 +233,7 @@ void appendVertex(const std::vector<double>& v, const PlyElement& e, const Verte
   }
 }
 
-void prepareCloud(PointCloud& cloud, std::size_t n, bool color) {
+void prepareCloud(core::PointCloud& cloud, std::size_t n, bool color) {
   cloud.x.resize(n);
   cloud.y.resize(n);
   cloud.z.resize(n);
@@ -310,7 +310,7 @@ void skipBinaryElement(BinaryReader& rd, const PlyElement& e) {
 }
 
 void readBinaryVertices(const std::string& path, std::ifstream& in, BinaryReader& rd,
-                        const PlyElement& e, const VertexLayout& lay, PointCloud& cloud) {
+                        const PlyElement& e, const VertexLayout& lay, core::PointCloud& cloud) {
   const bool color = lay.hasColor();
   const std::size_t np = e.properties.size();
   if (e.fixedSize()) {
@@ -412,7 +412,7 @@ class AsciiReader {
 };
 
 void readAsciiVertices(const std::string& path, AsciiReader& rd, const PlyElement& e,
-                       const VertexLayout& lay, PointCloud& cloud) {
+                       const VertexLayout& lay, core::PointCloud& cloud) {
   const bool color = lay.hasColor();
   const std::size_t np = e.properties.size();
   std::vector<double> v(np, 0.0);
@@ -456,7 +456,7 @@ void readAsciiVertices(const std::string& path, AsciiReader& rd, const PlyElemen
 
 }  // namespace
 
-PointCloud readPly(const std::string& path) {
+core::PointCloud readPly(const std::string& path) {
   detail::requireReadableFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw fileError(path, "cannot open for reading");
@@ -468,7 +468,7 @@ PointCloud readPly(const std::string& path) {
   const VertexLayout lay(*vertex);
   if (!lay.hasXyz()) throw fileError(path, "PLY vertex element has no x/y/z properties");
 
-  PointCloud cloud;
+  core::PointCloud cloud;
   if (h.format == PlyFormat::Ascii) {
     AsciiReader rd(path, in, h.lines);
     for (auto e = h.elements.begin(); e != vertex; ++e) {
@@ -542,7 +542,7 @@ void writeBinaryPly(const std::string& path, std::size_t n, const std::vector<Pl
 
 }  // namespace detail
 
-void writePly(const std::string& path, const PointCloud& cloud, const std::vector<Label>* labels,
+void writePly(const std::string& path, const core::PointCloud& cloud, const std::vector<core::Label>* labels,
               const PlyWriteOptions& options) {
   const std::size_t n = cloud.size();
   if (cloud.y.size() != n || cloud.z.size() != n) {

@@ -15,26 +15,26 @@ namespace upd::io {
 
 namespace fs = std::filesystem;
 
-std::uint8_t rosPixelOf(Label label) {
+std::uint8_t rosPixelOf(core::Label label) {
   switch (label) {
-    case Label::NonTraversable:
+    case core::Label::NonTraversable:
       return kRosOccupied;
-    case Label::Traversable:
+    case core::Label::Traversable:
       return kRosFree;
-    case Label::Unknown:
+    case core::Label::Unknown:
       break;
   }
   return kRosUnknown;
 }
 
-Label labelOfRosPixel(std::uint8_t value) {
-  return value < 100 ? Label::NonTraversable : value > 250 ? Label::Traversable : Label::Unknown;
+core::Label labelOfRosPixel(std::uint8_t value) {
+  return value < 100 ? core::Label::NonTraversable : value > 250 ? core::Label::Traversable : core::Label::Unknown;
 }
 
-Label RosMap::labelAt(double x, double y) const {
+core::Label RosMap::labelAt(double x, double y) const {
   const int ix = static_cast<int>(std::floor((x - origin_xy.x()) / resolution_m));
   const int iy = static_cast<int>(std::floor((y - origin_xy.y()) / resolution_m));
-  if (ix < 0 || iy < 0 || ix >= width || iy >= height) return Label::Unknown;
+  if (ix < 0 || iy < 0 || ix >= width || iy >= height) return core::Label::Unknown;
   return at(ix, iy);
 }
 

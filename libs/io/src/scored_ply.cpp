@@ -43,9 +43,9 @@ void ScoredPoints::validate() const {
   }
 }
 
-ScoredPoints scoredPointsOf(const PipelineResult& result) {
+ScoredPoints scoredPointsOf(const core::PipelineResult& result) {
   ScoredPoints s;
-  const PointCloud& c = result.cloud;
+  const core::PointCloud& c = result.cloud;
   s.x = c.x;
   s.y = c.y;
   s.z = c.z;
@@ -95,7 +95,7 @@ void writeScoredPly(const std::string& path, const ScoredPoints& p,
       // Label is a uint8_t enum; reading it through unsigned char is allowed aliasing.
       byteColumn("label",
                  p.label.empty() ? nullptr : reinterpret_cast<const std::uint8_t*>(p.label.data),
-                 static_cast<std::uint8_t>(Label::Unknown)),
+                 static_cast<std::uint8_t>(core::Label::Unknown)),
       floatColumn("cost", p.cost)};
   if (!p.r.empty()) {
     cols.push_back(byteColumn("red", p.r.data, 0));
@@ -105,7 +105,7 @@ void writeScoredPly(const std::string& path, const ScoredPoints& p,
   detail::writeBinaryPly(path, p.size(), cols, options.comments, options.drop_non_finite_xyz);
 }
 
-void writeScoredPly(const std::string& path, const PipelineResult& result,
+void writeScoredPly(const std::string& path, const core::PipelineResult& result,
                     const PlyWriteOptions& options) {
   writeScoredPly(path, scoredPointsOf(result), options);
 }

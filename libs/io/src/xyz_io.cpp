@@ -42,12 +42,12 @@ bool parseDouble(const char* first, const char* last, double& v) {
 
 }  // namespace
 
-PointCloud readXyz(const std::string& path) {
+core::PointCloud readXyz(const std::string& path) {
   detail::requireReadableFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw fileError(path, "cannot open for reading");
 
-  PointCloud cloud;
+  core::PointCloud cloud;
   std::vector<std::pair<const char*, const char*>> tokens;
   std::string line;
   std::size_t line_no = 0;
@@ -104,7 +104,7 @@ PointCloud readXyz(const std::string& path) {
   return cloud;
 }
 
-void writeXyz(const std::string& path, const PointCloud& cloud) {
+void writeXyz(const std::string& path, const core::PointCloud& cloud) {
   const std::size_t n = cloud.size();
   if (cloud.y.size() != n || cloud.z.size() != n) {
     throw std::invalid_argument("writeXyz: x, y, z of the cloud differ in size");

@@ -25,8 +25,8 @@ namespace {
 // Row-major labels of the grid's window, one per cell.
 struct CellRaster {
   int nx = 0, ny = 0;
-  std::vector<Label> label;
-  Label at(int cx, int cy) const { return label[static_cast<std::size_t>(cy) * nx + cx]; }
+  std::vector<core::Label> label;
+  core::Label at(int cx, int cy) const { return label[static_cast<std::size_t>(cy) * nx + cx]; }
 };
 
 CellRaster truthRaster(const TraversabilityGrid& grid, const TruthLabelAt& truth) {
@@ -43,7 +43,7 @@ CellRaster truthRaster(const TraversabilityGrid& grid, const TruthLabelAt& truth
 
 CellRaster mapRaster(const TraversabilityGrid& grid) {
   CellRaster r{grid.sizeX(), grid.sizeY(), {}};
-  r.label.assign(static_cast<std::size_t>(r.nx) * r.ny, Label::Unknown);
+  r.label.assign(static_cast<std::size_t>(r.nx) * r.ny, core::Label::Unknown);
   forEachKnownCell(grid, [&](int cx, int cy, const GridCell& cell) {
     r.label[static_cast<std::size_t>(cy) * r.nx + cx] = labelOf(cell, grid.params());
   });
@@ -59,7 +59,7 @@ bool obstacleWithin(const CellRaster& raster, int cx, int cy, int reach_cells, d
       const int x = cx + dx, y = cy + dy;
       if (x < 0 || y < 0 || x >= raster.nx || y >= raster.ny) continue;
       if (std::hypot(dx, dy) * cell_m > tolerance_m + 1e-9) continue;
-      if (raster.at(x, y) == Label::NonTraversable) return true;
+      if (raster.at(x, y) == core::Label::NonTraversable) return true;
     }
   }
   return false;
@@ -80,15 +80,15 @@ MapEvaluation evaluateGrid(const TraversabilityGrid& grid, const TruthLabelAt& t
   MapEvaluation e;
   for (int cy = 0; cy < map_labels.ny; ++cy) {
     for (int cx = 0; cx < map_labels.nx; ++cx) {
-      const Label m = map_labels.at(cx, cy);
-      const Label t = truth_labels.at(cx, cy);
-      if (m == Label::Unknown || t == Label::Unknown) continue;  // not observed, or no truth
-      if (m == Label::NonTraversable) {
+      const core::Label m = map_labels.at(cx, cy);
+      const core::Label t = truth_labels.at(cx, cy);
+      if (m == core::Label::Unknown || t == core::Label::Unknown) continue;  // not observed, or no truth
+      if (m == core::Label::NonTraversable) {
         ++e.map_non_traversable;
         e.map_non_traversable_matched +=
             obstacleWithin(truth_labels, cx, cy, reach, cell_m, tolerance_m) ? 1 : 0;
       }
-      if (t == Label::NonTraversable) {
+      if (t == core::Label::NonTraversable) {
         ++e.truth_non_traversable;
         e.truth_non_traversable_found +=
             obstacleWithin(map_labels, cx, cy, reach, cell_m, tolerance_m) ? 1 : 0;

@@ -20,18 +20,18 @@ void PointsWorld::validate() const {
   need(label, "label");
 }
 
-PointsWorld viewPoints(const PointCloud& cloud_world, const Classification& classes,
-                       const UpdResult* upd) {
+PointsWorld viewPoints(const core::PointCloud& cloud_world, const core::Classification& classes,
+                       const core::UpdResult* upd) {
   const std::size_t n = cloud_world.size();
-  requireParam(classes.label.size() == n, "viewPoints", "classes.label.size()",
+  core::requireParam(classes.label.size() == n, "viewPoints", "classes.label.size()",
                classes.label.size(), "must equal the cloud's size");
-  requireParam(classes.slope_rad.empty() || classes.slope_rad.size() == n, "viewPoints",
+  core::requireParam(classes.slope_rad.empty() || classes.slope_rad.size() == n, "viewPoints",
                "classes.slope_rad.size()", classes.slope_rad.size(),
                "must be 0 or the cloud's size");
-  requireParam(classes.cost.empty() || classes.cost.size() == n, "viewPoints",
+  core::requireParam(classes.cost.empty() || classes.cost.size() == n, "viewPoints",
                "classes.cost.size()", classes.cost.size(), "must be 0 or the cloud's size");
   if (upd != nullptr) {
-    requireParam(upd->zeta.size() == n, "viewPoints", "upd.zeta.size()", upd->zeta.size(),
+    core::requireParam(upd->zeta.size() == n, "viewPoints", "upd.zeta.size()", upd->zeta.size(),
                  "must equal the cloud's size");
   }
   PointsWorld v;
@@ -48,17 +48,17 @@ PointsWorld viewPoints(const PointCloud& cloud_world, const Classification& clas
 }
 
 void FusionParams::validate() const {
-  requireParam(std::isfinite(logodds_hit) && logodds_hit > 0, "FusionParams", "logodds_hit",
+  core::requireParam(std::isfinite(logodds_hit) && logodds_hit > 0, "FusionParams", "logodds_hit",
                logodds_hit, "must be > 0");
-  requireParam(std::isfinite(logodds_miss) && logodds_miss < 0, "FusionParams", "logodds_miss",
+  core::requireParam(std::isfinite(logodds_miss) && logodds_miss < 0, "FusionParams", "logodds_miss",
                logodds_miss, "must be < 0");
-  requireParam(std::isfinite(logodds_min) && logodds_min < 0, "FusionParams", "logodds_min",
+  core::requireParam(std::isfinite(logodds_min) && logodds_min < 0, "FusionParams", "logodds_min",
                logodds_min, "must be < 0");
-  requireParam(std::isfinite(logodds_max) && logodds_max > 0, "FusionParams", "logodds_max",
+  core::requireParam(std::isfinite(logodds_max) && logodds_max > 0, "FusionParams", "logodds_max",
                logodds_max, "must be > 0");
-  requireParam(nontrav_fraction > 0 && nontrav_fraction <= 1, "FusionParams", "nontrav_fraction",
+  core::requireParam(nontrav_fraction > 0 && nontrav_fraction <= 1, "FusionParams", "nontrav_fraction",
                nontrav_fraction, "must be in (0, 1]");
-  requireParam(min_points_per_cell >= 1, "FusionParams", "min_points_per_cell", min_points_per_cell,
+  core::requireParam(min_points_per_cell >= 1, "FusionParams", "min_points_per_cell", min_points_per_cell,
                "must be >= 1");
 }
 

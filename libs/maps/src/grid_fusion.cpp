@@ -14,8 +14,8 @@ namespace upd::maps {
 
 namespace {
 
-static_assert(static_cast<int>(Label::Traversable) == 0 &&
-                  static_cast<int>(Label::NonTraversable) == 1,
+static_assert(static_cast<int>(core::Label::Traversable) == 0 &&
+                  static_cast<int>(core::Label::NonTraversable) == 1,
               "the loops below read a labelled point's label as its non-traversable count");
 
 // Cell codes of points that have no cell (above any cell index: at most 46000^2 cells).
@@ -87,7 +87,7 @@ inline std::int32_t cellOffset(double v, double lo, bool inside) {
 // whole-number bounds), and the counts of invalid and unknown points among them.
 UPD_VECTOR_CLONES
 void cellCodes(const float* __restrict x, const float* __restrict y, const float* __restrict z,
-               const Label* __restrict label, const Window& w, std::size_t begin,
+               const core::Label* __restrict label, const Window& w, std::size_t begin,
                std::size_t end, std::uint32_t* __restrict cell_of, std::uint32_t& invalid,
                std::uint32_t& unknown) {
   std::uint32_t n_invalid = 0, n_unknown = 0;
@@ -129,7 +129,7 @@ void runStarts(const std::uint32_t* __restrict cell_of, std::size_t begin, std::
 // a point without this cell or value adds +0.0, which leaves a sum unchanged (sums are never
 // -0.0: they start at +0.0). max z is kept as the least -z: the same comparisons, negated.
 inline void addRun(FrameCell& f, const float* const* __restrict layer,
-                   const Label* __restrict label, const std::uint32_t* __restrict cell_of,
+                   const core::Label* __restrict label, const std::uint32_t* __restrict cell_of,
                    std::uint32_t cell, std::size_t begin, std::size_t end) {
   const Int4 negate_z = {std::numeric_limits<std::int32_t>::min(), 0, 0, 0};
   const Float4 inf = {kInf, kInf, kInf, kInf};
@@ -171,7 +171,7 @@ inline void addRun(FrameCell& f, const float* const* __restrict layer,
 struct RunInputs {
   const std::uint32_t* cell_of;
   const float* layer[kLayers];  // a layer the view lacks: NaN for every point
-  const Label* label;
+  const core::Label* label;
   double inv_size_x;
   std::uint32_t size_x;
   std::uint32_t* slots;     // per cell: its FrameCell, or kNoSlot
@@ -358,7 +358,7 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
                               const FusionParams& params) {
   params.validate();
   points.validate();
-  requireParam(std::isfinite(time_s), "integrateScan", "time_s", time_s, "must be finite");
+  core::requireParam(std::isfinite(time_s), "integrateScan", "time_s", time_s, "must be finite");
   GridFusionStats stats;
   stats.window_moved = grid.moveTo(robot_xy);
 
@@ -367,13 +367,13 @@ GridFusionStats integrateScan(TraversabilityGrid& grid, const PointsWorld& point
   const GridCellIndexer ix = grid.indexer();
   const Window window{ix.inv_cell, ix.i0, ix.i0 + ix.size_x, ix.j0, ix.j0 + ix.size_y,
                       static_cast<std::uint32_t>(size_x)};
-  const ScanBuffers buf = takeScanBuffers(points, size_x, size_y, openmp::maxThreads());
+  const ScanBuffers buf = takeScanBuffers(points, size_x, size_y, core::openmp::maxThreads());
   const RunInputs& run_inputs = buf.in;
 
   std::size_t invalid = 0, unknown = 0, used = 0, updated = 0, hit = 0, sparse = 0;
 #pragma omp parallel reduction(+ : invalid, unknown, used, updated, hit, sparse)
   {
-    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    const int team = core::openmp::teamSize(), me = core::openmp::threadIndex();
     // 1. Each thread takes a chunk of the points: their cells and where their runs start.
     const std::size_t chunk_begin = points.size * me / team,
                       chunk_end = points.size * (me + 1) / team;

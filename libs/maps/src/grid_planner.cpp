@@ -13,11 +13,11 @@ namespace upd::maps {
 
 void GridPlannerParams::validate() const {
   const auto nonneg = [](double v) { return std::isfinite(v) && v >= 0; };
-  requireParam(nonneg(inflation_m), "GridPlannerParams", "inflation_m", inflation_m,
+  core::requireParam(nonneg(inflation_m), "GridPlannerParams", "inflation_m", inflation_m,
                "must be >= 0");
-  requireParam(nonneg(clearance_m), "GridPlannerParams", "clearance_m", clearance_m,
+  core::requireParam(nonneg(clearance_m), "GridPlannerParams", "clearance_m", clearance_m,
                "must be >= 0");
-  requireParam(nonneg(clearance_weight), "GridPlannerParams", "clearance_weight", clearance_weight,
+  core::requireParam(nonneg(clearance_weight), "GridPlannerParams", "clearance_weight", clearance_weight,
                "must be >= 0");
 }
 

@@ -105,8 +105,8 @@ struct Chunk {
 constexpr std::size_t kChunk = 16384;
 
 // Adds labelled point i to the run of its voxel.
-inline void addToRun(FrameVoxel& run, const PointsWorld& points, std::size_t i, Label label) {
-  if (label == Label::NonTraversable) {
+inline void addToRun(FrameVoxel& run, const PointsWorld& points, std::size_t i, core::Label label) {
+  if (label == core::Label::NonTraversable) {
     ++run.n_nontrav;
   } else {
     ++run.n_trav;
@@ -153,8 +153,8 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
         last_hit = marksHit(tree.keyToCoord(key));
       }
     }
-    const Label label = points.label[i];
-    if (label != Label::Traversable && label != Label::NonTraversable) {
+    const core::Label label = points.label[i];
+    if (label != core::Label::Traversable && label != core::Label::NonTraversable) {
       ++ch.unknown;
       continue;
     }
@@ -193,10 +193,10 @@ void checkInsertArgs(const TraversabilityOcTree& tree, const PointsWorld& points
   params.validate();
   fusion.validate();
   points.validate();
-  requireParam(std::abs(tree.getResolution() - params.resolution_m) <= 1e-9 * params.resolution_m,
+  core::requireParam(std::abs(tree.getResolution() - params.resolution_m) <= 1e-9 * params.resolution_m,
                "insertScan", "OctreeParams.resolution_m", params.resolution_m,
                "differs from the tree's resolution");
-  requireParam(sensor_origin_world.allFinite(), "insertScan", "sensor_origin_world",
+  core::requireParam(sensor_origin_world.allFinite(), "insertScan", "sensor_origin_world",
                std::to_string(sensor_origin_world.x()) + "," +
                    std::to_string(sensor_origin_world.y()) + "," +
                    std::to_string(sensor_origin_world.z()),

@@ -17,19 +17,19 @@ constexpr double kMaxCellsPerSide = 46000;
 }  // namespace
 
 void GridParams::validate() const {
-  requireParam(std::isfinite(cell_size_m) && cell_size_m > 0, "GridParams", "cell_size_m",
+  core::requireParam(std::isfinite(cell_size_m) && cell_size_m > 0, "GridParams", "cell_size_m",
                cell_size_m, "must be > 0");
-  requireParam(std::isfinite(extent_m) && extent_m >= 2 * cell_size_m, "GridParams", "extent_m",
+  core::requireParam(std::isfinite(extent_m) && extent_m >= 2 * cell_size_m, "GridParams", "extent_m",
                extent_m, "must be at least two cells");
-  requireParam(extent_m / cell_size_m <= kMaxCellsPerSide, "GridParams", "extent_m", extent_m,
+  core::requireParam(extent_m / cell_size_m <= kMaxCellsPerSide, "GridParams", "extent_m", extent_m,
                "gives more than 46000 cells per side (raise cell_size_m)");
-  requireParam(std::isfinite(center_x_m), "GridParams", "center_x_m", center_x_m, "must be finite");
-  requireParam(std::isfinite(center_y_m), "GridParams", "center_y_m", center_y_m, "must be finite");
-  requireParam(recenter_fraction > 0 && recenter_fraction < 0.5, "GridParams", "recenter_fraction",
+  core::requireParam(std::isfinite(center_x_m), "GridParams", "center_x_m", center_x_m, "must be finite");
+  core::requireParam(std::isfinite(center_y_m), "GridParams", "center_y_m", center_y_m, "must be finite");
+  core::requireParam(recenter_fraction > 0 && recenter_fraction < 0.5, "GridParams", "recenter_fraction",
                recenter_fraction, "must be in (0, 0.5)");
-  requireParam(p_nontrav_threshold > 0 && p_nontrav_threshold < 1, "GridParams",
+  core::requireParam(p_nontrav_threshold > 0 && p_nontrav_threshold < 1, "GridParams",
                "p_nontrav_threshold", p_nontrav_threshold, "must be in (0, 1)");
-  requireParam(min_hits_known >= 1, "GridParams", "min_hits_known", min_hits_known, "must be >= 1");
+  core::requireParam(min_hits_known >= 1, "GridParams", "min_hits_known", min_hits_known, "must be >= 1");
 }
 
 int GridParams::cellsPerSide() const {
@@ -167,7 +167,7 @@ GridCell* TraversabilityGrid::cellAt(double x_m, double y_m) {
 
 bool TraversabilityGrid::moveTo(const Eigen::Vector2d& robot_xy) {
   if (!params_.follow_robot) return false;
-  requireParam(robot_xy.allFinite(), "TraversabilityGrid::moveTo", "robot_xy",
+  core::requireParam(robot_xy.allFinite(), "TraversabilityGrid::moveTo", "robot_xy",
                std::to_string(robot_xy.x()) + "," + std::to_string(robot_xy.y()), "must be finite");
   const double ri = std::floor(robot_xy.x() / cellSize());
   const double rj = std::floor(robot_xy.y() / cellSize());
@@ -209,11 +209,11 @@ bool isKnown(const GridCell& cell, const GridParams& params) {
          !std::isnan(cell.logodds_nontrav);
 }
 
-Label labelOf(const GridCell& cell, const GridParams& params) {
-  if (!isKnown(cell, params)) return Label::Unknown;
+core::Label labelOf(const GridCell& cell, const GridParams& params) {
+  if (!isKnown(cell, params)) return core::Label::Unknown;
   return probabilityFromLogOdds(cell.logodds_nontrav) >= params.p_nontrav_threshold
-             ? Label::NonTraversable
-             : Label::Traversable;
+             ? core::Label::NonTraversable
+             : core::Label::Traversable;
 }
 
 float probabilityOf(const GridCell& cell, const GridParams& params) {
@@ -230,9 +230,9 @@ bool isKnown(const TraversabilityGrid& grid, double x_m, double y_m) {
   return c != nullptr && isKnown(*c, grid.params());
 }
 
-Label cellLabel(const TraversabilityGrid& grid, double x_m, double y_m) {
+core::Label cellLabel(const TraversabilityGrid& grid, double x_m, double y_m) {
   const GridCell* c = grid.cellAt(x_m, y_m);
-  return c != nullptr ? labelOf(*c, grid.params()) : Label::Unknown;
+  return c != nullptr ? labelOf(*c, grid.params()) : core::Label::Unknown;
 }
 
 Eigen::MatrixXf layerMatrix(const TraversabilityGrid& grid, GridLayer layer) {
@@ -250,15 +250,15 @@ GridStats computeStats(const TraversabilityGrid& grid) {
   for (int cy = 0; cy < grid.sizeY(); ++cy) {
     for (int cx = 0; cx < grid.sizeX(); ++cx) {
       switch (labelOf(grid.at(cx, cy), grid.params())) {
-        case Label::Traversable:
+        case core::Label::Traversable:
           ++s.known;
           ++s.traversable;
           break;
-        case Label::NonTraversable:
+        case core::Label::NonTraversable:
           ++s.known;
           ++s.non_traversable;
           break;
-        case Label::Unknown: break;
+        case core::Label::Unknown: break;
       }
     }
   }

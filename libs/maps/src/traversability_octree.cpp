@@ -100,29 +100,29 @@ std::istream& TraversabilityOcTreeNode::readData(std::istream& s) {
 // Parameters
 
 void OctreeParams::validate() const {
-  requireParam(std::isfinite(resolution_m) && resolution_m > 0, "OctreeParams", "resolution_m",
+  core::requireParam(std::isfinite(resolution_m) && resolution_m > 0, "OctreeParams", "resolution_m",
                resolution_m, "must be > 0");
-  requireParam(std::isfinite(max_range_m), "OctreeParams", "max_range_m", max_range_m,
+  core::requireParam(std::isfinite(max_range_m), "OctreeParams", "max_range_m", max_range_m,
                "must be finite (<= 0 for no limit)");
-  requireParam(prob_hit > 0.5 && prob_hit < 1, "OctreeParams", "prob_hit", prob_hit,
+  core::requireParam(prob_hit > 0.5 && prob_hit < 1, "OctreeParams", "prob_hit", prob_hit,
                "must be in (0.5, 1)");
-  requireParam(prob_miss > 0 && prob_miss < 0.5, "OctreeParams", "prob_miss", prob_miss,
+  core::requireParam(prob_miss > 0 && prob_miss < 0.5, "OctreeParams", "prob_miss", prob_miss,
                "must be in (0, 0.5)");
-  requireParam(prob_clamp_min > 0 && prob_clamp_min < 0.5, "OctreeParams", "prob_clamp_min",
+  core::requireParam(prob_clamp_min > 0 && prob_clamp_min < 0.5, "OctreeParams", "prob_clamp_min",
                prob_clamp_min, "must be in (0, 0.5)");
-  requireParam(prob_clamp_max > 0.5 && prob_clamp_max < 1, "OctreeParams", "prob_clamp_max",
+  core::requireParam(prob_clamp_max > 0.5 && prob_clamp_max < 1, "OctreeParams", "prob_clamp_max",
                prob_clamp_max, "must be in (0.5, 1)");
-  requireParam(std::isfinite(extent_m) && extent_m >= 2 * resolution_m, "OctreeParams", "extent_m",
+  core::requireParam(std::isfinite(extent_m) && extent_m >= 2 * resolution_m, "OctreeParams", "extent_m",
                extent_m, "must be at least two voxels");
-  requireParam(std::isfinite(height_m) && height_m >= 2 * resolution_m, "OctreeParams", "height_m",
+  core::requireParam(std::isfinite(height_m) && height_m >= 2 * resolution_m, "OctreeParams", "height_m",
                height_m, "must be at least two voxels");
-  requireParam(std::isfinite(center_x_m), "OctreeParams", "center_x_m", center_x_m,
+  core::requireParam(std::isfinite(center_x_m), "OctreeParams", "center_x_m", center_x_m,
                "must be finite");
-  requireParam(std::isfinite(center_y_m), "OctreeParams", "center_y_m", center_y_m,
+  core::requireParam(std::isfinite(center_y_m), "OctreeParams", "center_y_m", center_y_m,
                "must be finite");
-  requireParam(std::isfinite(center_z_m), "OctreeParams", "center_z_m", center_z_m,
+  core::requireParam(std::isfinite(center_z_m), "OctreeParams", "center_z_m", center_z_m,
                "must be finite");
-  requireParam(recenter_fraction > 0 && recenter_fraction < 0.5, "OctreeParams",
+  core::requireParam(recenter_fraction > 0 && recenter_fraction < 0.5, "OctreeParams",
                "recenter_fraction", recenter_fraction, "must be in (0, 0.5)");
 }
 

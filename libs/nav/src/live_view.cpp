@@ -80,9 +80,9 @@ void LiveView::update(const FrameEvidence& frame, const maps::TraversabilityGrid
       r = 1.f - t;
       g = t;
       b = 0.f;
-    } else if (i < frame.classes.label.size() && frame.classes.label[i] != Label::Unknown) {
+    } else if (i < frame.classes.label.size() && frame.classes.label[i] != core::Label::Unknown) {
       // Roughness index: no zeta, colour by label.
-      const bool nt = frame.classes.label[i] == Label::NonTraversable;
+      const bool nt = frame.classes.label[i] == core::Label::NonTraversable;
       r = nt ? 1.f : 0.f;
       g = nt ? 0.f : 1.f;
     }

@@ -1,7 +1,7 @@
 #include "upd/nav/nav_config.h"
 
-#include "upd/mrpt/ini_params.h"
-#include "upd/mrpt/robot_config.h"
+#include "upd/mrpt_bridge/ini_params.h"
+#include "upd/mrpt_bridge/robot_config.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -15,14 +15,14 @@ namespace fs = std::filesystem;
 namespace upd::nav {
 
 void LoopParams::validate() const {
-  requireParam(std::isfinite(control_period_s) && control_period_s > 0 && control_period_s <= 2,
+  core::requireParam(std::isfinite(control_period_s) && control_period_s > 0 && control_period_s <= 2,
                "LoopParams", "control_period_s", control_period_s, "must be in (0, 2]");
-  requireParam(std::isfinite(max_time_s) && max_time_s > 0, "LoopParams", "max_time_s", max_time_s,
+  core::requireParam(std::isfinite(max_time_s) && max_time_s > 0, "LoopParams", "max_time_s", max_time_s,
                "must be > 0");
-  requireParam(seed >= 0, "LoopParams", "seed", seed, "must be >= 0");
-  requireParam(std::isfinite(truth_cell_m) && truth_cell_m > 0 && truth_cell_m <= 0.2, "LoopParams",
+  core::requireParam(seed >= 0, "LoopParams", "seed", seed, "must be >= 0");
+  core::requireParam(std::isfinite(truth_cell_m) && truth_cell_m > 0 && truth_cell_m <= 0.2, "LoopParams",
                "truth_cell_m", truth_cell_m, "must be in (0, 0.2]");
-  requireParam(std::isfinite(clearance_search_m) && clearance_search_m > 0, "LoopParams",
+  core::requireParam(std::isfinite(clearance_search_m) && clearance_search_m > 0, "LoopParams",
                "clearance_search_m", clearance_search_m, "must be > 0");
 }
 
@@ -48,7 +48,7 @@ void NavConfig::validate() const {
 namespace {
 
 // [NavigatorParams] string keys: paths relative to the file that holds them.
-void readPath(mrptbridge::IniReader& ini, const char* key, std::string& out) {
+void readPath(mrpt_bridge::IniReader& ini, const char* key, std::string& out) {
   ini.markKnown("NavigatorParams", key);
   if (!ini.hasKey("NavigatorParams", key)) return;
   const std::string v = ini.rawValue("NavigatorParams", key);
@@ -66,17 +66,17 @@ void readPath(mrptbridge::IniReader& ini, const char* key, std::string& out) {
 NavConfig loadNavConfig(const std::string& robot_ini, const std::string& nav_ini) {
   NavConfig c;
   {
-    mrptbridge::IniReader ini(robot_ini);
+    mrpt_bridge::IniReader ini(robot_ini);
     // The sections the loop uses; the others are the `upd` commands' (see the header comment).
-    mrptbridge::RobotConfigParts parts;
+    mrpt_bridge::RobotConfigParts parts;
     parts.pipeline = &c.pipeline;
     parts.baseline = &c.baseline;
     parts.grid = &c.grid;
     parts.fusion = &c.fusion;
-    mrptbridge::readRobotConfig(ini, parts);
+    mrpt_bridge::readRobotConfig(ini, parts);
   }
   {
-    mrptbridge::IniReader ini(nav_ini);
+    mrpt_bridge::IniReader ini(nav_ini);
     forEachNavSection(c,
                       [&](const char* name, const char*, auto& params) { ini.read(name, params); });
     readPath(ini, "ptg_ini", c.ptg_ini);

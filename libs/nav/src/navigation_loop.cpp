@@ -63,8 +63,8 @@ std::string cacheDirFor(const std::string& cache_root, const std::string& ptg_in
   return (fs::path(cache_root) / hex).string();
 }
 
-FrameScorerParams scorerParams(const NavConfig& config, ObstacleDetector detector) {
-  FrameScorerParams p;
+core::FrameScorerParams scorerParams(const NavConfig& config, core::ObstacleDetector detector) {
+  core::FrameScorerParams p;
   p.pipeline = config.pipeline;
   p.detector = detector;
   p.baseline = config.baseline;
@@ -74,7 +74,7 @@ FrameScorerParams scorerParams(const NavConfig& config, ObstacleDetector detecto
 
 }  // namespace
 
-NavigationLoop::NavigationLoop(RobotBase& base, const NavConfig& config, ObstacleDetector detector,
+NavigationLoop::NavigationLoop(RobotBase& base, const NavConfig& config, core::ObstacleDetector detector,
                                const std::string& navlog_path)
     : base_(base),
       config_(config),
@@ -88,7 +88,7 @@ NavigationLoop::NavigationLoop(RobotBase& base, const NavConfig& config, Obstacl
 
 NavigationLoop::~NavigationLoop() = default;
 
-const FrameEvidence& NavigationLoop::addFrame(const PointCloud& cloud_world, double time_s,
+const FrameEvidence& NavigationLoop::addFrame(const core::PointCloud& cloud_world, double time_s,
                                               double ground_z_m) {
   // The cloud is already in the world frame: scored there, as the identity pose says.
   scorer_.score(cloud_world, Eigen::Isometry3d::Identity(), last_frame_);
@@ -105,7 +105,7 @@ const FrameEvidence& NavigationLoop::addFrame(const PointCloud& cloud_world, dou
   last_missing_ground_.clear();
   std::vector<float> gx, gy, gz;
   for (const GroundGap& gap : findGroundGaps(cloud_world, ground_z_m, config_.negative)) {
-    if (maps::cellLabel(grid_, gap.near_world.x(), gap.near_world.y()) != Label::Traversable) {
+    if (maps::cellLabel(grid_, gap.near_world.x(), gap.near_world.y()) != core::Label::Traversable) {
       continue;
     }
     const auto pts = sampleGap(gap, 0.5 * grid_.cellSize());
@@ -118,7 +118,7 @@ const FrameEvidence& NavigationLoop::addFrame(const PointCloud& cloud_world, dou
     }
   }
   if (!gx.empty()) {
-    const std::vector<Label> labels(gx.size(), Label::NonTraversable);
+    const std::vector<core::Label> labels(gx.size(), core::Label::NonTraversable);
     maps::PointsWorld missing;
     missing.x = gx.data();
     missing.y = gy.data();

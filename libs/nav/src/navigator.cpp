@@ -28,12 +28,12 @@ const char* toString(NavState s) {
 }
 
 void NavigatorParams::validate() const {
-  requireParam(std::isfinite(target_allowed_distance_m) && target_allowed_distance_m > 0,
+  core::requireParam(std::isfinite(target_allowed_distance_m) && target_allowed_distance_m > 0,
                "NavigatorParams", "target_allowed_distance_m", target_allowed_distance_m,
                "must be > 0");
-  requireParam(std::isfinite(no_progress_timeout_s) && no_progress_timeout_s > 0, "NavigatorParams",
+  core::requireParam(std::isfinite(no_progress_timeout_s) && no_progress_timeout_s > 0, "NavigatorParams",
                "no_progress_timeout_s", no_progress_timeout_s, "must be > 0");
-  requireParam(std::isfinite(waypoint_allowed_distance_m) && waypoint_allowed_distance_m > 0,
+  core::requireParam(std::isfinite(waypoint_allowed_distance_m) && waypoint_allowed_distance_m > 0,
                "NavigatorParams", "waypoint_allowed_distance_m", waypoint_allowed_distance_m,
                "must be > 0");
 }

@@ -7,15 +7,15 @@
 namespace upd::nav {
 
 void NegativeObstacleParams::validate() const {
-  requireParam(std::isfinite(min_gap_m) && min_gap_m > 0, "NegativeObstacleParams", "min_gap_m",
+  core::requireParam(std::isfinite(min_gap_m) && min_gap_m > 0, "NegativeObstacleParams", "min_gap_m",
                min_gap_m, "must be > 0");
-  requireParam(std::isfinite(min_drop_m) && min_drop_m > 0, "NegativeObstacleParams", "min_drop_m",
+  core::requireParam(std::isfinite(min_drop_m) && min_drop_m > 0, "NegativeObstacleParams", "min_drop_m",
                min_drop_m, "must be > 0");
-  requireParam(std::isfinite(max_range_m) && max_range_m > 0, "NegativeObstacleParams",
+  core::requireParam(std::isfinite(max_range_m) && max_range_m > 0, "NegativeObstacleParams",
                "max_range_m", max_range_m, "must be > 0");
 }
 
-std::vector<GroundGap> findGroundGaps(const PointCloud& cloud, double ground_z_m,
+std::vector<GroundGap> findGroundGaps(const core::PointCloud& cloud, double ground_z_m,
                                       const NegativeObstacleParams& params) {
   params.validate();
   std::vector<GroundGap> gaps;

@@ -11,11 +11,11 @@
 namespace upd::nav {
 
 void ObstacleParams::validate() const {
-  requireParam(std::isfinite(range_m) && range_m > 0, "ObstacleParams", "range_m", range_m,
+  core::requireParam(std::isfinite(range_m) && range_m > 0, "ObstacleParams", "range_m", range_m,
                "must be > 0");
-  requireParam(std::isfinite(decimation_m) && decimation_m > 0, "ObstacleParams", "decimation_m",
+  core::requireParam(std::isfinite(decimation_m) && decimation_m > 0, "ObstacleParams", "decimation_m",
                decimation_m, "must be > 0");
-  requireParam(std::isfinite(point_height_m), "ObstacleParams", "point_height_m", point_height_m,
+  core::requireParam(std::isfinite(point_height_m), "ObstacleParams", "point_height_m", point_height_m,
                "must be finite");
 }
 
@@ -92,7 +92,7 @@ std::vector<Eigen::Vector2d> ObstacleSource::pointsInRobot(const Pose2D& pose_wo
     if (x0 <= x1 && y0 <= y1 && g.cellIndex(x0, y0, cx0, cy0) && g.cellIndex(x1, y1, cx1, cy1)) {
       for (int cy = cy0; cy <= cy1; ++cy) {
         for (int cx = cx0; cx <= cx1; ++cx) {
-          if (maps::labelOf(g.at(cx, cy), g.params()) == Label::NonTraversable) {
+          if (maps::labelOf(g.at(cx, cy), g.params()) == core::Label::NonTraversable) {
             add(g.cellCenter(cx, cy));
           }
         }

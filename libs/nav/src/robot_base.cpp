@@ -11,9 +11,9 @@
 namespace upd::nav {
 
 void SimulatedBaseParams::validate() const {
-  requireParam(std::isfinite(velocity_lag_s) && velocity_lag_s >= 0, "SimulatedBaseParams",
+  core::requireParam(std::isfinite(velocity_lag_s) && velocity_lag_s >= 0, "SimulatedBaseParams",
                "velocity_lag_s", velocity_lag_s, "must be >= 0");
-  requireParam(std::isfinite(command_delay_s) && command_delay_s >= 0, "SimulatedBaseParams",
+  core::requireParam(std::isfinite(command_delay_s) && command_delay_s >= 0, "SimulatedBaseParams",
                "command_delay_s", command_delay_s, "must be >= 0");
 }
 

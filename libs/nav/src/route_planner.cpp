@@ -11,19 +11,19 @@ namespace upd::nav {
 
 void RoutePlannerParams::validate() const {
   const auto nonneg = [](double v) { return std::isfinite(v) && v >= 0; };
-  requireParam(nonneg(inflation_m), "RoutePlannerParams", "inflation_m", inflation_m,
+  core::requireParam(nonneg(inflation_m), "RoutePlannerParams", "inflation_m", inflation_m,
                "must be >= 0");
-  requireParam(nonneg(clearance_m), "RoutePlannerParams", "clearance_m", clearance_m,
+  core::requireParam(nonneg(clearance_m), "RoutePlannerParams", "clearance_m", clearance_m,
                "must be >= 0");
-  requireParam(nonneg(clearance_weight), "RoutePlannerParams", "clearance_weight", clearance_weight,
+  core::requireParam(nonneg(clearance_weight), "RoutePlannerParams", "clearance_weight", clearance_weight,
                "must be >= 0");
-  requireParam(nonneg(unknown_cost), "RoutePlannerParams", "unknown_cost", unknown_cost,
+  core::requireParam(nonneg(unknown_cost), "RoutePlannerParams", "unknown_cost", unknown_cost,
                "must be >= 0");
-  requireParam(nonneg(start_free_radius_m), "RoutePlannerParams", "start_free_radius_m",
+  core::requireParam(nonneg(start_free_radius_m), "RoutePlannerParams", "start_free_radius_m",
                start_free_radius_m, "must be >= 0");
-  requireParam(std::isfinite(waypoint_spacing_m) && waypoint_spacing_m > 0, "RoutePlannerParams",
+  core::requireParam(std::isfinite(waypoint_spacing_m) && waypoint_spacing_m > 0, "RoutePlannerParams",
                "waypoint_spacing_m", waypoint_spacing_m, "must be > 0");
-  requireParam(std::isfinite(replan_period_s) && replan_period_s > 0, "RoutePlannerParams",
+  core::requireParam(std::isfinite(replan_period_s) && replan_period_s > 0, "RoutePlannerParams",
                "replan_period_s", replan_period_s, "must be > 0");
 }
 
@@ -78,9 +78,9 @@ RouteRaster rasterize(const maps::TraversabilityGrid& grid,
   for (int cy = 0; cy < ny; ++cy) {
     for (int cx = 0; cx < nx; ++cx) {
       const std::size_t i = static_cast<std::size_t>(cy) * nx + cx;
-      const Label l = maps::labelOf(grid.at(cx, cy), grid.params());
-      r.blocked[i] = l == Label::NonTraversable;
-      if (l == Label::Unknown) r.extra_cost[i] = params.unknown_cost;
+      const core::Label l = maps::labelOf(grid.at(cx, cy), grid.params());
+      r.blocked[i] = l == core::Label::NonTraversable;
+      if (l == core::Label::Unknown) r.extra_cost[i] = params.unknown_cost;
       r.exempt[i] = (grid.cellCenter(cx, cy) - start_world).squaredNorm() <= start_free2;
     }
   }

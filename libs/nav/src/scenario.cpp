@@ -69,7 +69,7 @@ Eigen::Vector3d xyYaw(const Pose2D& p) { return {p.x_m, p.y_m, p.yaw_rad}; }
 // One run in progress: the simulated base, the loop and the ground truth it is checked against.
 class ScenarioRun {
  public:
-  ScenarioRun(const sim::WorldSpec& world, const NavConfig& config, ObstacleDetector detector,
+  ScenarioRun(const sim::WorldSpec& world, const NavConfig& config, core::ObstacleDetector detector,
               const std::string& navlog_path)
       : world_(world),
         config_(config),
@@ -103,7 +103,7 @@ class ScenarioRun {
     clock.set(base_.timeS());
     const Eigen::Isometry3d body =
         sim::bodyPoseOnTerrain(world_.terrain, xyYaw(base_.pose()), config_.body);
-    const PointCloud cloud =
+    const core::PointCloud cloud =
         sim::renderCameraWorld(world_.terrain, body, config_.camera, config_.depth_noise,
                                static_cast<std::uint32_t>(config_.loop.seed + k));
     const FrameEvidence& ev = loop_.addFrame(cloud, base_.timeS(), body.translation().z());
@@ -152,10 +152,10 @@ void summarize(ScenarioRun& run, const sim::WorldSpec& world, const NavConfig& c
 }  // namespace
 
 ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
-                           const NavConfig& config, ObstacleDetector detector,
+                           const NavConfig& config, core::ObstacleDetector detector,
                            const std::string& navlog_path, const StepCallback& on_step) {
   config.validate();
-  const Stopwatch wall;
+  const core::Stopwatch wall;
   SimulatedClock clock;
   ScenarioRun run(world, config, detector, navlog_path);
 
@@ -360,14 +360,14 @@ void writeScenarioOutputs(const ScenarioResult& r, const sim::WorldSpec& world,
 
   const auto truth_bg = [&](double x, double y) {
     switch (world.terrain.truthAt(x, y)) {
-      case Label::Traversable: {
+      case core::Label::Traversable: {
         // Shade by height so ramps and platforms read as relief.
         const double h = world.terrain.heightAt(x, y);
         const auto g = static_cast<std::uint8_t>(std::clamp(200.0 - 150.0 * h, 80.0, 230.0));
         return cv::Vec3b(static_cast<std::uint8_t>(g * 0.8), g, static_cast<std::uint8_t>(g * 0.8));
       }
-      case Label::NonTraversable: return cv::Vec3b(40, 40, 180);
-      case Label::Unknown: break;
+      case core::Label::NonTraversable: return cv::Vec3b(40, 40, 180);
+      case core::Label::Unknown: break;
     }
     return cv::Vec3b(128, 128, 128);
   };

@@ -170,7 +170,7 @@ bool OpenNI2Camera::read(DepthFrame& frame, int timeout_ms) {
     }
   }
   // Pinhole intrinsics from the fields of view (OpenNI reports no calibration).
-  CameraIntrinsics K;
+  core::CameraIntrinsics K;
   K.width = frame.depth.width;
   K.height = frame.depth.height;
   K.fx = 0.5 * K.width / std::tan(0.5 * d.depth.getHorizontalFieldOfView());

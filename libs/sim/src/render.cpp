@@ -7,11 +7,11 @@
 namespace upd::sim {
 
 void DepthNoise::validate() const {
-  requireParam(std::isfinite(sigma_coeff_per_m) && sigma_coeff_per_m >= 0, "DepthNoise",
+  core::requireParam(std::isfinite(sigma_coeff_per_m) && sigma_coeff_per_m >= 0, "DepthNoise",
                "sigma_coeff_per_m", sigma_coeff_per_m, "must be >= 0");
-  requireParam(std::isfinite(min_range_m) && min_range_m >= 0, "DepthNoise", "min_range_m",
+  core::requireParam(std::isfinite(min_range_m) && min_range_m >= 0, "DepthNoise", "min_range_m",
                min_range_m, "must be >= 0");
-  requireParam(std::isfinite(max_range_m) && max_range_m > min_range_m, "DepthNoise", "max_range_m",
+  core::requireParam(std::isfinite(max_range_m) && max_range_m > min_range_m, "DepthNoise", "max_range_m",
                max_range_m, "must be finite and > min_range_m");
 }
 
@@ -40,20 +40,20 @@ Eigen::Isometry3d cameraPoseLookingAt(const Eigen::Vector3d& eye, const Eigen::V
 namespace {
 
 // Renders the depth image; when truth is given, labels every pixel from its exact hit.
-DepthImage render(const Terrain& terrain, const Eigen::Isometry3d& pose_world_camera,
-                  const CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed,
-                  std::vector<Label>* truth) {
+core::DepthImage render(const Terrain& terrain, const Eigen::Isometry3d& pose_world_camera,
+                  const core::CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed,
+                  std::vector<core::Label>* truth) {
   K.validate();
   noise.validate();
   if (!pose_world_camera.matrix().allFinite()) {
     throw std::invalid_argument("render: pose_world_camera must be finite");
   }
-  DepthImage img;
+  core::DepthImage img;
   img.width = K.width;
   img.height = K.height;
   const std::size_t n = static_cast<std::size_t>(K.width) * K.height;
   img.depth_m.assign(n, 0.f);
-  if (truth) truth->assign(n, Label::Unknown);
+  if (truth) truth->assign(n, core::Label::Unknown);
 
   const Eigen::Matrix3d R = pose_world_camera.linear();
   const Eigen::Vector3d eye = pose_world_camera.translation();
@@ -87,19 +87,19 @@ DepthImage render(const Terrain& terrain, const Eigen::Isometry3d& pose_world_ca
 
 }  // namespace
 
-DepthImage renderDepth(const Terrain& terrain, const Eigen::Isometry3d& pose_world_camera,
-                       const CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed) {
+core::DepthImage renderDepth(const Terrain& terrain, const Eigen::Isometry3d& pose_world_camera,
+                       const core::CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed) {
   return render(terrain, pose_world_camera, K, noise, seed, nullptr);
 }
 
 RenderedScene renderScene(const Terrain& terrain, const Eigen::Isometry3d& pose_world_camera,
-                          const CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed,
+                          const core::CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed,
                           const std::string& name) {
   RenderedScene out;
   out.pose_world_camera = pose_world_camera;
   out.depth = render(terrain, pose_world_camera, K, noise, seed, &out.scene.truth);
   out.scene.name = name;
-  out.scene.cloud = depthToCloud(out.depth, K);
+  out.scene.cloud = core::depthToCloud(out.depth, K);
   out.scene.up = (pose_world_camera.linear().transpose() * Eigen::Vector3d::UnitZ())
                      .normalized()
                      .cast<float>();

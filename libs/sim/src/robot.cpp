@@ -6,24 +6,24 @@ namespace upd::sim {
 
 void RobotBodyParams::validate() const {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0; };
-  requireParam(positive(length_m), "RobotBodyParams", "length_m", length_m, "must be > 0");
-  requireParam(positive(width_m), "RobotBodyParams", "width_m", width_m, "must be > 0");
-  requireParam(positive(wheelbase_m) && wheelbase_m <= length_m, "RobotBodyParams", "wheelbase_m",
+  core::requireParam(positive(length_m), "RobotBodyParams", "length_m", length_m, "must be > 0");
+  core::requireParam(positive(width_m), "RobotBodyParams", "width_m", width_m, "must be > 0");
+  core::requireParam(positive(wheelbase_m) && wheelbase_m <= length_m, "RobotBodyParams", "wheelbase_m",
                wheelbase_m, "must be in (0, length_m]");
-  requireParam(positive(track_m) && track_m <= width_m, "RobotBodyParams", "track_m", track_m,
+  core::requireParam(positive(track_m) && track_m <= width_m, "RobotBodyParams", "track_m", track_m,
                "must be in (0, width_m]");
 }
 
 void CameraMountParams::validate() const {
-  requireParam(std::isfinite(forward_m), "CameraMountParams", "forward_m", forward_m,
+  core::requireParam(std::isfinite(forward_m), "CameraMountParams", "forward_m", forward_m,
                "must be finite");
-  requireParam(std::isfinite(left_m), "CameraMountParams", "left_m", left_m, "must be finite");
-  requireParam(std::isfinite(height_m) && height_m > 0, "CameraMountParams", "height_m", height_m,
+  core::requireParam(std::isfinite(left_m), "CameraMountParams", "left_m", left_m, "must be finite");
+  core::requireParam(std::isfinite(height_m) && height_m > 0, "CameraMountParams", "height_m", height_m,
                "must be > 0");
-  requireParam(std::isfinite(pitch_rad) && std::abs(pitch_rad) < 80.0 * kDegToRad,
-               "CameraMountParams", "pitch_deg", pitch_rad * kRadToDeg,
+  core::requireParam(std::isfinite(pitch_rad) && std::abs(pitch_rad) < 80.0 * core::kDegToRad,
+               "CameraMountParams", "pitch_deg", pitch_rad * core::kRadToDeg,
                "must be within (-80, 80) deg");
-  requireParam(
+  core::requireParam(
       image_downscale == 1 || image_downscale == 2 || image_downscale == 4 || image_downscale == 8,
       "CameraMountParams", "image_downscale", image_downscale, "must be 1, 2, 4 or 8");
 }
@@ -56,10 +56,10 @@ Eigen::Isometry3d cameraOnRobot(const CameraMountParams& mount) {
   return T;
 }
 
-CameraIntrinsics simulatedIntrinsics(const CameraMountParams& mount) {
-  const CameraIntrinsics kinect;
+core::CameraIntrinsics simulatedIntrinsics(const CameraMountParams& mount) {
+  const core::CameraIntrinsics kinect;
   const double d = mount.image_downscale;
-  CameraIntrinsics K;
+  core::CameraIntrinsics K;
   K.width = kinect.width / mount.image_downscale;
   K.height = kinect.height / mount.image_downscale;
   K.fx = kinect.fx / d;
@@ -100,13 +100,13 @@ Eigen::Isometry3d bodyPoseFlat(const Eigen::Vector3d& xy_yaw) {
   return T;
 }
 
-PointCloud renderCameraWorld(const Terrain& terrain, const Eigen::Isometry3d& pose_world_body,
+core::PointCloud renderCameraWorld(const Terrain& terrain, const Eigen::Isometry3d& pose_world_body,
                              const CameraMountParams& mount, const DepthNoise& noise,
                              std::uint32_t seed) {
   const Eigen::Isometry3d pose_world_camera = pose_world_body * cameraOnRobot(mount);
-  const CameraIntrinsics K = simulatedIntrinsics(mount);
-  const DepthImage depth = renderDepth(terrain, pose_world_camera, K, noise, seed);
-  return transformCloud(depthToCloud(depth, K), pose_world_camera);
+  const core::CameraIntrinsics K = simulatedIntrinsics(mount);
+  const core::DepthImage depth = renderDepth(terrain, pose_world_camera, K, noise, seed);
+  return core::transformCloud(core::depthToCloud(depth, K), pose_world_camera);
 }
 
 }  // namespace upd::sim

@@ -11,11 +11,11 @@ namespace sg = scene_geometry;
 
 void SceneParams::validate() const {
   // The lower bound keeps a 3 x 3 m scene below ~10 million points.
-  requireParam(std::isfinite(spacing_m) && spacing_m >= 0.001 && spacing_m <= 0.5, "SceneParams",
+  core::requireParam(std::isfinite(spacing_m) && spacing_m >= 0.001 && spacing_m <= 0.5, "SceneParams",
                "spacing_m", spacing_m, "must be in [0.001, 0.5]");
-  requireParam(std::isfinite(noise_m) && noise_m >= 0, "SceneParams", "noise_m", noise_m,
+  core::requireParam(std::isfinite(noise_m) && noise_m >= 0, "SceneParams", "noise_m", noise_m,
                "must be >= 0");
-  requireParam(seed >= 0, "SceneParams", "seed", seed, "must be >= 0");
+  core::requireParam(seed >= 0, "SceneParams", "seed", seed, "must be >= 0");
 }
 
 std::vector<std::string> sceneNames() {
@@ -39,14 +39,14 @@ Scene cornerScene(double spacing_m) {
     for (int i = 0; i <= n; ++i) {
       const double x = i * spacing_m;
       s.cloud.push_back(static_cast<float>(x), static_cast<float>(j * spacing_m), 0.f);
-      s.truth.push_back(x <= sg::kCornerEdgeBand_m + 1e-9 ? Label::NonTraversable
-                                                          : Label::Traversable);
+      s.truth.push_back(x <= sg::kCornerEdgeBand_m + 1e-9 ? core::Label::NonTraversable
+                                                          : core::Label::Traversable);
     }
   }
   for (int k = 1; k <= n; ++k) {
     for (int j = 0; j <= n; ++j) {
       s.cloud.push_back(0.f, static_cast<float>(j * spacing_m), static_cast<float>(k * spacing_m));
-      s.truth.push_back(Label::NonTraversable);
+      s.truth.push_back(core::Label::NonTraversable);
     }
   }
   s.cloud.sensor_origin = Eigen::Vector3f(1.5f, 0.5f, 1.0f);
@@ -54,13 +54,7 @@ Scene cornerScene(double spacing_m) {
 }
 
 Rock sceneRock(double x, double y, double rx, double ry, double h, double yaw = 0.0) {
-  Rock r;
-  r.center_xy = {x, y};
-  r.radius_x_m = rx;
-  r.radius_y_m = ry;
-  r.height_m = h;
-  r.yaw_rad = yaw;
-  return r;
+  return Rock{{x, y}, rx, ry, h, yaw};  // centre, radii, height, yaw
 }
 
 Eigen::Vector3f sensorOrigin(const std::string& name) {

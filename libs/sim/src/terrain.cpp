@@ -28,73 +28,73 @@ bool finite(const Eigen::Vector2d& v) { return std::isfinite(v.x()) && std::isfi
 // ----------------------------------------------------------------------------- validation
 
 void TruthParams::validate() const {
-  requireParam(std::isfinite(max_slope_rad) && max_slope_rad > 0 && max_slope_rad < kPi / 2,
+  core::requireParam(std::isfinite(max_slope_rad) && max_slope_rad > 0 && max_slope_rad < kPi / 2,
                "TruthParams", "max_slope_rad", max_slope_rad, "must be in (0, pi/2)");
-  requireParam(std::isfinite(max_step_m) && max_step_m > 0, "TruthParams", "max_step_m", max_step_m,
+  core::requireParam(std::isfinite(max_step_m) && max_step_m > 0, "TruthParams", "max_step_m", max_step_m,
                "must be > 0");
-  requireParam(std::isfinite(border_m) && border_m >= 0, "TruthParams", "border_m", border_m,
+  core::requireParam(std::isfinite(border_m) && border_m >= 0, "TruthParams", "border_m", border_m,
                "must be >= 0");
 }
 
 double Ramp::slopeLength() const { return height_m / std::tan(slope_rad); }
 
 void Ramp::validate() const {
-  requireParam(finite(start_xy), "Ramp", "start_xy", start_xy.transpose(), "must be finite");
-  requireParam(std::isfinite(yaw_rad), "Ramp", "yaw_rad", yaw_rad, "must be finite");
-  requireParam(std::isfinite(slope_rad) && slope_rad > 0 && slope_rad <= 60.0 * kDegToRad, "Ramp",
+  core::requireParam(finite(start_xy), "Ramp", "start_xy", start_xy.transpose(), "must be finite");
+  core::requireParam(std::isfinite(yaw_rad), "Ramp", "yaw_rad", yaw_rad, "must be finite");
+  core::requireParam(std::isfinite(slope_rad) && slope_rad > 0 && slope_rad <= 60.0 * core::kDegToRad, "Ramp",
                "slope_rad", slope_rad, "must be in (0, 60 deg]");
-  requireParam(std::isfinite(width_m) && width_m > 0, "Ramp", "width_m", width_m, "must be > 0");
-  requireParam(std::isfinite(height_m) && height_m > 0, "Ramp", "height_m", height_m,
+  core::requireParam(std::isfinite(width_m) && width_m > 0, "Ramp", "width_m", width_m, "must be > 0");
+  core::requireParam(std::isfinite(height_m) && height_m > 0, "Ramp", "height_m", height_m,
                "must be > 0");
-  requireParam(std::isfinite(platform_length_m) && platform_length_m >= 0, "Ramp",
+  core::requireParam(std::isfinite(platform_length_m) && platform_length_m >= 0, "Ramp",
                "platform_length_m", platform_length_m, "must be >= 0");
 }
 
 void Box::validate() const {
-  requireParam(finite(center_xy), "Box", "center_xy", center_xy.transpose(), "must be finite");
-  requireParam(std::isfinite(length_m) && length_m > 0, "Box", "length_m", length_m, "must be > 0");
-  requireParam(std::isfinite(width_m) && width_m > 0, "Box", "width_m", width_m, "must be > 0");
-  requireParam(std::isfinite(height_m) && height_m > 0, "Box", "height_m", height_m, "must be > 0");
-  requireParam(std::isfinite(yaw_rad), "Box", "yaw_rad", yaw_rad, "must be finite");
+  core::requireParam(finite(center_xy), "Box", "center_xy", center_xy.transpose(), "must be finite");
+  core::requireParam(std::isfinite(length_m) && length_m > 0, "Box", "length_m", length_m, "must be > 0");
+  core::requireParam(std::isfinite(width_m) && width_m > 0, "Box", "width_m", width_m, "must be > 0");
+  core::requireParam(std::isfinite(height_m) && height_m > 0, "Box", "height_m", height_m, "must be > 0");
+  core::requireParam(std::isfinite(yaw_rad), "Box", "yaw_rad", yaw_rad, "must be finite");
 }
 
 void Ditch::validate() const {
-  requireParam(finite(center_xy), "Ditch", "center_xy", center_xy.transpose(), "must be finite");
-  requireParam(std::isfinite(length_m) && length_m > 0, "Ditch", "length_m", length_m,
+  core::requireParam(finite(center_xy), "Ditch", "center_xy", center_xy.transpose(), "must be finite");
+  core::requireParam(std::isfinite(length_m) && length_m > 0, "Ditch", "length_m", length_m,
                "must be > 0");
-  requireParam(std::isfinite(width_m) && width_m > 0, "Ditch", "width_m", width_m, "must be > 0");
-  requireParam(std::isfinite(depth_m) && depth_m > 0, "Ditch", "depth_m", depth_m, "must be > 0");
-  requireParam(std::isfinite(yaw_rad), "Ditch", "yaw_rad", yaw_rad, "must be finite");
+  core::requireParam(std::isfinite(width_m) && width_m > 0, "Ditch", "width_m", width_m, "must be > 0");
+  core::requireParam(std::isfinite(depth_m) && depth_m > 0, "Ditch", "depth_m", depth_m, "must be > 0");
+  core::requireParam(std::isfinite(yaw_rad), "Ditch", "yaw_rad", yaw_rad, "must be finite");
 }
 
 void Rock::validate() const {
-  requireParam(finite(center_xy), "Rock", "center_xy", center_xy.transpose(), "must be finite");
-  requireParam(std::isfinite(radius_x_m) && radius_x_m > 0, "Rock", "radius_x_m", radius_x_m,
+  core::requireParam(finite(center_xy), "Rock", "center_xy", center_xy.transpose(), "must be finite");
+  core::requireParam(std::isfinite(radius_x_m) && radius_x_m > 0, "Rock", "radius_x_m", radius_x_m,
                "must be > 0");
-  requireParam(std::isfinite(radius_y_m) && radius_y_m > 0, "Rock", "radius_y_m", radius_y_m,
+  core::requireParam(std::isfinite(radius_y_m) && radius_y_m > 0, "Rock", "radius_y_m", radius_y_m,
                "must be > 0");
-  requireParam(std::isfinite(height_m) && height_m > 0, "Rock", "height_m", height_m,
+  core::requireParam(std::isfinite(height_m) && height_m > 0, "Rock", "height_m", height_m,
                "must be > 0");
-  requireParam(std::isfinite(yaw_rad), "Rock", "yaw_rad", yaw_rad, "must be finite");
+  core::requireParam(std::isfinite(yaw_rad), "Rock", "yaw_rad", yaw_rad, "must be finite");
 }
 
 void Stairs::validate() const {
-  requireParam(finite(start_xy), "Stairs", "start_xy", start_xy.transpose(), "must be finite");
-  requireParam(std::isfinite(yaw_rad), "Stairs", "yaw_rad", yaw_rad, "must be finite");
-  requireParam(std::isfinite(width_m) && width_m > 0, "Stairs", "width_m", width_m, "must be > 0");
-  requireParam(steps >= 1, "Stairs", "steps", steps, "must be >= 1");
-  requireParam(std::isfinite(rise_m) && rise_m > 0, "Stairs", "rise_m", rise_m, "must be > 0");
-  requireParam(std::isfinite(run_m) && run_m > 0, "Stairs", "run_m", run_m, "must be > 0");
-  requireParam(std::isfinite(top_length_m) && top_length_m >= 0, "Stairs", "top_length_m",
+  core::requireParam(finite(start_xy), "Stairs", "start_xy", start_xy.transpose(), "must be finite");
+  core::requireParam(std::isfinite(yaw_rad), "Stairs", "yaw_rad", yaw_rad, "must be finite");
+  core::requireParam(std::isfinite(width_m) && width_m > 0, "Stairs", "width_m", width_m, "must be > 0");
+  core::requireParam(steps >= 1, "Stairs", "steps", steps, "must be >= 1");
+  core::requireParam(std::isfinite(rise_m) && rise_m > 0, "Stairs", "rise_m", rise_m, "must be > 0");
+  core::requireParam(std::isfinite(run_m) && run_m > 0, "Stairs", "run_m", run_m, "must be > 0");
+  core::requireParam(std::isfinite(top_length_m) && top_length_m >= 0, "Stairs", "top_length_m",
                top_length_m, "must be >= 0");
 }
 
 void Roughness::validate() const {
-  requireParam(std::isfinite(rms_height_m) && rms_height_m >= 0, "Roughness", "rms_height_m",
+  core::requireParam(std::isfinite(rms_height_m) && rms_height_m >= 0, "Roughness", "rms_height_m",
                rms_height_m, "must be >= 0");
-  requireParam(std::isfinite(wavelength_m) && wavelength_m > 0, "Roughness", "wavelength_m",
+  core::requireParam(std::isfinite(wavelength_m) && wavelength_m > 0, "Roughness", "wavelength_m",
                wavelength_m, "must be > 0");
-  requireParam(seed >= 0, "Roughness", "seed", seed, "must be >= 0");
+  core::requireParam(seed >= 0, "Roughness", "seed", seed, "must be >= 0");
 }
 
 // ----------------------------------------------------------------------------- construction
@@ -102,8 +102,8 @@ void Roughness::validate() const {
 Terrain::Terrain(const Eigen::Vector2d& min_xy, const Eigen::Vector2d& max_xy,
                  const TruthParams& truth)
     : min_xy_(min_xy), max_xy_(max_xy), truth_(truth) {
-  requireParam(finite(min_xy), "Terrain", "min_xy", min_xy.transpose(), "must be finite");
-  requireParam(finite(max_xy) && max_xy.x() > min_xy.x() && max_xy.y() > min_xy.y(), "Terrain",
+  core::requireParam(finite(min_xy), "Terrain", "min_xy", min_xy.transpose(), "must be finite");
+  core::requireParam(finite(max_xy) && max_xy.x() > min_xy.x() && max_xy.y() > min_xy.y(), "Terrain",
                "max_xy", max_xy.transpose(), "must be finite and > min_xy on both axes");
   truth_.validate();
   rebuildIndex();
@@ -414,8 +414,8 @@ bool Terrain::jumpAlong(const Segment& seg, const Eigen::Vector2d& p, double rad
   return false;
 }
 
-Label Terrain::truthAt(double x, double y) const {
-  if (!contains(x, y)) return Label::Unknown;
+core::Label Terrain::truthAt(double x, double y) const {
+  if (!contains(x, y)) return core::Label::Unknown;
   const Eigen::Vector2d p(x, y);
   const double border = truth_.border_m;
   const auto& near = cell_near_shapes_[cellOf(x, y)];
@@ -428,11 +428,11 @@ Label Terrain::truthAt(double x, double y) const {
     if (s.kind == Shape::Kind::Ditch || (s.kind == Shape::Kind::Box && s.wall)) {
       const double du = std::max({s.u_min - u, 0.0, u - s.u_max});
       const double dv = std::max(std::abs(v) - s.v_half, 0.0);
-      if (du * du + dv * dv <= border * border) return Label::NonTraversable;
+      if (du * du + dv * dv <= border * border) return core::Label::NonTraversable;
     } else if (s.kind == Shape::Kind::Rock) {
       if (s.height_m > truth_.max_step_m) {
         const double ru = s.radius_u_m + border, rv = s.radius_v_m + border;
-        if ((u / ru) * (u / ru) + (v / rv) * (v / rv) <= 1.0) return Label::NonTraversable;
+        if ((u / ru) * (u / ru) + (v / rv) * (v / rv) <= 1.0) return core::Label::NonTraversable;
       } else if ((u / s.radius_u_m) * (u / s.radius_u_m) +
                      (v / s.radius_v_m) * (v / s.radius_v_m) <=
                  1.0) {
@@ -442,12 +442,12 @@ Label Terrain::truthAt(double x, double y) const {
   }
   for (std::uint32_t id : near) {
     for (const Segment& seg : edges_[id]) {
-      if (jumpAlong(seg, p, border)) return Label::NonTraversable;
+      if (jumpAlong(seg, p, border)) return core::Label::NonTraversable;
     }
   }
-  if (on_small_rock) return Label::Traversable;
-  if (slopeAt(x, y) > truth_.max_slope_rad) return Label::NonTraversable;
-  return Label::Traversable;
+  if (on_small_rock) return core::Label::Traversable;
+  if (slopeAt(x, y) > truth_.max_slope_rad) return core::Label::NonTraversable;
+  return core::Label::Traversable;
 }
 
 }  // namespace upd::sim

@@ -13,12 +13,12 @@ using terrain_detail::kAcross_m;
 // ----------------------------------------------------------------------------- sampling
 
 SurfaceSamples Terrain::sampleSurface(double spacing_m) const {
-  requireParam(std::isfinite(spacing_m) && spacing_m > 0, "Terrain::sampleSurface", "spacing_m",
+  core::requireParam(std::isfinite(spacing_m) && spacing_m > 0, "Terrain::sampleSurface", "spacing_m",
                spacing_m, "must be > 0");
   const Eigen::Vector2d size = max_xy_ - min_xy_;
   const double nxd = std::floor(size.x() / spacing_m + 1e-9);
   const double nyd = std::floor(size.y() / spacing_m + 1e-9);
-  requireParam((nxd + 1) * (nyd + 1) <= 2e8, "Terrain::sampleSurface", "spacing_m", spacing_m,
+  core::requireParam((nxd + 1) * (nyd + 1) <= 2e8, "Terrain::sampleSurface", "spacing_m", spacing_m,
                "gives more than 2e8 grid points over the extent");
   const auto nx = static_cast<std::size_t>(nxd), ny = static_cast<std::size_t>(nyd);
 
@@ -66,8 +66,8 @@ SurfaceSamples Terrain::sampleSurface(double spacing_m) const {
         const double lo = std::min(h1, h2), hi = std::max(h1, h2);
         if (hi - lo <= spacing_m) continue;  // no face point strictly between
         if (onEarlierEdge(k, e, q)) continue;
-        const Label label =
-            hi - lo > truth_.max_step_m ? Label::NonTraversable : truthAt(q.x(), q.y());
+        const core::Label label =
+            hi - lo > truth_.max_step_m ? core::Label::NonTraversable : truthAt(q.x(), q.y());
         for (int m = 1; lo + m * spacing_m < hi - 1e-9; ++m) {
           out.cloud.push_back(static_cast<float>(q.x()), static_cast<float>(q.y()),
                               static_cast<float>(lo + m * spacing_m));

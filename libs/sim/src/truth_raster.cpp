@@ -57,7 +57,7 @@ double TruthRaster::clearance(const Eigen::Vector3d& pose, const RobotBodyParams
   double best = search_m;
   for (int iy = iy0; iy <= iy1; ++iy) {
     for (int ix = ix0; ix <= ix1; ++ix) {
-      if (at(ix, iy) != Label::NonTraversable) continue;
+      if (at(ix, iy) != core::Label::NonTraversable) continue;
       best = std::min(best, distanceToFootprint(pose, cellCenter(ix, iy), body));
     }
   }

@@ -36,13 +36,7 @@ Box block(double cx, double cy, double length_m, double width_m, double height_m
 }
 
 Rock rock(double cx, double cy, double rx, double ry, double h, double yaw = 0.0) {
-  Rock r;
-  r.center_xy = {cx, cy};
-  r.radius_x_m = rx;
-  r.radius_y_m = ry;
-  r.height_m = h;
-  r.yaw_rad = yaw;
-  return r;
+  return Rock{{cx, cy}, rx, ry, h, yaw};  // centre, radii, height, yaw
 }
 
 WorldSpec mixedWorld() {
@@ -50,7 +44,7 @@ WorldSpec mixedWorld() {
   Ramp ramp;
   ramp.start_xy = {3.0, -2.5};
   ramp.yaw_rad = 0.0;
-  ramp.slope_rad = 20.0 * kDegToRad;
+  ramp.slope_rad = 20.0 * core::kDegToRad;
   ramp.width_m = 1.5;
   ramp.height_m = 0.3;
   const double top_x = 3.0 + ramp.slopeLength();
@@ -107,7 +101,7 @@ WorldSpec rampWorld() {
   Terrain t({0.0, -4.0}, {10.0, 4.0});
   t.add(block(7.0, 0.5, 4.0, 3.0, 0.3));  // platform x in [5, 9], y in [-1, 2]
   Ramp ramp;
-  ramp.slope_rad = 20.0 * kDegToRad;
+  ramp.slope_rad = 20.0 * core::kDegToRad;
   ramp.height_m = 0.3;
   ramp.width_m = 1.6;
   ramp.yaw_rad = kHalfPi;

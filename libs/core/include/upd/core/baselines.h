@@ -12,7 +12,7 @@
 
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 
 struct BaselineParams {
   double radius_m = 0.5;          ///< neighbourhood radius, the same d_m as the UPD [m]
@@ -42,4 +42,4 @@ struct BaselineResult {
 BaselineResult computeBaselines(const PointCloud& cloud, const KdTree& tree,
                                 const Eigen::Vector3f& up, const BaselineParams& params);
 
-}  // namespace upd
+}  // namespace upd::core

@@ -9,7 +9,7 @@
 
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 
 struct CameraIntrinsics {
   int width = 640;  ///< [px]
@@ -36,4 +36,4 @@ PointCloud depthToCloud(const DepthImage& depth, const CameraIntrinsics& K);
 /// The same into cloud, whose buffers are reused (a frame loop allocates nothing once warm).
 void depthToCloud(const DepthImage& depth, const CameraIntrinsics& K, PointCloud& cloud);
 
-}  // namespace upd
+}  // namespace upd::core

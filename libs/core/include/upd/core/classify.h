@@ -16,7 +16,7 @@
 
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 
 struct ClassifyParams {
   double zeta_min = 0.95;      ///< zeta below this: non-traversable [-]
@@ -48,4 +48,4 @@ Classification classify(const UpdResult& upd, const Eigen::Vector3f& up,
 void classify(const UpdResult& upd, const Eigen::Vector3f& up, const ClassifyParams& params,
               Classification& out);
 
-}  // namespace upd
+}  // namespace upd::core

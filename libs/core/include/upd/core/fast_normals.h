@@ -33,7 +33,7 @@
 #include "upd/core/normals.h"
 #include "upd/core/point_cloud.h"
 
-namespace upd {
+namespace upd::core {
 
 /// True when computeNormalsOrganized accepts cloud and params: an organized cloud, a radius
 /// neighbourhood (knn = 0) and uniform weights.
@@ -57,4 +57,4 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
 Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
                            const Eigen::Vector3f& up);
 
-}  // namespace upd
+}  // namespace upd::core

@@ -67,7 +67,7 @@
 #include "upd/core/point_cloud.h"
 #include "upd/core/upd.h"
 
-namespace upd {
+namespace upd::core {
 
 /// Sizes of the lattice, for the benchmark's profile.
 struct FastUpdStats {
@@ -102,4 +102,4 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
                     UpdResult& out, FastUpdStats* stats = nullptr,
                     double zeta_threshold = std::numeric_limits<double>::quiet_NaN());
 
-}  // namespace upd
+}  // namespace upd::core

@@ -29,7 +29,7 @@
 #include <string>
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 
 enum class ObstacleDetector { Upd, Roughness };
 /// "upd" or "roughness".
@@ -98,4 +98,4 @@ class FrameScorer {
   FrameScorerParams params_;
 };
 
-}  // namespace upd
+}  // namespace upd::core

@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 
 class KdTree {
  public:
@@ -53,4 +53,4 @@ class KdTree {
   std::vector<Node> nodes_;
 };
 
-}  // namespace upd
+}  // namespace upd::core

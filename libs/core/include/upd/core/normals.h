@@ -16,7 +16,7 @@
 #include <limits>
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 
 enum class NormalWeighting : int {
   Uniform = 0,   ///< xi_i = 1 (the paper's default)
@@ -121,4 +121,4 @@ struct NormalOrienter {
 Normals computeNormals(const PointCloud& cloud, const KdTree& tree, const NormalParams& params,
                        const Eigen::Vector3f& up);
 
-}  // namespace upd
+}  // namespace upd::core

@@ -10,7 +10,7 @@
 #include <omp.h>
 #endif
 
-namespace upd::openmp {
+namespace upd::core::openmp {
 
 /// Threads of the current team (1 outside a parallel region).
 static inline int teamSize() {
@@ -39,4 +39,4 @@ static inline int maxThreads() {
 #endif
 }
 
-}  // namespace upd::openmp
+}  // namespace upd::core::openmp

@@ -25,7 +25,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace upd {
+namespace upd::core {
 
 namespace detail {
 template <class T>
@@ -77,4 +77,4 @@ std::string enumNameList(const EnumName<E> (&names)[N]) {
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
-}  // namespace upd
+}  // namespace upd::core

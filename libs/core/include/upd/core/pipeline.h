@@ -23,7 +23,7 @@
 #include "upd/core/preprocess.h"
 #include "upd/core/upd.h"
 
-namespace upd {
+namespace upd::core {
 
 struct PipelineParams {
   Eigen::Vector3f up = Eigen::Vector3f::UnitZ();  ///< gravity-up in the cloud frame (any length)
@@ -71,4 +71,4 @@ PipelineResult runPipeline(const PointCloud& input, const PipelineParams& params
 /// allocates nothing once warm (with the fast path and no pre-processing filter).
 void runPipeline(const PointCloud& input, const PipelineParams& params, PipelineResult& res);
 
-}  // namespace upd
+}  // namespace upd::core

@@ -16,7 +16,7 @@
 #include <limits>
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 
 struct PointCloud {
   std::vector<float> x, y, z;
@@ -101,4 +101,4 @@ enum class Label : std::uint8_t { Traversable = 0, NonTraversable = 1, Unknown =
 
 const char* toString(Label l);
 
-}  // namespace upd
+}  // namespace upd::core

@@ -12,7 +12,7 @@
 
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 
 struct PreprocessParams {
   bool range_enabled = false;
@@ -79,4 +79,4 @@ PointCloud preprocess(const PointCloud& in, const PreprocessParams& p,
 void preprocess(const PointCloud& in, const PreprocessParams& p, PointCloud& out,
                 PreprocessStats* stats = nullptr);
 
-}  // namespace upd
+}  // namespace upd::core

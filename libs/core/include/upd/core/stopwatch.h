@@ -4,7 +4,7 @@
 
 #include <chrono>
 
-namespace upd {
+namespace upd::core {
 
 class Stopwatch {
  public:
@@ -20,4 +20,4 @@ class Stopwatch {
   std::chrono::steady_clock::time_point start_;
 };
 
-}  // namespace upd
+}  // namespace upd::core

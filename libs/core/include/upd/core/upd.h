@@ -14,7 +14,7 @@
 #include <limits>
 #include <vector>
 
-namespace upd {
+namespace upd::core {
 
 /// How runPipeline computes normals and the UPD (UpdParams::method). See pipeline.h for the
 /// rule that picks the fast path and fast_upd.h for how far it is from the exact one.
@@ -99,4 +99,4 @@ struct UpdResult {
 UpdResult computeUpd(const PointCloud& cloud, const KdTree& tree, const Normals& normals,
                      const UpdParams& params);
 
-}  // namespace upd
+}  // namespace upd::core

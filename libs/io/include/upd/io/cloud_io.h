@@ -31,24 +31,24 @@ namespace upd::io {
 /// Reads a cloud, choosing the format by the extension (case-insensitive): .pcd, .ply,
 /// .xyz or .txt (XYZ text). Any other extension throws std::runtime_error naming the file
 /// and the supported extensions.
-PointCloud readCloud(const std::string& path);
+core::PointCloud readCloud(const std::string& path);
 
 /// PCD of any DATA kind (ascii, binary, binary_compressed). Fields x, y, z are required (any
 /// numeric type); colour is read from `rgb` (float-packed) or `rgba` (uint32); other fields are
 /// ignored. sensor_origin is the VIEWPOINT translation (its rotation is not kept).
-PointCloud readPcd(const std::string& path);
+core::PointCloud readPcd(const std::string& path);
 
 /// PLY `format ascii 1.0`, `binary_little_endian 1.0` or `binary_big_endian 1.0`. Reads the
 /// vertex element's x, y, z (any numeric type) and red, green, blue when present (uchar; other
 /// integer types are clamped to 0..255, float types are taken as 0..1); every other property
 /// and element (faces with list properties included) is skipped.
-PointCloud readPly(const std::string& path);
+core::PointCloud readPly(const std::string& path);
 
 /// XYZ text: one point per line, `x y z` or `x y z r g b` (r, g, b in 0..255), separated by
 /// whitespace and/or commas. `#` starts a comment; blank lines are ignored; a first line with
 /// no number at all (a column header such as `x,y,z`) is skipped. Every point line must have
 /// the column count of the first one. A bad line throws, naming the file and the line number.
-PointCloud readXyz(const std::string& path);
+core::PointCloud readXyz(const std::string& path);
 
 /// Options of the PLY writers.
 struct PlyWriteOptions {
@@ -62,16 +62,16 @@ struct PlyWriteOptions {
 /// Writes a binary little-endian PLY with vertex properties `x y z`, then `label` (uchar, the
 /// Label values) when labels is given, then `red green blue` (uchar) when the cloud has
 /// colour. labels, when given, must hold one entry per point (else std::invalid_argument).
-void writePly(const std::string& path, const PointCloud& cloud,
-              const std::vector<Label>* labels = nullptr, const PlyWriteOptions& options = {});
+void writePly(const std::string& path, const core::PointCloud& cloud,
+              const std::vector<core::Label>* labels = nullptr, const PlyWriteOptions& options = {});
 
 /// Writes XYZ text (`x y z` or `x y z r g b` per line); the floats are written in their
 /// shortest exact form, so readXyz gives back the same values.
-void writeXyz(const std::string& path, const PointCloud& cloud);
+void writeXyz(const std::string& path, const core::PointCloud& cloud);
 
 /// Writes a binary PCD (fields x y z, plus rgb when the cloud has colour) with width x height
 /// kept for an organized cloud and the VIEWPOINT set from sensor_origin.
-void writePcd(const std::string& path, const PointCloud& cloud);
+void writePcd(const std::string& path, const core::PointCloud& cloud);
 
 /// A read-only view of n contiguous values (pre-C++20 std::span). Builds implicitly from a
 /// std::vector; empty means "absent".
@@ -95,7 +95,7 @@ struct ScoredPoints {
   ArrayView<float> x, y, z;
   ArrayView<float> nx, ny, nz;        ///< unit normal
   ArrayView<float> rx, ry, rz, zeta;  ///< UPD vector r (eq. 6) and zeta (eq. 8)
-  ArrayView<Label> label;
+  ArrayView<core::Label> label;
   ArrayView<float> cost;              ///< traversal cost in [0, 1]
   ArrayView<std::uint8_t> r, g, b;    ///< colour
 
@@ -107,13 +107,13 @@ struct ScoredPoints {
 
 /// Views of a pipeline result (its scored cloud, normals, UPD and classes). The result must
 /// outlive the returned views.
-ScoredPoints scoredPointsOf(const PipelineResult& result);
+ScoredPoints scoredPointsOf(const core::PipelineResult& result);
 
 /// Writes a binary little-endian PLY with the properties listed in the header comment.
 /// Throws std::invalid_argument for inconsistent sizes, std::runtime_error for I/O failures.
 void writeScoredPly(const std::string& path, const ScoredPoints& points,
                     const PlyWriteOptions& options = {});
-void writeScoredPly(const std::string& path, const PipelineResult& result,
+void writeScoredPly(const std::string& path, const core::PipelineResult& result,
                     const PlyWriteOptions& options = {});
 
 /// The vertex property names writeScoredPly writes, in order (colour not included).

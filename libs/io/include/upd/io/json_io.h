@@ -31,7 +31,7 @@ nlohmann::json histogramJson(const std::vector<float>& values, double lo, double
 /// Every parameter of params, by the keys of the structs' visit() (angles in degrees under
 /// their `_deg` keys): {"up": [x, y, z], "preprocess": {...}, "normals": {...}, "upd": {...},
 /// "classify": {...}}.
-nlohmann::json paramsJson(const PipelineParams& params);
+nlohmann::json paramsJson(const core::PipelineParams& params);
 
 /// The run summary. points_in is the size of the cloud given to runPipeline. Keys:
 /// points_in, points_scored (finite zeta), points_invalid (scored-cloud points with NaN zeta
@@ -39,7 +39,7 @@ nlohmann::json paramsJson(const PipelineParams& params);
 /// zeta {min, mean, max, histogram {edges, counts}}, labels {traversable, non_traversable,
 /// unknown}, timing_ms {preprocess, index, normals, upd, classify, total}, preprocess {the
 /// PreprocessStats counters}, normals_invalid, params (paramsJson).
-nlohmann::json summaryJson(const PipelineResult& result, const PipelineParams& params,
+nlohmann::json summaryJson(const core::PipelineResult& result, const core::PipelineParams& params,
                            std::size_t points_in);
 
 /// Writes j (indented, newline-terminated) through writeFileAtomically.

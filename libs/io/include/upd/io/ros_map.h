@@ -23,8 +23,8 @@ inline constexpr std::uint8_t kRosUnknown = 205;
 
 /// The PGM value of a label, and back (as map_server reads a trinary map: < 100 occupied,
 /// > 250 free, unknown in between).
-std::uint8_t rosPixelOf(Label label);
-Label labelOfRosPixel(std::uint8_t value);
+std::uint8_t rosPixelOf(core::Label label);
+core::Label labelOfRosPixel(std::uint8_t value);
 
 /// A map as the files hold it. Cells are indexed (ix, iy) from the lower-left corner, as the
 /// project's grids are; the PGM's row order is the writer's and reader's business.
@@ -32,11 +32,11 @@ struct RosMap {
   double resolution_m = 0.05;                           ///< cell side [m/cell]
   Eigen::Vector2d origin_xy = Eigen::Vector2d::Zero();  ///< lower-left corner (world) [m]
   int width = 0, height = 0;                            ///< [cells]
-  std::vector<Label> labels;  ///< width * height, row-major from the bottom row (iy = 0)
+  std::vector<core::Label> labels;  ///< width * height, row-major from the bottom row (iy = 0)
 
-  Label at(int ix, int iy) const { return labels[static_cast<std::size_t>(iy) * width + ix]; }
+  core::Label at(int ix, int iy) const { return labels[static_cast<std::size_t>(iy) * width + ix]; }
   /// The label of the cell holding a world position; Unknown outside the map.
-  Label labelAt(double x, double y) const;
+  core::Label labelAt(double x, double y) const;
 };
 
 /// Writes yaml_path and the PGM beside it (same stem, ".pgm"), each atomically (the PGM first).

@@ -23,7 +23,7 @@
 namespace upd::maps {
 
 /// The true label at world position (x_m, y_m); Unknown where the truth says nothing.
-using TruthLabelAt = std::function<Label(double x_m, double y_m)>;
+using TruthLabelAt = std::function<core::Label(double x_m, double y_m)>;
 
 struct MapEvaluation {
   std::size_t map_non_traversable = 0;          ///< scored map cells labelled NonTraversable

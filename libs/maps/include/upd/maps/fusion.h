@@ -40,7 +40,7 @@ struct PointsWorld {
   const float* x = nullptr;  ///< [m], world frame
   const float* y = nullptr;  ///< [m], world frame
   const float* z = nullptr;  ///< [m], world frame, up
-  const Label* label = nullptr;
+  const core::Label* label = nullptr;
   const float* zeta = nullptr;       ///< UPD zeta [-]; NaN where not scored
   const float* slope_rad = nullptr;  ///< slope of r [rad]; NaN where not scored
   const float* cost = nullptr;       ///< traversal cost [0, 1]; NaN where unknown
@@ -52,8 +52,8 @@ struct PointsWorld {
 
 /// Views cloud_world (already transformed to the world frame) with the classification computed
 /// on it and, optionally, its UPD (for zeta). Throws std::invalid_argument when the sizes differ.
-PointsWorld viewPoints(const PointCloud& cloud_world, const Classification& classes,
-                       const UpdResult* upd = nullptr);
+PointsWorld viewPoints(const core::PointCloud& cloud_world, const core::Classification& classes,
+                       const core::UpdResult* upd = nullptr);
 
 /// The log-odds fusion rule; see the header comment. Loaded from the [FusionParams] ini section.
 struct FusionParams {

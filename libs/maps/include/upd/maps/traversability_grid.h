@@ -186,14 +186,14 @@ class TraversabilityGrid {
 /// Known = observed with at least min_hits_known hits.
 bool isKnown(const GridCell& cell, const GridParams& params);
 /// Unknown, NonTraversable (p >= p_nontrav_threshold) or Traversable.
-Label labelOf(const GridCell& cell, const GridParams& params);
+core::Label labelOf(const GridCell& cell, const GridParams& params);
 /// Probability of being non-traversable; NaN when unknown.
 float probabilityOf(const GridCell& cell, const GridParams& params);
 
 /// Queries at a world position; outside the window the cell is unknown.
 float probabilityNonTraversable(const TraversabilityGrid& grid, double x_m, double y_m);
 bool isKnown(const TraversabilityGrid& grid, double x_m, double y_m);
-Label cellLabel(const TraversabilityGrid& grid, double x_m, double y_m);
+core::Label cellLabel(const TraversabilityGrid& grid, double x_m, double y_m);
 
 /// A layer as a sizeY() x sizeX() matrix: entry (cy, cx) is cell (cx, cy), so row 0 is the
 /// SOUTH edge (y min) as in CDynamicGrid::getAsMatrix. Unknown cells are NaN (Hits: 0).

@@ -50,8 +50,8 @@ struct LoopParams {
 };
 
 struct NavConfig {
-  PipelineParams pipeline;
-  BaselineParams baseline;
+  core::PipelineParams pipeline;
+  core::BaselineParams baseline;
   maps::GridParams grid;
   maps::FusionParams fusion;
   sim::DepthNoise depth_noise;

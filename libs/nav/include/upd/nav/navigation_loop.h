@@ -40,7 +40,7 @@ class NavigationLoop {
  public:
   /// base must outlive the loop. navlog_path: where the navigator writes its MRPT navlog
   /// (empty: none).
-  NavigationLoop(RobotBase& base, const NavConfig& config, ObstacleDetector detector,
+  NavigationLoop(RobotBase& base, const NavConfig& config, core::ObstacleDetector detector,
                  const std::string& navlog_path = "");
   ~NavigationLoop();
   NavigationLoop(const NavigationLoop&) = delete;
@@ -50,7 +50,7 @@ class NavigationLoop {
   /// check) with the loop's FrameScorer, reusing the last frame's buffers, and fuses it at
   /// time_s. ground_z_m: height of the ground under the robot (0 on flat
   /// ground), the level below which hidden ground counts as missing.
-  const FrameEvidence& addFrame(const PointCloud& cloud_world, double time_s,
+  const FrameEvidence& addFrame(const core::PointCloud& cloud_world, double time_s,
                                 double ground_z_m = 0.0);
   /// Obstacles known a priori (world frame), e.g. rectangleFence() of the mission area.
   void setFixedObstacles(std::vector<Eigen::Vector2d> points_world);
@@ -83,7 +83,7 @@ class NavigationLoop {
  private:
   RobotBase& base_;
   NavConfig config_;
-  FrameScorer scorer_;
+  core::FrameScorer scorer_;
   std::string navlog_path_;
   maps::TraversabilityGrid grid_;
   ObstacleSource obstacles_;

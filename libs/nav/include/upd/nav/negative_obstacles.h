@@ -47,7 +47,7 @@ struct GroundGap {
 /// The gaps of an organized cloud in the world frame (z up, image rows top = far), with its
 /// sensor origin set; ground_z_m is the height of the ground under the robot. An unorganized
 /// cloud has no columns: no gaps.
-std::vector<GroundGap> findGroundGaps(const PointCloud& organized_world, double ground_z_m,
+std::vector<GroundGap> findGroundGaps(const core::PointCloud& organized_world, double ground_z_m,
                                       const NegativeObstacleParams& params);
 
 /// Points every spacing_m (> 0) along the gap's horizontal segment, near and far ends included.

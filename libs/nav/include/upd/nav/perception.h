@@ -8,12 +8,12 @@
 
 namespace upd::nav {
 
-using upd::ObstacleDetector;
-using upd::parseObstacleDetector;
-using upd::toString;
+using upd::core::ObstacleDetector;
+using upd::core::parseObstacleDetector;
+using upd::core::toString;
 
 /// A scored frame in the world frame (obstacles_world filled).
-struct FrameEvidence : ScoredFrame {
+struct FrameEvidence : core::ScoredFrame {
   double score_ms = 0.0;  ///< wall time of the scoring [ms] (timings.total_ms)
 };
 

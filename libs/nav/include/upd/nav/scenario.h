@@ -45,7 +45,7 @@ const char* toString(RunEnd e);
 
 struct ScenarioResult {
   std::string scenario;
-  ObstacleDetector detector = ObstacleDetector::Upd;
+  core::ObstacleDetector detector = core::ObstacleDetector::Upd;
   Eigen::Vector2d goal_xy = Eigen::Vector2d::Zero();
   bool reached = false;  ///< the navigator reported the goal and the robot is within tolerance
   RunEnd end = RunEnd::TimeLimit;
@@ -72,7 +72,7 @@ using StepCallback = std::function<void(const TrajectorySample&)>;
 /// Runs the loop on world (name is recorded). navlog_path: where the MRPT navlog goes (empty:
 /// none). Restores MRPT's clock to real time when it returns.
 ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
-                           const NavConfig& config, ObstacleDetector detector,
+                           const NavConfig& config, core::ObstacleDetector detector,
                            const std::string& navlog_path = "", const StepCallback& on_step = {});
 
 /// summary.json's content: reached, end state, navigator error, simulated time, path length,

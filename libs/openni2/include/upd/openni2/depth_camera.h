@@ -17,8 +17,8 @@
 namespace upd::openni2 {
 
 struct DepthFrame {
-  DepthImage depth;          ///< z-depth [m]; 0 = invalid
-  CameraIntrinsics K;        ///< of this image
+  core::DepthImage depth;          ///< z-depth [m]; 0 = invalid
+  core::CameraIntrinsics K;        ///< of this image
   std::uint64_t index = 0;   ///< frame number from the device or recording
   double device_time_s = 0;  ///< the device's timestamp [s]
 };

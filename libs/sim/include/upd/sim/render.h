@@ -45,21 +45,21 @@ Eigen::Isometry3d cameraPoseLookingAt(const Eigen::Vector3d& eye, const Eigen::V
                                       const Eigen::Vector3d& up_world = Eigen::Vector3d::UnitZ());
 
 /// Renders the z-depth image seen from pose_world_camera (camera-optical to world).
-DepthImage renderDepth(const Terrain& terrain, const Eigen::Isometry3d& pose_world_camera,
-                       const CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed);
+core::DepthImage renderDepth(const Terrain& terrain, const Eigen::Isometry3d& pose_world_camera,
+                       const core::CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed);
 
 /// A rendered view: the depth image and, as a Scene, its organized cloud in the camera-optical
 /// frame (sensor origin 0, invalid pixels NaN) with per-pixel truth (Terrain::truthAt of the
 /// exact hit; Unknown for invalid pixels) and the world up expressed in the camera frame.
 struct RenderedScene {
-  DepthImage depth;
+  core::DepthImage depth;
   Scene scene;
   Eigen::Isometry3d pose_world_camera = Eigen::Isometry3d::Identity();
 };
 
 /// Renders as renderDepth (same image for the same seed) and labels every pixel.
 RenderedScene renderScene(const Terrain& terrain, const Eigen::Isometry3d& pose_world_camera,
-                          const CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed,
+                          const core::CameraIntrinsics& K, const DepthNoise& noise, std::uint32_t seed,
                           const std::string& name = "rendered");
 
 }  // namespace upd::sim

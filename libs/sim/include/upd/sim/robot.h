@@ -45,7 +45,7 @@ struct CameraMountParams {
   double forward_m = 0.3;               ///< optical centre ahead of the robot origin [m]
   double left_m = 0.0;                  ///< ... to its left [m]
   double height_m = 0.5;                ///< ... above the ground [m]
-  double pitch_rad = 22.0 * kDegToRad;  ///< optical axis pitched down from the robot's x [rad]
+  double pitch_rad = 22.0 * core::kDegToRad;  ///< optical axis pitched down from the robot's x [rad]
   /// The simulated image is the Kinect's 640 x 480 (fx = fy = 525) divided by this: 4 gives
   /// 160 x 120, enough for the navigation loop at a fraction of the cost.
   int image_downscale = 1;
@@ -72,7 +72,7 @@ Eigen::Isometry3d mountOnRobot(const CameraMountParams& mount);
 /// (x_mount = z_optical, y_mount = -x_optical, z_mount = -y_optical).
 Eigen::Matrix3d opticalInMount();
 /// The simulated camera's intrinsics (the Kinect's scaled by image_downscale).
-CameraIntrinsics simulatedIntrinsics(const CameraMountParams& mount);
+core::CameraIntrinsics simulatedIntrinsics(const CameraMountParams& mount);
 
 /// pose_world_robot in 3D: the planar pose xy_yaw resting on the terrain (header comment).
 Eigen::Isometry3d bodyPoseOnTerrain(const Terrain& terrain, const Eigen::Vector3d& xy_yaw,
@@ -82,7 +82,7 @@ Eigen::Isometry3d bodyPoseFlat(const Eigen::Vector3d& xy_yaw);
 
 /// What the camera sees from the body pose: a cloud in the world frame with its sensor origin
 /// at the camera (rendered with simulatedIntrinsics and noise, seeded by seed).
-PointCloud renderCameraWorld(const Terrain& terrain, const Eigen::Isometry3d& pose_world_body,
+core::PointCloud renderCameraWorld(const Terrain& terrain, const Eigen::Isometry3d& pose_world_body,
                              const CameraMountParams& mount, const DepthNoise& noise,
                              std::uint32_t seed);
 

@@ -48,7 +48,7 @@ namespace upd::sim {
 namespace scene_geometry {
 constexpr double kCornerSide_m = 1.0;
 constexpr double kCornerEdgeBand_m = 0.05;
-constexpr double kRampSlope_rad = 20.0 * kDegToRad;
+constexpr double kRampSlope_rad = 20.0 * core::kDegToRad;
 constexpr double kRampLength_m = 2.0;    ///< horizontal, from x = 0
 constexpr double kRampWidth_m = 1.5;     ///< centred on y = 0
 constexpr double kRampPlatform_m = 1.0;  ///< flat top beyond x = kRampLength_m
@@ -62,8 +62,8 @@ constexpr double kDitchDepth_m = 0.3;
 
 struct Scene {
   std::string name;
-  PointCloud cloud;
-  std::vector<Label> truth;                       ///< one per point of cloud
+  core::PointCloud cloud;
+  std::vector<core::Label> truth;                       ///< one per point of cloud
   Eigen::Vector3f up = Eigen::Vector3f::UnitZ();  ///< gravity-up in the cloud frame (unit)
 };
 

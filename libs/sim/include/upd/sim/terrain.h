@@ -41,7 +41,7 @@ namespace upd::sim {
 
 /// Ground-truth thresholds for a small rover.
 struct TruthParams {
-  double max_slope_rad = 25.0 * kDegToRad;  ///< steeper surfaces are non-traversable [rad]
+  double max_slope_rad = 25.0 * core::kDegToRad;  ///< steeper surfaces are non-traversable [rad]
   double max_step_m = 0.05;  ///< taller vertical discontinuities are non-traversable [m]
   double border_m = 0.05;    ///< band around such discontinuities, both sides [m]
 
@@ -60,7 +60,7 @@ struct TruthParams {
 struct Ramp {
   Eigen::Vector2d start_xy = Eigen::Vector2d::Zero();  ///< centre of the lower edge [m]
   double yaw_rad = 0.0;                                ///< direction of ascent from +x [rad]
-  double slope_rad = 20.0 * kDegToRad;                 ///< (0, 60 deg] [rad]
+  double slope_rad = 20.0 * core::kDegToRad;                 ///< (0, 60 deg] [rad]
   double width_m = 1.5;                                ///< across the direction of ascent [m]
   double height_m = 0.3;                               ///< height at the top of the slope [m]
   double platform_length_m = 0.0;                      ///< flat top beyond the slope, may be 0 [m]
@@ -132,8 +132,8 @@ struct Roughness {
 /// Points sampled on the surface with their truth: the first surface_points are the top
 /// surface on the grid, the rest lie on vertical faces.
 struct SurfaceSamples {
-  PointCloud cloud;
-  std::vector<Label> truth;
+  core::PointCloud cloud;
+  std::vector<core::Label> truth;
   std::size_t surface_points = 0;
 };
 
@@ -174,7 +174,7 @@ class Terrain {
   /// the edge of a low step reads its flatter side.
   double slopeAt(double x, double y) const;
   /// Truth by the rule in the header comment.
-  Label truthAt(double x, double y) const;
+  core::Label truthAt(double x, double y) const;
   /// Upper bound of the height anywhere [m].
   double maxHeight() const;
 

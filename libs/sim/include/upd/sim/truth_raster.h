@@ -28,9 +28,9 @@ class TruthRaster {
   int sizeY() const { return ny_; }
   /// The lower-left corner of cell (0, 0) in the world (the terrain's minXY) [m].
   const Eigen::Vector2d& origin() const { return min_xy_; }
-  Label at(int ix, int iy) const { return labels_[static_cast<std::size_t>(iy) * nx_ + ix]; }
+  core::Label at(int ix, int iy) const { return labels_[static_cast<std::size_t>(iy) * nx_ + ix]; }
   /// Row-major from the bottom row (iy = 0), sizeX() * sizeY().
-  const std::vector<Label>& labels() const { return labels_; }
+  const std::vector<core::Label>& labels() const { return labels_; }
   Eigen::Vector2d cellCenter(int ix, int iy) const;
 
   /// pose_world_robot is planar: (x [m], y [m], yaw [rad]).
@@ -42,7 +42,7 @@ class TruthRaster {
   Eigen::Vector2d min_xy_;
   double cell_m_;
   int nx_ = 0, ny_ = 0;
-  std::vector<Label> labels_;
+  std::vector<core::Label> labels_;
 };
 
 }  // namespace upd::sim

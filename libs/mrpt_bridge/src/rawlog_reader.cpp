@@ -1,0 +1,320 @@
+#include "upd/mrpt_bridge/rawlog_reader.h"
+
+#include <mrpt/maps/registerAllClasses.h>
+#include <mrpt/obs/registerAllClasses.h>
+
+#include "mrpt_util.h"
+#include "upd/mrpt_bridge/pose_source.h"
+
+#include <mrpt/img/CImage.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CActionRobotMovement3D.h>
+#include <mrpt/obs/CObservation.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace upd::mrpt_bridge {
+
+const char* toString(RawlogLayout layout) {
+  switch (layout) {
+    case RawlogLayout::Empty:
+      return "empty";
+    case RawlogLayout::ActionsAndFrames:
+      return "actions + sensory frames";
+    case RawlogLayout::ObservationsOnly:
+      return "observations only";
+    case RawlogLayout::Mixed:
+      return "mixed (actions + sensory frames and bare observations)";
+  }
+  return "unknown";
+}
+
+std::string RawlogEntry::className() const {
+  return observation ? detail::shortClassName(*observation) : std::string();
+}
+
+std::size_t RawlogStats::skippedTotal() const {
+  std::size_t n = 0;
+  for (const auto& [reason, count] : skipped) n += count;
+  return n;
+}
+
+std::string RawlogStats::summary() const {
+  std::ostringstream os;
+  os << objects << " objects (" << action_collections << " action collections, " << sensory_frames
+     << " sensory frames): " << entries << " observations";
+  if (!entries_by_class.empty()) {
+    os << " (";
+    bool first = true;
+    for (const auto& [name, count] : entries_by_class) {
+      os << (first ? "" : ", ") << count << " " << name;
+      first = false;
+    }
+    os << ")";
+  }
+  os << ", " << odometry_actions << " odometry actions";
+  if (!skipped.empty()) {
+    os << "; skipped:";
+    for (const auto& [reason, count] : skipped) os << " " << count << " x " << reason << ";";
+  }
+  return os.str();
+}
+
+std::string detectImagesDirectory(const std::string& rawlog_path) {
+  // CRawlog::detectImagesDirectory() of MRPT 2.5.8 joins the directory and the names without a
+  // separator ("/data/runImages"), so it never finds "/data/run_Images": the same search, with
+  // std::filesystem.
+  namespace fs = std::filesystem;
+  const fs::path file(rawlog_path);
+  const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  const std::string stem = file.stem().string();
+  std::error_code ec;
+  for (const char* suffix : {"_Images", "_images", "_IMAGES"}) {
+    const fs::path candidate = dir / (stem + suffix);
+    if (fs::is_directory(candidate, ec)) return candidate.string();
+  }
+  return (dir / "Images").string();
+}
+
+namespace {
+
+// MRPT nests "Exception while parsing typed object 'X' from <stream> for file '<path>'" once per
+// level: keep the chain of classes and the innermost message.
+std::string describeReadError(const std::string& what) {
+  std::string msg = detail::condenseMessage(what);
+  const std::string head = "Exception while parsing typed object '";
+  std::string chain;
+  for (;;) {
+    if (msg.rfind(head, 0) != 0) break;
+    const auto name_end = msg.find('\'', head.size());
+    if (name_end == std::string::npos) break;
+    std::string name = msg.substr(head.size(), name_end - head.size());
+    if (name.find(' ') != std::string::npos) break;  // not a class name: keep the text as is
+    const auto ns = name.rfind("::");
+    if (ns != std::string::npos) name = name.substr(ns + 2);
+    chain += (chain.empty() ? "" : " > ") + name;
+    // Skip " from ... for file '...'" up to the ": " that starts the next level.
+    const auto next = msg.find("': ", name_end + 1);
+    if (next == std::string::npos) {
+      msg.clear();
+      break;
+    }
+    msg = msg.substr(next + 3);
+  }
+  if (chain.empty()) return msg;
+  return "in " + chain + (msg.empty() ? std::string() : ": " + msg);
+}
+
+Eigen::Isometry3d planarIsometry(double x, double y, double phi) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  t.translation() = Eigen::Vector3d(x, y, 0.0);
+  return t;
+}
+
+}  // namespace
+
+struct RawlogReader::Impl {
+  std::string path;
+  std::string images_dir;
+  mrpt::io::CFileGZInputStream in;
+  mrpt::serialization::CArchive::UniquePtr archive;
+  RawlogStats stats;
+  bool seen_frames = false, seen_bare_observations = false;
+  bool finished = false;
+  std::string failure;  // set once a read failed: later calls throw it again
+  std::size_t failure_object = 0;
+
+  struct Pending {
+    std::shared_ptr<mrpt::obs::CObservation> obs;
+    std::size_t object_index;
+  };
+  std::deque<Pending> pending;                 // observations of the last sensory frame
+  std::optional<Eigen::Isometry3d> increment;  // odometry not yet attached to an observation
+
+  void skip(const std::string& reason) { ++stats.skipped[reason]; }
+
+  void addIncrement(const Eigen::Isometry3d& inc) {
+    increment = increment ? Eigen::Isometry3d(*increment * inc) : inc;
+    ++stats.odometry_actions;
+  }
+
+  // Uses the first robot movement of a collection (or of a bare action); counts the rest.
+  void handleAction(const mrpt::obs::CAction& a, bool& used) {
+    const bool is_movement = dynamic_cast<const mrpt::obs::CActionRobotMovement3D*>(&a) ||
+                             dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(&a);
+    if (!is_movement) {
+      skip("action " + detail::shortClassName(a) + " (not a robot movement)");
+      return;
+    }
+    if (used) {
+      skip("extra robot movement in one CActionCollection (the first is used)");
+      return;
+    }
+    if (const auto* m3 = dynamic_cast<const mrpt::obs::CActionRobotMovement3D*>(&a)) {
+      addIncrement(toIsometry(m3->poseChange.mean));
+      used = true;
+      return;
+    }
+    const auto& m2 = dynamic_cast<const mrpt::obs::CActionRobotMovement2D&>(a);
+    if (!m2.poseChange) {
+      skip("CActionRobotMovement2D without a pose change");
+      return;
+    }
+    const mrpt::poses::CPose2D d = m2.poseChange->getMeanVal();
+    addIncrement(planarIsometry(d.x(), d.y(), d.phi()));
+    used = true;
+  }
+
+  void handleActions(const mrpt::obs::CActionCollection& acts) {
+    ++stats.action_collections;
+    seen_frames = true;
+    if (acts.size() == 0) skip("empty CActionCollection");
+    bool used = false;
+    for (const auto& a : acts) {
+      if (a) {
+        handleAction(*a, used);
+      } else {
+        skip("null action in a CActionCollection");
+      }
+    }
+  }
+
+  void handleObject(const mrpt::serialization::CSerializable::Ptr& o, std::size_t object_index) {
+    if (!o) {
+      skip("null object");
+      return;
+    }
+    if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(o)) {
+      ++stats.sensory_frames;
+      seen_frames = true;
+      if (sf->size() == 0) skip("empty CSensoryFrame");
+      for (const auto& obs : *sf) {
+        if (!obs) {
+          skip("null observation in a CSensoryFrame");
+          continue;
+        }
+        pending.push_back({obs, object_index});
+      }
+      return;
+    }
+    if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(o)) {
+      handleActions(*acts);
+      return;
+    }
+    if (auto obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(o)) {
+      seen_bare_observations = true;
+      pending.push_back({obs, object_index});
+      return;
+    }
+    if (auto act = std::dynamic_pointer_cast<mrpt::obs::CAction>(o)) {
+      // A bare action outside a collection: use a movement, count anything else.
+      seen_frames = true;
+      bool used = false;
+      handleAction(*act, used);
+      return;
+    }
+    skip("top-level " + detail::shortClassName(*o) +
+         " (not an action, sensory frame or observation)");
+  }
+
+  [[noreturn]] void fail(std::size_t object_index, const std::string& why) {
+    std::ostringstream os;
+    os << "rawlog " << path << ": cannot read object #" << object_index << ": " << why
+       << "; read before it: " << stats.objects << " objects, " << stats.entries << " observations";
+    failure = os.str();
+    failure_object = object_index;
+    finished = true;
+    throw RawlogError(failure, path, object_index);
+  }
+};
+
+RawlogReader::RawlogReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
+  // Observation classes register when their module loads; a program that links mrpt-maps but
+  // calls nothing in it would not know CObservationPointCloud (and friends) when reading.
+  mrpt::obs::registerAllClasses_mrpt_obs();
+  mrpt::maps::registerAllClasses_mrpt_maps();
+  impl_->path = path;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw std::runtime_error("rawlog " + path + ": not found");
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw std::runtime_error("rawlog " + path + ": not a regular file");
+  }
+  if (!std::ifstream(path).good()) throw std::runtime_error("rawlog " + path + ": unreadable");
+  if (!impl_->in.open(path)) throw std::runtime_error("rawlog " + path + ": cannot be opened");
+  impl_->archive = mrpt::serialization::archiveUniquePtrFrom(impl_->in);
+  impl_->images_dir = detectImagesDirectory(path);
+  mrpt::img::CImage::setImagesPathBase(impl_->images_dir);
+}
+
+RawlogReader::~RawlogReader() = default;
+
+bool RawlogReader::next(RawlogEntry& entry) {
+  Impl& d = *impl_;
+  for (;;) {
+    if (!d.pending.empty()) {
+      Impl::Pending p = std::move(d.pending.front());
+      d.pending.pop_front();
+      entry.index = d.stats.entries++;
+      entry.object_index = p.object_index;
+      entry.timestamp_s = detail::toSeconds(p.obs->timestamp);
+      entry.odometry_increment = d.increment;
+      d.increment.reset();
+      ++d.stats.entries_by_class[detail::shortClassName(*p.obs)];
+      entry.observation = std::move(p.obs);
+      return true;
+    }
+    if (!d.failure.empty()) throw RawlogError(d.failure, d.path, d.failure_object);
+    if (d.finished) return false;
+
+    const std::size_t object_index = d.stats.objects;
+    const uint64_t position = d.in.getPosition();
+    mrpt::serialization::CSerializable::Ptr object;
+    try {
+      *d.archive >> object;
+    } catch (const mrpt::serialization::CExceptionEOF& e) {
+      if (d.in.getPosition() != position) {
+        d.fail(object_index,
+               "truncated, the file ends inside it (" + describeReadError(e.what()) + ")");
+      }
+      d.finished = true;
+      if (d.increment) d.skip("odometry at the end of the file with no observation after it");
+      d.increment.reset();
+      return false;
+    } catch (const std::exception& e) {
+      d.fail(object_index, "corrupt or truncated (" + describeReadError(e.what()) + ")");
+    }
+    ++d.stats.objects;
+    d.handleObject(object, object_index);
+  }
+}
+
+const RawlogStats& RawlogReader::stats() const { return impl_->stats; }
+
+RawlogLayout RawlogReader::layout() const {
+  if (impl_->seen_frames && impl_->seen_bare_observations) return RawlogLayout::Mixed;
+  if (impl_->seen_frames) return RawlogLayout::ActionsAndFrames;
+  if (impl_->seen_bare_observations) return RawlogLayout::ObservationsOnly;
+  return RawlogLayout::Empty;
+}
+
+const std::string& RawlogReader::path() const { return impl_->path; }
+const std::string& RawlogReader::imagesDirectory() const { return impl_->images_dir; }
+
+RawlogStats scanRawlog(const std::string& path) {
+  RawlogReader reader(path);
+  RawlogEntry entry;
+  while (reader.next(entry)) {
+  }
+  return reader.stats();
+}
+
+}  // namespace upd::mrpt_bridge

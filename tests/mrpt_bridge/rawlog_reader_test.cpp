@@ -1,0 +1,289 @@
+// The streaming rawlog reader on every rawlog of the shared data, on truncated and corrupt
+// copies, and on files written here in both layouts.
+#include "upd/mrpt_bridge/rawlog_reader.h"
+#include "temp_dir.h"
+#include "test_data.h"
+
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservationComment.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPosePDFGaussian.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+namespace {
+
+using upd::mrpt_bridge::RawlogEntry;
+using upd::mrpt_bridge::RawlogError;
+using upd::mrpt_bridge::RawlogLayout;
+using upd::mrpt_bridge::RawlogReader;
+namespace fs = std::filesystem;
+
+using upd::test::TempDir;
+
+void writePrefix(const std::string& from, const fs::path& to, double fraction) {
+  std::ifstream in(from, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream out(to, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size() * fraction));
+}
+
+TEST(RawlogReader, SenaActionsAndFramesAllEntriesWithOdometry) {
+  UPD_REQUIRE_SHARED_FILE(path, "mrpt/2006-01ENE-21-SENA_Telecom_Faculty_one_loop_only.rawlog");
+  RawlogReader reader(path);
+  RawlogEntry e;
+  std::size_t n = 0, with_odometry = 0;
+  double travelled_m = 0, last_t = -1;
+  while (reader.next(e)) {
+    ASSERT_TRUE(e.observation);
+    EXPECT_EQ(e.index, n);
+    EXPECT_EQ(e.className(), "CObservation2DRangeScan");
+    ASSERT_TRUE(std::isfinite(e.timestamp_s));
+    EXPECT_GE(e.timestamp_s, last_t);  // file order is time order here
+    last_t = e.timestamp_s;
+    if (e.odometry_increment) {
+      ++with_odometry;
+      travelled_m += e.odometry_increment->translation().norm();
+      // planar odometry: no z, rotation about z only
+      EXPECT_NEAR(e.odometry_increment->translation().z(), 0.0, 1e-12);
+      EXPECT_NEAR(e.odometry_increment->linear()(2, 2), 1.0, 1e-12);
+    }
+    ++n;
+  }
+  EXPECT_EQ(n, 225u);
+  EXPECT_EQ(with_odometry, 224u);  // the first frame has no action before it
+  EXPECT_GT(travelled_m, 10.0);    // one loop of a faculty corridor
+  const auto& s = reader.stats();
+  EXPECT_EQ(s.objects, 449u);
+  EXPECT_EQ(s.action_collections, 224u);
+  EXPECT_EQ(s.sensory_frames, 225u);
+  EXPECT_EQ(s.odometry_actions, 224u);
+  EXPECT_EQ(s.entries, 225u);
+  EXPECT_EQ(s.entries_by_class.at("CObservation2DRangeScan"), 225u);
+  EXPECT_EQ(s.skippedTotal(), 0u);
+  EXPECT_EQ(reader.layout(), RawlogLayout::ActionsAndFrames);
+  EXPECT_FALSE(reader.next(e));  // stays at the end
+}
+
+struct ExpectedFile {
+  const char* rel;
+  std::size_t objects, entries;
+  const char* cls;
+  RawlogLayout layout;
+};
+
+TEST(RawlogReader, EverySharedRawlogReadsToTheEnd) {
+  const ExpectedFile files[] = {
+      {"mrpt/2006-01ENE-21-SENA_Telecom_Faculty_one_loop_only.rawlog", 449, 225,
+       "CObservation2DRangeScan", RawlogLayout::ActionsAndFrames},
+      {"mrpt/test-3d-obs-ground.rawlog", 1, 1, "CObservation3DRangeScan",
+       RawlogLayout::ActionsAndFrames},
+      {"mrpt/tests_rgbd.rawlog", 1, 1, "CObservation3DRangeScan", RawlogLayout::ObservationsOnly},
+      {"mrpt/test_velodyne_VLP16.rawlog", 1, 1, "CObservationVelodyneScan",
+       RawlogLayout::ObservationsOnly},
+  };
+  std::size_t checked = 0;
+  for (const auto& f : files) {
+    const std::string path = upd::test::sharedFile(f.rel);
+    if (path.empty()) continue;
+    SCOPED_TRACE(f.rel);
+    const auto stats = upd::mrpt_bridge::scanRawlog(path);
+    EXPECT_EQ(stats.objects, f.objects);
+    EXPECT_EQ(stats.entries, f.entries);
+    EXPECT_EQ(stats.entries_by_class.at(f.cls), f.entries);
+    RawlogReader reader(path);
+    RawlogEntry e;
+    while (reader.next(e)) {
+    }
+    EXPECT_EQ(reader.layout(), f.layout);
+    ++checked;
+  }
+  // Any further rawlog in the directory must read without error too.
+  const fs::path dir = upd::test::sharedDataDir() / "mrpt";
+  if (fs::is_directory(dir)) {
+    for (const auto& item : fs::directory_iterator(dir)) {
+      if (item.path().extension() != ".rawlog") continue;
+      SCOPED_TRACE(item.path().string());
+      EXPECT_NO_THROW(upd::mrpt_bridge::scanRawlog(item.path().string()));
+    }
+  }
+  if (checked == 0) GTEST_SKIP() << "no shared rawlog found under " << upd::test::sharedDataDir();
+}
+
+TEST(RawlogReader, TruncatedFileGivesCleanErrorNamingFileAndObject) {
+  UPD_REQUIRE_SHARED_FILE(path, "mrpt/2006-01ENE-21-SENA_Telecom_Faculty_one_loop_only.rawlog");
+  TempDir tmp;
+  const fs::path cut = tmp.path() / "sena_half.rawlog";
+  writePrefix(path, cut, 0.5);
+  RawlogReader reader(cut.string());
+  RawlogEntry e;
+  std::size_t read = 0;
+  try {
+    while (reader.next(e)) ++read;
+    FAIL() << "a truncated rawlog read to its end";
+  } catch (const RawlogError& err) {
+    const std::string what = err.what();
+    EXPECT_NE(what.find(cut.string()), std::string::npos) << what;
+    EXPECT_NE(what.find("object #" + std::to_string(err.objectIndex())), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+    EXPECT_EQ(err.path(), cut.string());
+    EXPECT_GT(err.objectIndex(), 100u);  // about half of 449
+    EXPECT_LT(err.objectIndex(), 449u);
+    EXPECT_GT(read, 50u);  // what came before is still delivered
+  }
+  // Asking again repeats the error instead of inventing an end.
+  EXPECT_THROW(reader.next(e), RawlogError);
+}
+
+TEST(RawlogReader, TruncatedSingleObservationFiles) {
+  for (const char* rel : {"mrpt/test-3d-obs-ground.rawlog", "mrpt/tests_rgbd.rawlog",
+                          "mrpt/test_velodyne_VLP16.rawlog"}) {
+    const std::string path = upd::test::sharedFile(rel);
+    if (path.empty()) continue;
+    SCOPED_TRACE(rel);
+    TempDir tmp;
+    for (double fraction : {0.1, 0.5, 0.9, 0.999}) {
+      const fs::path cut =
+          tmp.path() / ("cut_" + std::to_string(static_cast<int>(fraction * 1000)) + ".rawlog");
+      writePrefix(path, cut, fraction);
+      try {
+        upd::mrpt_bridge::scanRawlog(cut.string());
+        ADD_FAILURE() << "no error for " << fraction << " of " << rel;
+      } catch (const RawlogError& err) {
+        EXPECT_NE(std::string(err.what()).find(cut.string()), std::string::npos);
+        EXPECT_EQ(err.objectIndex(), 0u);
+      }
+    }
+  }
+}
+
+TEST(RawlogReader, GarbageAndMissingFiles) {
+  TempDir tmp;
+  const fs::path garbage = tmp.path() / "garbage.rawlog";
+  {
+    std::ofstream out(garbage, std::ios::binary);
+    std::uint32_t x = 12345u;  // fixed-seed LCG bytes
+    for (int i = 0; i < 4096; ++i) {
+      x = x * 1664525u + 1013904223u;
+      out.put(static_cast<char>(x >> 24));
+    }
+  }
+  try {
+    upd::mrpt_bridge::scanRawlog(garbage.string());
+    FAIL() << "garbage was read as a rawlog";
+  } catch (const RawlogError& err) {
+    const std::string what = err.what();
+    EXPECT_NE(what.find(garbage.string()), std::string::npos);
+    EXPECT_EQ(what.find('\n'), std::string::npos);
+    for (char c : what) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << "non-printable in: " << what;
+  }
+  const fs::path text = tmp.path() / "text.rawlog";
+  std::ofstream(text) << "this is not a rawlog\n";
+  EXPECT_THROW(upd::mrpt_bridge::scanRawlog(text.string()), RawlogError);
+
+  const std::string missing = (tmp.path() / "nope.rawlog").string();
+  try {
+    RawlogReader reader(missing);
+    FAIL() << "a missing file opened";
+  } catch (const std::runtime_error& err) {
+    EXPECT_EQ(std::string(err.what()), "rawlog " + missing + ": not found");
+  }
+
+  const fs::path empty = tmp.path() / "empty.rawlog";
+  std::ofstream(empty).close();
+  const auto stats = upd::mrpt_bridge::scanRawlog(empty.string());
+  EXPECT_EQ(stats.objects, 0u);
+  EXPECT_EQ(stats.entries, 0u);
+}
+
+// Both layouts written here: an odometry increment reaches the next observation even across an
+// empty sensory frame; a frame with no action before it is not lost; skips are counted.
+TEST(RawlogReader, WrittenLayoutsAndSkipReasons) {
+  using namespace mrpt::obs;
+  TempDir tmp;
+  const fs::path file = tmp.path() / "mixed.rawlog";
+  const auto movement = [](double x, double y, double phi) {
+    CActionRobotMovement2D act;
+    CActionRobotMovement2D::TMotionModelOptions opts;
+    act.computeFromOdometry(mrpt::poses::CPose2D(x, y, phi), opts);
+    CActionCollection acts;
+    acts.insert(act);
+    return acts;
+  };
+  const auto odoObs = [](double x) {
+    auto o = CObservationOdometry::Create();
+    o->odometry = mrpt::poses::CPose2D(x, 0, 0);
+    o->timestamp = mrpt::Clock::fromDouble(1000.0 + x);
+    return o;
+  };
+  {
+    mrpt::io::CFileGZOutputStream out(file.string());
+    auto ar = mrpt::serialization::archiveFrom(out);
+    CSensoryFrame sf0;  // no action before it
+    sf0.insert(odoObs(0.0));
+    ar << sf0;
+    ar << movement(1.0, 0.0, 0.0);
+    CSensoryFrame empty;
+    ar << empty;  // the increment must survive this
+    ar << movement(0.0, 2.0, 0.0);
+    CSensoryFrame sf1;
+    sf1.insert(odoObs(1.0));
+    sf1.insert(odoObs(2.0));
+    ar << sf1;
+    ar << *odoObs(3.0);  // observation-only layout in the same file
+    CObservationComment comment;
+    comment.text = "hello";
+    ar << comment;
+    ar << movement(5.0, 0.0, 0.0);  // nothing after it
+  }
+  RawlogReader reader(file.string());
+  RawlogEntry e;
+  ASSERT_TRUE(reader.next(e));
+  EXPECT_FALSE(e.odometry_increment);
+  EXPECT_NEAR(e.timestamp_s, 1000.0, 1e-6);
+  ASSERT_TRUE(reader.next(e));
+  ASSERT_TRUE(e.odometry_increment);  // (1,0) then (0,2), composed
+  EXPECT_NEAR(e.odometry_increment->translation().x(), 1.0, 1e-9);
+  EXPECT_NEAR(e.odometry_increment->translation().y(), 2.0, 1e-9);
+  EXPECT_EQ(e.object_index, 4u);
+  ASSERT_TRUE(reader.next(e));
+  EXPECT_FALSE(e.odometry_increment);  // same frame, the increment went to the first one
+  EXPECT_EQ(e.object_index, 4u);
+  ASSERT_TRUE(reader.next(e));
+  EXPECT_EQ(e.className(), "CObservationOdometry");
+  ASSERT_TRUE(reader.next(e));
+  EXPECT_EQ(e.className(), "CObservationComment");
+  EXPECT_FALSE(reader.next(e));
+  const auto& s = reader.stats();
+  EXPECT_EQ(s.entries, 5u);
+  EXPECT_EQ(s.odometry_actions, 3u);
+  EXPECT_EQ(s.skipped.at("empty CSensoryFrame"), 1u);
+  EXPECT_EQ(s.skipped.at("odometry at the end of the file with no observation after it"), 1u);
+  EXPECT_EQ(reader.layout(), RawlogLayout::Mixed);
+  EXPECT_NE(s.summary().find("5 observations"), std::string::npos) << s.summary();
+}
+
+}  // namespace
+
+namespace {
+
+TEST(RawlogReader, ImagesDirectoryFollowsMrptConvention) {
+  TempDir tmp;
+  const fs::path rawlog = tmp.path() / "run.rawlog";
+  EXPECT_EQ(fs::path(upd::mrpt_bridge::detectImagesDirectory(rawlog.string())),
+            tmp.path() / "Images");
+  fs::create_directories(tmp.path() / "run_Images");
+  EXPECT_EQ(fs::path(upd::mrpt_bridge::detectImagesDirectory(rawlog.string())),
+            tmp.path() / "run_Images");
+}
+
+}  // namespace
