@@ -2,9 +2,11 @@
 // traversability grid and the OctoMap tree, and exports them (PNG with legend, ROS map_server
 // PGM + YAML, .ot/.bt, .3Dscene, optional per-frame PLY and an annotated rawlog) with a
 // summary.json. A ground-truth grid next to the rawlog (as `upd simulate` writes it) is used
-// to score the map (maps::evaluateGrid).
+// to score the map (maps::evaluateGrid). A damaged rawlog keeps the maps of its good frames and
+// exits kExitPartial (playback_damage.h).
 #include "cli.h"
 #include "commands.h"
+#include "playback_damage.h"
 #include "run_config.h"
 
 #include "upd/core/stopwatch.h"
@@ -65,7 +67,15 @@ const char* const kPlaybackUsage =
     "  --ply               also write every frame's scored cloud as DIR/frames/NNNNNN.ply\n"
     "  --output-rawlog     also write DIR/annotated.rawlog: each frame with its non-traversable\n"
     "                      points as a CObservationPointCloud (label UPD_NON_TRAVERSABLE)\n"
-    "  --quiet             no progress line\n";
+    "  --strict            a damaged rawlog is an error (exit 1, nothing written) instead of\n"
+    "                      a partial run\n"
+    "  --quiet             no progress line\n\n"
+    "A damaged rawlog (cut off, or an object that does not deserialize) is played up to the\n"
+    "damage: the maps of the observations before it are written, summary.json records the\n"
+    "damage (object index, byte offset in the decompressed stream, reason) and one line on\n"
+    "stderr names it. Damage before the first observation writes nothing.\n\n"
+    "exit status: 0 done; 1 failed, nothing written; 2 usage error; 3 partial: the rawlog is\n"
+    "damaged and the maps of its good frames were written (not with --strict).\n";
 
 namespace {
 
@@ -79,7 +89,7 @@ struct PlaybackOptions {
   long from = 0, to = -1, every = 1;  ///< to < 0: to the end
   std::optional<std::string> poses_path;
   std::optional<std::string> truth_path;
-  bool ply = false, output_rawlog = false, quiet = false;
+  bool ply = false, output_rawlog = false, quiet = false, strict = false;
 
   /// Entry idx is inside --from/--to/--every.
   bool selected(long idx) const {
@@ -90,7 +100,7 @@ struct PlaybackOptions {
 PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   const Args args(argv,
                   {"--config", "--output", "--from", "--to", "--every", "--poses", "--truth"},
-                  {"--ply", "--output-rawlog", "--quiet"});
+                  {"--ply", "--output-rawlog", "--quiet", "--strict"});
   if (args.positionals().size() != 1) throw UsageError("expected exactly one RAWLOG");
   if (!args.has("--config")) throw UsageError("--config FILE.ini is required");
   if (!args.has("--output")) throw UsageError("--output DIR is required");
@@ -113,6 +123,7 @@ PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   o.ply = args.flag("--ply");
   o.output_rawlog = args.flag("--output-rawlog");
   o.quiet = args.flag("--quiet");
+  o.strict = args.flag("--strict");
   return o;
 }
 
@@ -323,6 +334,7 @@ struct Playback {
   std::vector<double> frame_ms;
   std::size_t read = 0, processed = 0, points_scored = 0;
   std::string pose_source;  ///< where the robot poses came from
+  std::optional<RawlogDamage> damage;  ///< set when the rawlog ended in damage (not --strict)
 
   explicit Playback(const RunConfig& config) : grid(config.grid), tree(config.octree) {}
 };
@@ -367,12 +379,36 @@ mrpt_bridge::RobotPoseTracker poseTracker(const PlaybackOptions& o, const RunCon
                                       config.ground_truth);
 }
 
+// Observations in the rawlog (for the progress line): those before the damage in a damaged one.
+std::size_t countEntries(const std::string& rawlog) {
+  mrpt_bridge::RawlogReader reader(rawlog);
+  mrpt_bridge::RawlogEntry entry;
+  try {
+    while (reader.next(entry)) {
+    }
+  } catch (const mrpt_bridge::RawlogError&) {
+  }
+  return reader.stats().entries;
+}
+
+// reader.next(), where damage ends the run as the end of the file would (recorded in
+// run.damage), unless strict or nothing was read before it: then it stays an error.
+bool nextIntact(mrpt_bridge::RawlogReader& reader, mrpt_bridge::RawlogEntry& entry, bool strict,
+                Playback& run) {
+  try {
+    return reader.next(entry);
+  } catch (const mrpt_bridge::RawlogError& err) {
+    if (strict || reader.stats().entries == 0) throw;
+    run.damage = damageOf(err, reader.stats().entries);
+    return false;
+  }
+}
+
 // Reads every entry, scores the selected ones with a pose and fuses them into the maps.
 void playFrames(const PlaybackOptions& o, const RunConfig& config,
                 mrpt_bridge::RobotPoseTracker& tracker, Playback& run) {
   mrpt_bridge::RawlogReader reader(o.rawlog);  // throws naming the file when missing
-  const std::size_t total =
-      (!o.quiet && ::isatty(2)) ? mrpt_bridge::scanRawlog(o.rawlog).entries : 0;
+  const std::size_t total = (!o.quiet && ::isatty(2)) ? countEntries(o.rawlog) : 0;
   const mrpt_bridge::UpdObserver observer(config.observer);
   std::optional<AnnotatedRawlog> annotated;
   if (o.output_rawlog) annotated.emplace((o.out_dir / "annotated.rawlog").string());
@@ -380,7 +416,7 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
 
   mrpt_bridge::RawlogEntry entry;
   mrpt_bridge::ObserverResult res;  // reused frame to frame
-  while (reader.next(entry)) {
+  while (nextIntact(reader, entry, o.strict, run)) {
     ++run.read;
     // Every entry updates the pose tracker, so odometry between selected frames is kept.
     const mrpt_bridge::RobotPose pose = tracker.update(entry);
@@ -467,6 +503,7 @@ json summaryJson(const PlaybackOptions& o, const RunConfig& config, Playback& ru
   summary["wall_time_s"] = wall_time_s;
   summary["grid"] = gridJson(run.grid);
   summary["octree"] = octreeJson(run.tree);
+  if (run.damage) summary["damage"] = damageJson(*run.damage);
   if (truth.grid) {
     summary["ground_truth"] = truthJson(run.grid, truth, config.evaluation.tolerance_m);
   }
@@ -507,6 +544,10 @@ int runPlayback(const std::vector<std::string>& argv) {
   const json summary = summaryJson(options, config, run, truth, wall.elapsedMs() / 1000.0);
   io::writeJsonAtomically((options.out_dir / "summary.json").string(), summary);
   printSummary(options, summary, config.evaluation.tolerance_m);
+  if (run.damage) {
+    std::fprintf(stderr, "%s\n", damageLine(*run.damage, options.out_dir.string()).c_str());
+    return kExitPartial;
+  }
   return 0;
 }
 

@@ -139,6 +139,12 @@ TEST(RawlogReader, TruncatedFileGivesCleanErrorNamingFileAndObject) {
     EXPECT_GT(err.objectIndex(), 100u);  // about half of 449
     EXPECT_LT(err.objectIndex(), 449u);
     EXPECT_GT(read, 50u);  // what came before is still delivered
+    // Where the unread object starts in the decompressed stream, and why, for a caller that
+    // keeps what came before (upd playback's damage record).
+    EXPECT_GT(err.byteOffset(), 0u);
+    EXPECT_NE(what.find("byte " + std::to_string(err.byteOffset())), std::string::npos) << what;
+    EXPECT_FALSE(err.reason().empty());
+    EXPECT_NE(what.find(err.reason()), std::string::npos) << what;
   }
   // Asking again repeats the error instead of inventing an end.
   EXPECT_THROW(reader.next(e), RawlogError);

@@ -131,6 +131,8 @@ struct RawlogReader::Impl {
   bool finished = false;
   std::string failure;  // set once a read failed: later calls throw it again
   std::size_t failure_object = 0;
+  uint64_t failure_offset = 0;
+  std::string failure_reason;
 
   struct Pending {
     std::shared_ptr<mrpt::obs::CObservation> obs;
@@ -225,14 +227,17 @@ struct RawlogReader::Impl {
          " (not an action, sensory frame or observation)");
   }
 
-  [[noreturn]] void fail(std::size_t object_index, const std::string& why) {
+  [[noreturn]] void fail(std::size_t object_index, uint64_t offset, const std::string& why) {
     std::ostringstream os;
-    os << "rawlog " << path << ": cannot read object #" << object_index << ": " << why
-       << "; read before it: " << stats.objects << " objects, " << stats.entries << " observations";
+    os << "rawlog " << path << ": cannot read object #" << object_index << " (at byte " << offset
+       << " of the decompressed stream): " << why << "; read before it: " << stats.objects
+       << " objects, " << stats.entries << " observations";
     failure = os.str();
     failure_object = object_index;
+    failure_offset = offset;
+    failure_reason = why;
     finished = true;
-    throw RawlogError(failure, path, object_index);
+    throw RawlogError(failure, path, object_index, offset, why);
   }
 };
 
@@ -272,7 +277,9 @@ bool RawlogReader::next(RawlogEntry& entry) {
       entry.observation = std::move(p.obs);
       return true;
     }
-    if (!d.failure.empty()) throw RawlogError(d.failure, d.path, d.failure_object);
+    if (!d.failure.empty()) {
+      throw RawlogError(d.failure, d.path, d.failure_object, d.failure_offset, d.failure_reason);
+    }
     if (d.finished) return false;
 
     const std::size_t object_index = d.stats.objects;
@@ -282,7 +289,7 @@ bool RawlogReader::next(RawlogEntry& entry) {
       *d.archive >> object;
     } catch (const mrpt::serialization::CExceptionEOF& e) {
       if (d.in.getPosition() != position) {
-        d.fail(object_index,
+        d.fail(object_index, position,
                "truncated, the file ends inside it (" + describeReadError(e.what()) + ")");
       }
       d.finished = true;
@@ -290,7 +297,7 @@ bool RawlogReader::next(RawlogEntry& entry) {
       d.increment.reset();
       return false;
     } catch (const std::exception& e) {
-      d.fail(object_index, "corrupt or truncated (" + describeReadError(e.what()) + ")");
+      d.fail(object_index, position, "corrupt or truncated (" + describeReadError(e.what()) + ")");
     }
     ++d.stats.objects;
     d.handleObject(object, object_index);

@@ -10,7 +10,8 @@
 // yield are counted by reason in RawlogStats::skipped.
 //
 // Errors: a missing file throws one line naming it; a corrupt or truncated file throws
-// RawlogError naming the file, the object index and what was read up to there. Externally
+// RawlogError naming the file, the object index, its byte offset and what was read up to there
+// (the observations yielded before it are intact). Externally
 // stored images are found through CImage::setImagesPathBase(detectImagesDirectory(file)), which
 // the constructor sets (MRPT keeps that path base process-wide: read one rawlog at a time).
 #pragma once
@@ -18,6 +19,7 @@
 #include <Eigen/Geometry>
 
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <memory>
@@ -70,18 +72,32 @@ struct RawlogStats {
   std::string summary() const;
 };
 
-/// A rawlog that cannot be read to its end (corrupt, truncated, unknown class, ...).
+/// A rawlog that cannot be read to its end (corrupt, truncated, unknown class, ...). Every
+/// object before objectIndex() was read intact: a caller may keep what it got from them.
 class RawlogError : public std::runtime_error {
  public:
-  RawlogError(const std::string& what, std::string path, std::size_t object_index)
-      : std::runtime_error(what), path_(std::move(path)), object_index_(object_index) {}
+  RawlogError(const std::string& what, std::string path, std::size_t object_index,
+              std::uint64_t byte_offset = 0, std::string reason = {})
+      : std::runtime_error(what),
+        path_(std::move(path)),
+        object_index_(object_index),
+        byte_offset_(byte_offset),
+        reason_(std::move(reason)) {}
   const std::string& path() const { return path_; }
   /// 0-based index of the top-level object that could not be read.
   std::size_t objectIndex() const { return object_index_; }
+  /// Where that object starts [bytes from the start of the decompressed stream; for a plain,
+  /// uncompressed rawlog this is the file offset].
+  std::uint64_t byteOffset() const { return byte_offset_; }
+  /// Why it could not be read ("truncated, the file ends inside it (...)"), without the file
+  /// and the counts that what() adds.
+  const std::string& reason() const { return reason_; }
 
  private:
   std::string path_;
   std::size_t object_index_;
+  std::uint64_t byte_offset_;
+  std::string reason_;
 };
 
 class RawlogReader {
