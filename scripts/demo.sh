@@ -11,4 +11,4 @@ UPD="$UPD_BUILD/apps/upd/upd"
 "$UPD" simulate --world mixed --output "$OUT/mixed.rawlog"
 "$UPD" playback "$OUT/mixed.rawlog" --config "$UPD_ROOT/config/dune-kinect.ini" \
   --poses "$OUT/mixed.gt.tum" --output "$OUT/maps"
-echo "demo: maps in $OUT/maps (map.png, map.pgm/.yaml, map.ot/.bt, map.3Dscene, summary.json)"
+echo "demo: maps in $OUT/maps (map.png, map.pgm/.yaml, map.ot/.bt, map_traversability.ot, map.3Dscene, summary.json)"

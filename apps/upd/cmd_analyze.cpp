@@ -25,7 +25,12 @@ const char* const kAnalyzeUsage =
     "                        0,-1,0 for a level camera in the optical frame)\n"
     "  --config FILE.ini     parameters from an ini file (see config/*.ini, docs/PARAMETERS.md);\n"
     "                        options given on the command line override it\n"
-    "  --output OUT.ply      scored cloud: x y z nx ny nz rx ry rz zeta label cost\n"
+    "  --output OUT.ply      scored cloud, valid (finite) points only: x y z nx ny nz scalar_rx\n"
+    "                        scalar_ry scalar_rz scalar_zeta scalar_label scalar_cost quality\n"
+    "                        (= zeta), the names CloudCompare and MeshLab load as fields\n"
+    "  --organized           write every point of the scored cloud, invalid (NaN) ones included,\n"
+    "                        in cloud order, with its width and height as header comments (an\n"
+    "                        organized input keeps them with --no-preprocess)\n"
     "  --stats-json OUT.json summary: counts, zeta statistics, labels, per-stage timings and\n"
     "                        the method used (fast or exact path)\n";
 
@@ -33,7 +38,7 @@ int runAnalyze(const std::vector<std::string>& argv) {
   const Args args(argv,
                   {"--radius-m", "--normal-radius-m", "--knn", "--voxel-m", "--up", "--config",
                    "--output", "--stats-json"},
-                  {"--no-preprocess"});
+                  {"--no-preprocess", "--organized"});
   if (args.positionals().size() != 1) throw UsageError("expected exactly one INPUT file");
   const std::string input = args.positionals()[0];
 
@@ -54,7 +59,11 @@ int runAnalyze(const std::vector<std::string>& argv) {
   const core::PipelineResult result = core::runPipeline(cloud, params);
   const auto summary = io::summaryJson(result, params, cloud.size());
 
-  if (const auto out = args.str("--output")) io::writeScoredPly(*out, result);
+  if (const auto out = args.str("--output")) {
+    io::ScoredPlyOptions ply;
+    ply.organized = args.flag("--organized");
+    io::writeScoredPly(*out, result, ply);
+  }
   if (const auto out = args.str("--stats-json")) io::writeJsonAtomically(*out, summary);
 
   const auto& c = result.classes;

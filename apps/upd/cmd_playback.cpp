@@ -52,9 +52,10 @@ const char* const kPlaybackUsage =
     "usage: upd playback RAWLOG --config FILE.ini --output DIR [options]\n"
     "  Replays RAWLOG (either rawlog layout): UPD for every 3D observation in the world frame,\n"
     "  fused over time into a 2.5D traversability grid and an OctoMap tree. Writes into DIR:\n"
-    "  map.png (colour, with legend), map.pgm + map.yaml (ROS map_server), map.ot (OctoMap with\n"
-    "  traversability), map.bt (occupancy), map_colour.ot (for octovis), map.3Dscene (MRPT\n"
-    "  SceneViewer3D) and summary.json.\n\n"
+    "  map.png (colour, with legend), map.pgm + map.yaml (ROS map_server), map.ot (OctoMap\n"
+    "  ColorOcTree coloured by traversability, for every OctoMap tool; map_colour.ot is the same\n"
+    "  file), map_traversability.ot (the full tree, read with upd::maps::readTraversabilityOt),\n"
+    "  map.bt (occupancy), map.3Dscene (MRPT SceneViewer3D) and summary.json.\n\n"
     "options:\n"
     "  --config FILE.ini   robot/sensor parameters (config/dune-kinect.ini, ...) (required)\n"
     "  --output DIR        output directory, created if missing (required)\n"
@@ -457,9 +458,12 @@ void exportMaps(Playback& run, const fs::path& out_dir) {
   maps::writeColourPng(run.grid, map + ".png");
   maps::writeRosMap(run.grid, map);
   run.tree.updateInnerOccupancy();
-  maps::writeTraversabilityOt(run.tree, map + ".ot");
+  // map.ot is a standard ColorOcTree so that convert_octree, octovis and AbstractOcTree::read
+  // open it; the custom node type would need our library registered in the reading program.
+  maps::writeColourOt(run.tree, map + ".ot");
+  maps::writeColourOt(run.tree, map + "_colour.ot");  // the name earlier versions wrote
+  maps::writeTraversabilityOt(run.tree, map + "_traversability.ot");
   maps::writeOccupancyBt(run.tree, map + ".bt");
-  maps::writeColourOt(run.tree, map + "_colour.ot");
   write3DScene(run.grid, run.trajectory, map + ".3Dscene");
 }
 
@@ -507,8 +511,9 @@ json summaryJson(const PlaybackOptions& o, const RunConfig& config, Playback& ru
   if (truth.grid) {
     summary["ground_truth"] = truthJson(run.grid, truth, config.evaluation.tolerance_m);
   }
-  summary["outputs"] = {"map.png", "map.pgm", "map.yaml", "map.ot", "map.bt", "map_colour.ot",
-                        "map.3Dscene"};
+  summary["outputs"] = {"map.png", "map.pgm",       "map.yaml",
+                        "map.ot",  "map_colour.ot", "map_traversability.ot",
+                        "map.bt",  "map.3Dscene"};
   return summary;
 }
 

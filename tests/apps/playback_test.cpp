@@ -10,10 +10,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <mrpt/opengl/COpenGLScene.h>
+#include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -32,18 +34,41 @@ const std::string kConfig = std::string(UPD_SOURCE_DIR) + "/config/dune-kinect.i
 
 json readJson(const fs::path& p) { return json::parse(std::ifstream(p)); }
 
+// OctoMap's own converter (Debian's octomap-tools), as a user would try it: map.ot to .bt.
+void expectConvertOctreeOpens(const octomap::AbstractOcTree& tree, const fs::path& ot) {
+  if (std::system("command -v convert_octree >/dev/null 2>&1") != 0) {
+    std::printf("[ SKIPPED  ] convert_octree not found (apt-get install octomap-tools)\n");
+    return;
+  }
+  const fs::path bt = ot.parent_path() / "converted.bt";
+  const CmdResult r = test::runCommand("convert_octree '" + ot.string() + "' '" + bt.string() + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  octomap::OcTree converted(bt.string());
+  // Its .bt is the maximum-likelihood tree, pruned: fewer nodes, the same resolution.
+  EXPECT_EQ(converted.size() > 0, tree.size() > 0) << r.output;
+  EXPECT_LE(converted.size(), tree.size());
+  EXPECT_DOUBLE_EQ(converted.getResolution(), tree.getResolution());
+  fs::remove(bt);
+}
+
 void expectAllExports(const fs::path& out) {
   for (const char* f : {"map.png", "map.pgm", "map.yaml", "map.ot", "map.bt", "map_colour.ot",
-                        "map.3Dscene", "summary.json"}) {
+                        "map_traversability.ot", "map.3Dscene", "summary.json"}) {
     EXPECT_TRUE(fs::exists(out / f)) << (out / f);
   }
   for (const auto& e : fs::directory_iterator(out)) {
     EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
   }
-  // The .bt opens in liboctomap as a plain OcTree, the .ot as our traversability tree.
+  // The .bt opens in liboctomap as a plain OcTree, map.ot as a standard ColorOcTree (what
+  // any OctoMap program reads), map_traversability.ot with our reader.
   octomap::OcTree bt((out / "map.bt").string());
   EXPECT_GT(bt.getResolution(), 0.0);
-  EXPECT_NO_THROW(maps::readTraversabilityOt((out / "map.ot").string()));
+  std::unique_ptr<octomap::AbstractOcTree> ot(octomap::AbstractOcTree::read((out / "map.ot").string()));
+  ASSERT_NE(ot, nullptr);
+  EXPECT_EQ(ot->getTreeType(), "ColorOcTree");
+  EXPECT_NE(dynamic_cast<octomap::ColorOcTree*>(ot.get()), nullptr);
+  EXPECT_NO_THROW(maps::readTraversabilityOt((out / "map_traversability.ot").string()));
+  expectConvertOctreeOpens(*ot, out / "map.ot");
   // The .3Dscene reloads in MRPT (what SceneViewer3D does): ground plane, cells, path.
   mrpt::opengl::COpenGLScene scene;
   ASSERT_TRUE(scene.loadFromFile((out / "map.3Dscene").string()));

@@ -13,8 +13,9 @@ struct CmdResult {
   std::string output;  ///< stdout and stderr
 };
 
-inline CmdResult runUpd(const std::string& args) {
-  const std::string cmd = std::string(UPD_BINARY) + " " + args + " 2>&1";
+/// Runs a shell command line, stdout and stderr captured.
+inline CmdResult runCommand(const std::string& command_line) {
+  const std::string cmd = command_line + " 2>&1";
   CmdResult r;
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return r;
@@ -24,5 +25,11 @@ inline CmdResult runUpd(const std::string& args) {
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+#ifdef UPD_BINARY
+inline CmdResult runUpd(const std::string& args) {
+  return runCommand(std::string(UPD_BINARY) + " " + args);
+}
+#endif
 
 }  // namespace upd::test

@@ -443,24 +443,25 @@ TEST(ScoredPly, HeaderListsExactlyThePropertiesInOrder) {
       "property float nx",
       "property float ny",
       "property float nz",
-      "property float rx",
-      "property float ry",
-      "property float rz",
-      "property float zeta",
-      "property uchar label",
-      "property float cost",
+      "property float scalar_rx",
+      "property float scalar_ry",
+      "property float scalar_rz",
+      "property float scalar_zeta",
+      "property uchar scalar_label",
+      "property float scalar_cost",
+      "property float quality",
       "property uchar red",
       "property uchar green",
       "property uchar blue",
       "end_header"};
   EXPECT_EQ(h, expected);
   const auto& names = upd::io::scoredPlyProperties();
-  ASSERT_EQ(names.size(), 12u);
+  ASSERT_EQ(names.size(), 13u);
   for (std::size_t i = 0; i < names.size(); ++i) {
     EXPECT_NE(h[4 + i].find(" " + names[i]), std::string::npos);
   }
 
-  const std::size_t stride = 10 * 4 + 1 + 4 + 3;
+  const std::size_t stride = 10 * 4 + 1 + 4 + 4 + 3;
   ASSERT_EQ(bytes.size(), body + 4 * stride);
   for (std::size_t i = 0; i < 4; ++i) {
     const std::size_t at = body + i * stride;
@@ -481,8 +482,10 @@ TEST(ScoredPly, HeaderListsExactlyThePropertiesInOrder) {
     } else {
       EXPECT_EQ(k, cost[i]);
     }
-    EXPECT_EQ(static_cast<unsigned char>(bytes[at + 45]), c.r[i]);
-    EXPECT_EQ(static_cast<unsigned char>(bytes[at + 47]), c.b[i]);
+    const float quality = loadLittleEndian<float>(bytes, at + 45);  // zeta again, for MeshLab
+    EXPECT_TRUE(quality == zeta[i] || (std::isnan(quality) && std::isnan(zeta[i])));
+    EXPECT_EQ(static_cast<unsigned char>(bytes[at + 49]), c.r[i]);
+    EXPECT_EQ(static_cast<unsigned char>(bytes[at + 51]), c.b[i]);
   }
   // The scored file is still a cloud our reader (and any PLY reader) opens.
   expectSameCloud(c, upd::io::readPly(f));
@@ -500,13 +503,77 @@ TEST(ScoredPly, AbsentViewsAreNanAndUnknownAndNoColour) {
   const std::string bytes = readBytes(f);
   std::size_t body = 0;
   const auto h = headerLines(bytes, &body);
-  ASSERT_EQ(h.size(), 4u + 12u + 1u);
-  EXPECT_EQ(h[15], "property float cost");
-  const std::size_t stride = 45;
+  ASSERT_EQ(h.size(), 4u + 13u + 1u);
+  EXPECT_EQ(h[15], "property float scalar_cost");
+  const std::size_t stride = 49;
   ASSERT_EQ(bytes.size(), body + 3 * stride);
   EXPECT_TRUE(std::isnan(loadLittleEndian<float>(bytes, body + 12)));  // nx
   EXPECT_TRUE(std::isnan(loadLittleEndian<float>(bytes, body + 36)));  // zeta
   EXPECT_EQ(static_cast<unsigned char>(bytes[body + 40]), static_cast<unsigned>(core::Label::Unknown));
+}
+
+// An organized 3 x 2 frame with two invalid pixels (NaN, as a depth image gives them).
+upd::core::PipelineResult organizedResultWithHoles() {
+  upd::core::PipelineResult r;
+  r.cloud = randomCloud(6, false, 9);
+  r.cloud.width = 3;
+  r.cloud.height = 2;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  r.cloud.x[1] = r.cloud.y[1] = r.cloud.z[1] = nan;
+  r.cloud.z[4] = std::numeric_limits<float>::infinity();
+  r.upd.zeta = {1.f, nan, 0.9f, 0.8f, nan, 0.7f};
+  r.classes.label.assign(6, core::Label::Traversable);
+  r.classes.cost.assign(6, 0.25f);
+  return r;
+}
+
+TEST(ScoredPly, InvalidPointsAreLeftOutByDefault) {
+  TempDir dir;
+  const upd::core::PipelineResult r = organizedResultWithHoles();
+  const std::string f = dir.file("valid.ply");
+  upd::io::writeScoredPly(f, r);
+  const std::string bytes = readBytes(f);
+  std::size_t body = 0;
+  const auto h = headerLines(bytes, &body);
+  EXPECT_EQ(h[3], "element vertex 4");
+  ASSERT_EQ(bytes.size(), body + 4 * 49);
+  const std::vector<std::size_t> kept = {0, 2, 3, 5};
+  for (std::size_t v = 0; v < kept.size(); ++v) {
+    const std::size_t at = body + v * 49;
+    EXPECT_EQ(loadLittleEndian<float>(bytes, at), r.cloud.x[kept[v]]);
+    EXPECT_EQ(loadLittleEndian<float>(bytes, at + 8), r.cloud.z[kept[v]]);
+    EXPECT_EQ(loadLittleEndian<float>(bytes, at + 36), r.upd.zeta[kept[v]]);  // scalar_zeta
+  }
+  const core::PointCloud back = upd::io::readPly(f);
+  ASSERT_EQ(back.size(), 4u);
+  for (std::size_t i = 0; i < back.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(back.x[i]) && std::isfinite(back.y[i]) && std::isfinite(back.z[i]));
+  }
+}
+
+TEST(ScoredPly, OrganizedKeepsEveryPixelWithWidthAndHeight) {
+  TempDir dir;
+  const upd::core::PipelineResult r = organizedResultWithHoles();
+  const std::string f = dir.file("organized.ply");
+  upd::io::ScoredPlyOptions options;
+  options.organized = true;
+  upd::io::writeScoredPly(f, r, options);
+  const std::string bytes = readBytes(f);
+  std::size_t body = 0;
+  const auto h = headerLines(bytes, &body);
+  EXPECT_EQ(h[2], "comment UPD-Nav");
+  EXPECT_EQ(h[3], "comment width 3");
+  EXPECT_EQ(h[4], "comment height 2");
+  EXPECT_EQ(h[5], "element vertex 6");
+  ASSERT_EQ(bytes.size(), body + 6 * 49);
+  EXPECT_TRUE(std::isnan(loadLittleEndian<float>(bytes, body + 49)));  // pixel 1 is NaN
+  EXPECT_EQ(upd::io::readPly(f).size(), 6u);
+
+  upd::io::ScoredPoints p = upd::io::scoredPointsOf(r);
+  EXPECT_EQ(p.width, 3u);
+  EXPECT_EQ(p.height, 2u);
+  p.width = 4;  // 4 x 2 != 6 points
+  EXPECT_THROW(upd::io::writeScoredPly(dir.file("bad.ply"), p, options), std::invalid_argument);
 }
 
 TEST(ScoredPly, InconsistentSizesAreRejectedNamingTheField) {
@@ -549,7 +616,7 @@ TEST(ScoredPly, FromPipelineResult) {
   std::size_t body = 0;
   const auto h = headerLines(bytes, &body);
   EXPECT_EQ(h[3], "element vertex 5");
-  ASSERT_EQ(bytes.size(), body + 5 * 45);
+  ASSERT_EQ(bytes.size(), body + 5 * 49);
   EXPECT_EQ(loadLittleEndian<float>(bytes, body + 32), 5.f);  // rz
   EXPECT_EQ(static_cast<unsigned char>(bytes[body + 40]),
             static_cast<unsigned>(core::Label::NonTraversable));

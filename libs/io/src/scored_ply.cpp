@@ -41,6 +41,11 @@ void ScoredPoints::validate() const {
   if (r.empty() != g.empty() || r.empty() != b.empty()) {
     throw std::invalid_argument("ScoredPoints.r/g/b must be all present or all absent");
   }
+  if ((width != 0 || height != 0) && width * height != size()) {
+    throw std::invalid_argument("ScoredPoints.width x height (" + std::to_string(width) + " x " +
+                                std::to_string(height) + ") is not the point count " +
+                                std::to_string(size()));
+  }
 }
 
 ScoredPoints scoredPointsOf(const core::PipelineResult& result) {
@@ -58,6 +63,10 @@ ScoredPoints scoredPointsOf(const core::PipelineResult& result) {
   s.zeta = result.upd.zeta;
   s.label = result.classes.label;
   s.cost = result.classes.cost;
+  if (c.isOrganized()) {
+    s.width = c.width;
+    s.height = c.height;
+  }
   if (c.hasColor()) {
     s.r = c.r;
     s.g = c.g;
@@ -67,13 +76,14 @@ ScoredPoints scoredPointsOf(const core::PipelineResult& result) {
 }
 
 const std::vector<std::string>& scoredPlyProperties() {
-  static const std::vector<std::string> kNames = {"x",  "y",  "z",    "nx",    "ny",  "nz",
-                                                  "rx", "ry", "rz", "zeta", "label", "cost"};
+  static const std::vector<std::string> kNames = {
+      "x",         "y",           "z",            "nx",          "ny",     "nz",     "scalar_rx",
+      "scalar_ry", "scalar_rz",   "scalar_zeta",  "scalar_label", "scalar_cost", "quality"};
   return kNames;
 }
 
 void writeScoredPly(const std::string& path, const ScoredPoints& p,
-                    const PlyWriteOptions& options) {
+                    const ScoredPlyOptions& options) {
   p.validate();
   using detail::PlyColumn;
   auto floatColumn = [](const char* name, const ArrayView<float>& v) {
@@ -90,23 +100,28 @@ void writeScoredPly(const std::string& path, const ScoredPoints& p,
   std::vector<PlyColumn> cols = {
       floatColumn("x", p.x),   floatColumn("y", p.y),   floatColumn("z", p.z),
       floatColumn("nx", p.nx), floatColumn("ny", p.ny), floatColumn("nz", p.nz),
-      floatColumn("rx", p.rx), floatColumn("ry", p.ry), floatColumn("rz", p.rz),
-      floatColumn("zeta", p.zeta),
+      floatColumn("scalar_rx", p.rx), floatColumn("scalar_ry", p.ry),
+      floatColumn("scalar_rz", p.rz), floatColumn("scalar_zeta", p.zeta),
       // Label is a uint8_t enum; reading it through unsigned char is allowed aliasing.
-      byteColumn("label",
+      byteColumn("scalar_label",
                  p.label.empty() ? nullptr : reinterpret_cast<const std::uint8_t*>(p.label.data),
                  static_cast<std::uint8_t>(core::Label::Unknown)),
-      floatColumn("cost", p.cost)};
+      floatColumn("scalar_cost", p.cost), floatColumn("quality", p.zeta)};
   if (!p.r.empty()) {
     cols.push_back(byteColumn("red", p.r.data, 0));
     cols.push_back(byteColumn("green", p.g.data, 0));
     cols.push_back(byteColumn("blue", p.b.data, 0));
   }
-  detail::writeBinaryPly(path, p.size(), cols, options.comments, options.drop_non_finite_xyz);
+  std::vector<std::string> comments = options.comments;
+  if (options.organized && p.height > 1) {
+    comments.push_back("width " + std::to_string(p.width));
+    comments.push_back("height " + std::to_string(p.height));
+  }
+  detail::writeBinaryPly(path, p.size(), cols, comments, !options.organized);
 }
 
 void writeScoredPly(const std::string& path, const core::PipelineResult& result,
-                    const PlyWriteOptions& options) {
+                    const ScoredPlyOptions& options) {
   writeScoredPly(path, scoredPointsOf(result), options);
 }
 

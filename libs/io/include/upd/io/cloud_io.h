@@ -13,9 +13,13 @@
 // CloudCompare and MeshLab can colour by zeta or filter by label. Its writer takes views
 // (pointer + length) rather than a PipelineResult, so a caller that keeps points and results in
 // other buffers (the MRPT observer views a CPointsMap's x, y, z vectors) writes the same file
-// without copying. The property order is the format's contract: x y z nx ny nz rx ry rz zeta
-// label cost, then red green blue when there is colour (all float except the uchar label and
-// colour).
+// without copying. The property order is the format's contract: x y z nx ny nz scalar_rx
+// scalar_ry scalar_rz scalar_zeta scalar_label scalar_cost quality, then red green blue when
+// there is colour (all float except the uchar label and colour). The names follow the viewers:
+// CloudCompare loads a property whose name starts with `scalar_` as a scalar field (its
+// command-line mode loads no other extra property) and nx ny nz as normals; MeshLab shows
+// `quality` (a copy of zeta). By default only points with a finite x, y and z are written:
+// viewers read a NaN coordinate as 0, a cluster at the origin.
 #pragma once
 
 #include "upd/core/pipeline.h"
@@ -99,6 +103,10 @@ struct ScoredPoints {
   ArrayView<float> cost;              ///< traversal cost in [0, 1]
   ArrayView<std::uint8_t> r, g, b;    ///< colour
 
+  /// The image layout of an organized cloud (width x height == size()), else 0 x 0; written
+  /// as header comments `width W` and `height H` by the organized scored PLY.
+  std::size_t width = 0, height = 0;
+
   std::size_t size() const { return x.size; }
   /// Throws std::invalid_argument naming the first view whose size is neither 0 nor n (x, y,
   /// z must all be n), or when only some of r, g, b are present.
@@ -109,12 +117,22 @@ struct ScoredPoints {
 /// outlive the returned views.
 ScoredPoints scoredPointsOf(const core::PipelineResult& result);
 
+/// Options of the scored PLY writer.
+struct ScoredPlyOptions {
+  /// Every point, vertex i = point i, NaN rows included (and `width`/`height` comments when
+  /// the points are organized), so the file lines up pixel by pixel with the image. Off by
+  /// default: points with a NaN or infinite x, y or z are left out.
+  bool organized = false;
+  /// Extra header comment lines (e.g. the command line that made the file).
+  std::vector<std::string> comments;
+};
+
 /// Writes a binary little-endian PLY with the properties listed in the header comment.
 /// Throws std::invalid_argument for inconsistent sizes, std::runtime_error for I/O failures.
 void writeScoredPly(const std::string& path, const ScoredPoints& points,
-                    const PlyWriteOptions& options = {});
+                    const ScoredPlyOptions& options = {});
 void writeScoredPly(const std::string& path, const core::PipelineResult& result,
-                    const PlyWriteOptions& options = {});
+                    const ScoredPlyOptions& options = {});
 
 /// The vertex property names writeScoredPly writes, in order (colour not included).
 const std::vector<std::string>& scoredPlyProperties();

@@ -20,11 +20,12 @@
 // than recenter_fraction of the box size from its centre along any axis, and every node outside
 // the new box is deleted; without it the box is fixed around center_*_m.
 //
-// Files: .ot holds everything (occupancy and traversability) and reloads with
-// octomap::AbstractOcTree::read in programs that link this library; .bt holds occupancy only,
-// as a plain OcTree (id OcTree) that every OctoMap tool, octovis included, reads. Octovis
-// cannot know the TraversabilityOcTree type, so for viewing, writeColourOt() writes a
-// ColorOcTree .ot coloured by traversability.
+// Files: writeTraversabilityOt holds everything (occupancy and traversability) and reloads
+// with readTraversabilityOt, or octomap::AbstractOcTree::read in programs that link this
+// library (which registers the type); no OctoMap tool knows the type. For those tools,
+// writeColourOt() writes a standard ColorOcTree .ot coloured by traversability (what `upd
+// playback` calls map.ot: convert_octree, octovis and AbstractOcTree::read open it), and
+// writeOccupancyBt() a plain OcTree .bt with occupancy only.
 #pragma once
 
 #include "upd/maps/fusion.h"
