@@ -197,7 +197,7 @@ const nav::FrameEvidence& addFrame(LiveRun& run, const openni2::DepthFrame& raw,
   const core::PointCloud cloud_world = core::transformCloud(core::depthToCloud(frame.depth, frame.K),
                                                 sim::bodyPoseFlat(xy_yaw) * run.camera_on_robot);
   const nav::FrameEvidence& ev = run.loop.addFrame(cloud_world, run.base.timeS());
-  run.score_ms += ev.score_ms;
+  run.score_ms += ev.timings.total_ms;
   ++run.frames;
   return ev;
 }

@@ -34,11 +34,6 @@ const std::string kConfig = std::string(UPD_SOURCE_DIR) + "/config/dune-kinect.i
 const char* const kMaps[] = {"map.png", "map.pgm",       "map.yaml",   "map.ot",
                              "map.bt",  "map_colour.ot", "map.3Dscene"};
 
-std::string readBytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 void writeBytes(const fs::path& p, const std::string& bytes) {
   std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
@@ -109,7 +104,7 @@ const SimulatedRun& fixture() {
 void expectMapsEqual(const fs::path& out, const fs::path& ref) {
   for (const char* f : kMaps) {
     ASSERT_TRUE(fs::exists(out / f)) << out / f;
-    EXPECT_TRUE(readBytes(out / f) == readBytes(ref / f)) << f << " differs from " << ref;
+    EXPECT_TRUE(test::readFileBytes(out / f) == test::readFileBytes(ref / f)) << f << " differs from " << ref;
   }
   for (const auto& e : fs::directory_iterator(out)) {
     EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
@@ -171,7 +166,7 @@ TEST(PlaybackDamage, FixtureHasFramesAndActions) {
 // is a shorter, valid rawlog (MRPT's format has no end marker): exit 0 with the frames up to it.
 TEST(PlaybackDamage, PlainRawlogCutAtEveryBoundaryAndInsideEveryObject) {
   const SimulatedRun& f = fixture();
-  const std::string bytes = readBytes(f.plain);
+  const std::string bytes = test::readFileBytes(f.plain);
   const test::TempDir tmp("plain");
   for (std::size_t i = 0; i < f.object_end.size(); ++i) {
     SCOPED_TRACE("object #" + std::to_string(i));
@@ -199,7 +194,7 @@ TEST(PlaybackDamage, PlainRawlogCutAtEveryBoundaryAndInsideEveryObject) {
 // The simulator writes gzip: a cut anywhere in the compressed file stops inside some object.
 TEST(PlaybackDamage, GzipRawlogCutAnywhere) {
   const SimulatedRun& f = fixture();
-  const std::string bytes = readBytes(f.gz);
+  const std::string bytes = test::readFileBytes(f.gz);
   const test::TempDir tmp("gz");
   for (double fraction : {0.3, 0.5, 0.7, 0.9, 0.999}) {
     SCOPED_TRACE(fraction);
@@ -219,7 +214,7 @@ TEST(PlaybackDamage, DamageBeforeTheFirstFrameWritesNothing) {
   const SimulatedRun& f = fixture();
   const test::TempDir tmp("first");
   const fs::path cut = tmp.path() / "head.rawlog";
-  writeBytes(cut, readBytes(f.gz).substr(0, 100));
+  writeBytes(cut, test::readFileBytes(f.gz).substr(0, 100));
   const fs::path out = tmp.path() / "out";
   const CmdResult r = SimulatedRun::playback(cut, out);
   expectNothingWritten(r, out, cut);
@@ -232,7 +227,7 @@ TEST(PlaybackDamage, DamageBeforeTheFirstFrameWritesNothing) {
 TEST(PlaybackDamage, FlippedByteInASensoryFrame) {
   const SimulatedRun& f = fixture();
   const test::TempDir tmp("flip");
-  std::string plain = readBytes(f.plain);
+  std::string plain = test::readFileBytes(f.plain);
   // The last object that holds an observation, with frames before it.
   std::size_t i = f.object_end.size() - 1;
   while (f.obs_through[i] == f.obsBefore(i)) --i;
@@ -245,7 +240,7 @@ TEST(PlaybackDamage, FlippedByteInASensoryFrame) {
   const fs::path strict = tmp.path() / "strict";
   expectNothingWritten(SimulatedRun::playback(flipped, strict, "--strict"), strict, flipped);
 
-  std::string gz = readBytes(f.gz);
+  std::string gz = test::readFileBytes(f.gz);
   gz[gz.size() / 2] ^= 0xFF;
   const fs::path gz_flipped = tmp.path() / "gz_flipped.rawlog";
   writeBytes(gz_flipped, gz);

@@ -15,11 +15,6 @@ namespace core = upd::core;
 namespace upd::io {
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 RosMap sample() {
   RosMap m;
   m.resolution_m = 0.05;
@@ -35,7 +30,7 @@ RosMap sample() {
 TEST(RosMap, WritesTheMapServerFormat) {
   const test::TempDir dir;
   writeRosMap(sample(), dir.file("truth.yaml"));
-  const std::string pgm = slurp(dir.file("truth.pgm"));
+  const std::string pgm = test::readFileBytes(dir.file("truth.pgm"));
   const std::string header = "P5\n3 2\n255\n";
   ASSERT_EQ(pgm.size(), header.size() + 6);
   EXPECT_EQ(pgm.substr(0, header.size()), header);
@@ -45,7 +40,7 @@ TEST(RosMap, WritesTheMapServerFormat) {
   EXPECT_EQ(static_cast<std::uint8_t>(pixels[1]), kRosFree);
   EXPECT_EQ(static_cast<std::uint8_t>(pixels[3]), kRosFree);
   EXPECT_EQ(static_cast<std::uint8_t>(pixels[5]), kRosUnknown);
-  EXPECT_EQ(slurp(dir.file("truth.yaml")),
+  EXPECT_EQ(test::readFileBytes(dir.file("truth.yaml")),
             "image: truth.pgm\nresolution: 0.05\norigin: [-1, 2, 0.0]\nnegate: 0\n"
             "occupied_thresh: 0.65\nfree_thresh: 0.196\nmode: trinary\n");
   EXPECT_EQ(dir.listing().size(), 2u);  // no temporary file left

@@ -29,11 +29,6 @@ using upd::test::TempDir;
 
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 struct Pgm {
   int width = 0, height = 0, maxval = 0;
   std::string pixels;
@@ -43,7 +38,7 @@ struct Pgm {
 };
 
 Pgm readPgm(const std::string& path) {
-  const std::string data = slurp(path);
+  const std::string data = upd::test::readFileBytes(path);
   std::istringstream in(data);
   std::string magic;
   Pgm p;
@@ -90,7 +85,7 @@ TEST(RosMap, PgmAndYamlFollowMapServerFormatAndOrientation) {
   EXPECT_TRUE(noTemporaryFiles(dir));
   EXPECT_EQ(dir.listing().size(), 2u);
 
-  const std::string yaml = slurp(dir.file("trav.yaml"));
+  const std::string yaml = upd::test::readFileBytes(dir.file("trav.yaml"));
   EXPECT_EQ(yamlValue(yaml, "image"), "trav.pgm");
   EXPECT_EQ(yamlValue(yaml, "resolution"), "0.1");
   EXPECT_EQ(yamlValue(yaml, "negate"), "0");
@@ -235,10 +230,10 @@ TEST(GridExport, RewritingReplacesTheFileAtomically) {
   TraversabilityGrid g = twoCellGrid();
   TempDir dir("rewrite");
   upd::maps::writeRosMap(g, dir.file("m"));
-  const std::string first = slurp(dir.file("m.pgm"));
+  const std::string first = upd::test::readFileBytes(dir.file("m.pgm"));
   g.clear();
   upd::maps::writeRosMap(g, dir.file("m"));
-  const std::string second = slurp(dir.file("m.pgm"));
+  const std::string second = upd::test::readFileBytes(dir.file("m.pgm"));
   EXPECT_EQ(first.size(), second.size());
   EXPECT_NE(first, second);
   EXPECT_EQ(second.find(static_cast<char>(upd::io::kRosOccupied), 10), std::string::npos);

@@ -92,7 +92,6 @@ const FrameEvidence& NavigationLoop::addFrame(const core::PointCloud& cloud_worl
                                               double ground_z_m) {
   // The cloud is already in the world frame: scored there, as the identity pose says.
   scorer_.score(cloud_world, Eigen::Isometry3d::Identity(), last_frame_);
-  last_frame_.score_ms = last_frame_.timings.total_ms;
   BaseState s;
   if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
   const auto view = maps::viewPoints(last_frame_.cloud_world, last_frame_.classes,

@@ -107,7 +107,7 @@ class ScenarioRun {
         sim::renderCameraWorld(world_.terrain, body, config_.camera, config_.depth_noise,
                                static_cast<std::uint32_t>(config_.loop.seed + k));
     const FrameEvidence& ev = loop_.addFrame(cloud, base_.timeS(), body.translation().z());
-    frame_ms = ev.score_ms;
+    frame_ms = ev.timings.total_ms;
     const NavState state = loop_.step();
     base_.advance(config_.loop.control_period_s);
     TrajectorySample s = sample(state);

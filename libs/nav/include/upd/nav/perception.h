@@ -12,9 +12,7 @@ using upd::core::ObstacleDetector;
 using upd::core::parseObstacleDetector;
 using upd::core::toString;
 
-/// A scored frame in the world frame (obstacles_world filled).
-struct FrameEvidence : core::ScoredFrame {
-  double score_ms = 0.0;  ///< wall time of the scoring [ms] (timings.total_ms)
-};
+/// A scored frame in the world frame (obstacles_world filled; its wall time in timings.total_ms).
+using FrameEvidence = core::ScoredFrame;
 
 }  // namespace upd::nav
