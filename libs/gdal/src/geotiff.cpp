@@ -162,6 +162,8 @@ void writeDataset(const maps::TraversabilityGrid& grid, const std::string& tmp,
 
 }  // namespace
 
+void validateEpsg(int epsg) { spatialReference(epsg); }
+
 const std::vector<BandSpec>& geoTiffBands() {
   static const std::vector<BandSpec> bands{
       {"cost", "1", "mean traversal cost of the cell's points, 0 (easy) .. 1"},
@@ -183,7 +185,7 @@ const std::vector<BandSpec>& geoTiffBands() {
 
 void writeGeoTiff(const maps::TraversabilityGrid& grid, const std::string& path,
                   const GeoTiffOptions& options) {
-  if (options.epsg != 0) spatialReference(options.epsg);  // fail before creating anything
+  if (options.epsg != 0) validateEpsg(options.epsg);  // fail before creating anything
   initGdal();
   const QuietErrors quiet;
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid()) + ".tif";

@@ -41,6 +41,10 @@ struct GeoTiffOptions {
   int epsg = 0;
 };
 
+/// Throws std::invalid_argument naming the code when GDAL does not know it or it is not a
+/// projected CRS in metres.
+void validateEpsg(int epsg);
+
 /// Writes grid to path (the whole window). Throws std::invalid_argument for an EPSG code that
 /// GDAL does not know or that is not a projected CRS in metres, std::runtime_error when
 /// writing fails.
