@@ -178,12 +178,11 @@ void MapCommands::aMapOfAnotherFrameIsRefusedInOneLine() {
   gdal::writeGeoTiff(maps::TraversabilityGrid(p), (dir("coarse") / "map.tif").string());
   fs::copy_file(dir("whole") / "map_traversability.ot", dir("coarse") / "map_traversability.ot",
                 fs::copy_options::overwrite_existing);
-  // And the whole run's map in UTM 33N.
-  fs::create_directories(dir("utm"));
-  gdal::writeGeoTiff(gdal::readGeoTiff((dir("whole") / "map.tif").string()).grid,
-                     (dir("utm") / "map.tif").string(), {32633});
-  fs::copy_file(dir("whole") / "map_traversability.ot", dir("utm") / "map_traversability.ot",
-                fs::copy_options::overwrite_existing);
+  // A run played with --epsg: poses in UTM zone 33N, so map.tif carries that CRS.
+  play("utm", {"mixed"}, "--to 1 --epsg 32633");
+  const json utm = gdalinfo(dir("utm") / "map.tif");
+  EXPECT_NE(utm["coordinateSystem"]["wkt"].get<std::string>().find("ID[\"EPSG\",32633]"),
+            std::string::npos);
   for (const auto& [other, expected] : {std::pair{"coarse", "cell size 0.2"},
                                         std::pair{"utm", "CRS EPSG:32633"}}) {
     const CmdResult r = map("merge " + dir("whole").string() + " " + dir(other).string() +
