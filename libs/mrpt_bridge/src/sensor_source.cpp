@@ -34,7 +34,10 @@ std::vector<SensorSection> sectionsOf(const mrpt::config::CConfigFile& ini) {
   std::vector<SensorSection> out;
   for (const auto& n : names) {
     const std::string driver = ini.read_string(n, "driver", "");
-    if (!driver.empty()) out.push_back({n, driver});
+    // rawlog-grabber skips sections so marked (a sensor's calibration sub-sections).
+    if (!driver.empty() && !ini.read_bool(n, "rawlog-grabber-ignore", false)) {
+      out.push_back({n, driver});
+    }
   }
   return out;
 }
@@ -145,6 +148,11 @@ void checkSensorSection(const std::string& ini_path, const std::string& section)
   auto sensor = createSensor(ini_path, s);
   loadSensorConfig(*sensor, *ini, ini_path, s.name);
   stereoCalibration(*ini, ini_path, s.name);
+  if (s.driver == "COpenNI2Sensor" && mrpt::hwdrivers::COpenNI2Generic().getConnectedDevices() <= 0) {
+    // MRPT 2.5's ~COpenNI2Sensor throws (std::terminate) when no device was opened: this one
+    // object, which never opened anything, is deliberately not destroyed.
+    new mrpt::hwdrivers::CGenericSensor::Ptr(std::move(sensor));
+  }
 }
 
 MrptSensorSource::MrptSensorSource(const std::string& ini_path, const std::string& section)
