@@ -84,7 +84,8 @@ OpenNI2Camera::OpenNI2Camera(const std::string& oni_path) : impl_(std::make_uniq
     const auto uris = connectedDevices();
     if (uris.empty()) {
       throw std::runtime_error(
-          "no OpenNI2 depth camera connected (Kinect, Xtion): plug one in or pass --oni FILE.oni");
+          "no OpenNI2 depth camera connected (Xtion, Carmine; a Kinect v1 is read with "
+          "--kinect): plug one in or pass --oni FILE.oni");
     }
     if (d.device.open(uris.front().c_str()) != openni::STATUS_OK) {
       throw std::runtime_error("cannot open the OpenNI2 device " + uris.front() + ": " +

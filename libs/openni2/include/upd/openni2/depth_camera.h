@@ -1,4 +1,5 @@
-// A live depth camera through OpenNI2: a Kinect or an Xtion, or an .oni recording of one.
+// A live depth camera through OpenNI2: an Xtion or Carmine (PrimeSense PS1080), or an .oni
+// recording of one. Debian's OpenNI2 has no Kinect v1 driver: libs/freenect reads the Kinect v1.
 //
 // OpenNI2 is used directly (not through MRPT's COpenNI2Sensor, which aborts the process when no
 // device is attached): the constructor enumerates the devices first and fails with one line when
