@@ -9,6 +9,7 @@ UPD_BUILD="${UPD_BUILD:-$UPD_ROOT/build}"
 PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
           libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev
+          libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
           octomap-tools cloudcompare gdal-bin mrpt-apps)  # the last four: tests open our files in them
 
 missing=()
