@@ -8,9 +8,9 @@ UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 UPD_BUILD="${UPD_BUILD:-$UPD_ROOT/build}"
 PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
-          libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev
+          libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev
           libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
-          octomap-tools cloudcompare)  # the last two: tests open our files in them
+          octomap-tools cloudcompare gdal-bin mrpt-apps)  # the last four: tests open our files in them
 
 missing=()
 for p in "${PACKAGES[@]}"; do
