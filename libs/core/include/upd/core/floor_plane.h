@@ -9,8 +9,13 @@
 // max_tilt_rad of the prior up and which passes min_height_m..max_height_m below the camera;
 // the plane with the most inliers (distance <= inlier_distance_m) wins. It is then refitted by
 // least squares (the smallest-eigenvalue direction of the inliers' covariance), with the
-// inliers taken again from every point, twice. A floor is a surface: few points lie just off
-// it (min_surface_contrast), unlike a slice through a bush. Random sampling uses a fixed seed: the same
+// inliers taken again from every point, twice. Half the hypotheses take their second and third
+// points near the first in the cloud's order (image neighbours for an organized cloud), so a
+// floor that holds only a few % of the points is still sampled. A floor is large: its inliers
+// spread over min_area_m2 at least (a shelf is not a floor). The floor is the lowest surface in view: a
+// hypothesis scores its inliers minus the points under it (more than 3 x inlier_distance_m),
+// so a table top loses to the floor under it, and a plane with many points under it
+// (max_below_ratio) is no floor. Random sampling uses a fixed seed: the same
 // input gives the same result.
 //
 // Frames: the clouds are in the camera-optical frame (x right, y down, z forward). The plane
@@ -36,14 +41,15 @@ namespace upd::core {
 struct FloorPlaneParams {
   int ransac_iterations = 500;           ///< plane hypotheses tried
   double inlier_distance_m = 0.03;       ///< a point this close to the plane is on it [m]
-  double max_tilt_rad = 60.0 * kDegToRad;  ///< floor normal within this of the prior up [rad]
+  double max_tilt_rad = 45.0 * kDegToRad;  ///< floor normal within this of the prior up [rad]
   double min_height_m = 0.05;            ///< the camera is at least this high [m]
   double max_height_m = 3.0;             ///< ... and at most this [m]
-  double min_inlier_share = 0.05;        ///< fewer points on the plane: no floor found
+  double min_inlier_share = 0.02;        ///< fewer points on the plane: no floor found
   int min_inliers = 500;                 ///< ... and at least this many points on it
-  /// Points within inlier_distance_m over those within 3 x inlier_distance_m: at least this,
-  /// else the "plane" is a slice through clutter, not a surface.
-  double min_surface_contrast = 0.6;
+  /// Points more than 3 x inlier_distance_m under the plane, over the points on it: at most
+  /// this, else the plane is not the floor (a table top, a slice through clutter).
+  double max_below_ratio = 0.25;
+  double min_area_m2 = 1.0;              ///< the floor's inliers cover at least this [m^2]
   int max_sample_points = 50000;         ///< RANSAC scores on at most this many points
   int seed = 1;                          ///< random sampling seed
 
@@ -59,8 +65,10 @@ struct FloorPlaneParams {
     v("min_inlier_share", min_inlier_share,
       "share of the valid points that must lie on the floor, else no floor is found");
     v("min_inliers", min_inliers, "points that must lie on the floor, else no floor is found");
-    v("min_surface_contrast", min_surface_contrast,
-      "points within inlier_distance_m over those within 3 x it: a surface, not a slice");
+    v("max_below_ratio", max_below_ratio,
+      "points > 3 x inlier_distance_m under the plane over those on it (the floor is lowest)");
+    v("min_area_m2", min_area_m2,
+      "the points on the floor cover at least this (12 sigma1 sigma2 of their spread) [m^2]");
     v("max_sample_points", max_sample_points, "RANSAC scores hypotheses on this many points");
     v("seed", seed, "random sampling seed (the same input gives the same plane)");
   }
@@ -75,7 +83,8 @@ struct FloorPlane {
   double rms_residual_m = 0;       ///< RMS distance of the inliers to the plane [m]
   std::size_t inliers = 0;         ///< points on the plane
   std::size_t valid_points = 0;    ///< finite points considered
-  double surface_contrast = 0;     ///< inliers over the points within 3 x the inlier distance
+  std::size_t below = 0;           ///< points more than 3 x the inlier distance under it
+  double area_m2 = 0;              ///< the inliers' extent: 12 sigma1 sigma2 in the plane [m^2]
   double inlierShare() const {
     return valid_points ? static_cast<double>(inliers) / valid_points : 0.0;
   }
