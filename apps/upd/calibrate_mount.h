@@ -10,6 +10,10 @@
 #include <functional>
 #include <string>
 
+namespace mrpt::obs {
+class CObservation;
+}
+
 namespace upd::app {
 
 /// Frames `upd live --auto-mount` calibrates on.
@@ -25,5 +29,10 @@ sim::CameraMountParams autoMount(const std::function<bool(core::PointCloud&)>& n
 /// Reads [CameraMountParams] from mount_ini (as `upd calibrate-mount --output` writes it) over
 /// mount, strictly: another section or key in the file is an error naming it.
 void loadMountFile(const std::string& mount_ini, sim::CameraMountParams& mount);
+
+/// Puts a recorded camera observation on mount (`upd playback --mount`): a 3D range scan's
+/// sensor pose becomes the mount's frame (sim::mountOnRobot), a stereo pair's the optical frame
+/// (sim::cameraOnRobot). Other observations are left as recorded.
+void remount(mrpt::obs::CObservation& obs, const sim::CameraMountParams& mount);
 
 }  // namespace upd::app

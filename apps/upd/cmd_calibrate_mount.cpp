@@ -12,6 +12,7 @@
 #include "upd/mrpt_bridge/depth_files.h"
 #include "upd/mrpt_bridge/ini_params.h"
 #include "upd/mrpt_bridge/observation_cloud.h"
+#include "upd/mrpt_bridge/pose_source.h"
 #include "upd/mrpt_bridge/rawlog_reader.h"
 #include "upd/nav/nav_config.h"
 #include "upd/sim/mount_calibration.h"
@@ -19,6 +20,9 @@
 #ifdef UPD_HAVE_OPENNI2
 #include "upd/openni2/depth_camera.h"
 #endif
+
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationStereoImages.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -160,6 +164,14 @@ void loadMountFile(const std::string& mount_ini, sim::CameraMountParams& mount) 
   mrpt_bridge::IniReader ini(mount_ini);
   ini.read("CameraMountParams", mount);
   ini.checkAllKeysKnown();
+}
+
+void remount(mrpt::obs::CObservation& obs, const sim::CameraMountParams& mount) {
+  if (dynamic_cast<mrpt::obs::CObservation3DRangeScan*>(&obs)) {
+    obs.setSensorPose(mrpt_bridge::toCPose3D(sim::mountOnRobot(mount)));
+  } else if (dynamic_cast<mrpt::obs::CObservationStereoImages*>(&obs)) {
+    obs.setSensorPose(mrpt_bridge::toCPose3D(sim::cameraOnRobot(mount)));
+  }
 }
 
 sim::CameraMountParams autoMount(const std::function<bool(core::PointCloud&)>& next_cloud,

@@ -3,6 +3,7 @@
 // base shipped is the simulated differential drive (robot_base.h): integrators replace it with
 // their robot's (docs/NAVIGATION.md, "Driving a real robot"). The camera input is built when
 // OpenNI2 was found (libs/openni2, UPD_HAVE_OPENNI2); without it `upd live` says so.
+#include "calibrate_mount.h"
 #include "cli.h"
 #include "commands.h"
 #include "run_config.h"
@@ -32,7 +33,7 @@ namespace upd::app {
 
 const char* const kLiveUsage =
     "usage: upd live [--config FILE.ini] [--nav-config FILE.ini] [--oni FILE.oni] [--view]\n"
-    "                [--navigate X,Y] [--frames N] [--output DIR]\n"
+    "                [--navigate X,Y] [--frames N] [--output DIR] [--mount F.ini | --auto-mount]\n"
     "  Reads a Kinect or Xtion through OpenNI2 (or an .oni recording), runs the UPD and the\n"
     "  traversability map on every frame and, with --navigate, drives the robot base to the\n"
     "  goal with MRPT's reactive navigator. The shipped base is simulated (it moves on the\n"
@@ -46,6 +47,10 @@ const char* const kLiveUsage =
     "  --view             3D view: cloud coloured by zeta, the map, the robot, the route\n"
     "  --navigate X,Y     goal in the map frame (the robot starts at 0,0 facing +x) [m]\n"
     "  --frames N         stop after N frames (default: until the end, the goal or Ctrl-C)\n"
+    "  --mount FILE.ini   camera mount [CameraMountParams] over the nav config's (as written\n"
+    "                     by upd calibrate-mount --output)\n"
+    "  --auto-mount       measure the mount from the floor in the first frames (robot on a\n"
+    "                     level floor); no floor found: one line, exit status 1, no run\n"
     "  --output DIR       write map.png, summary.json and the navlog (with --navigate) at the "
     "end\n";
 
@@ -71,12 +76,15 @@ struct LiveOptions {
   std::optional<Eigen::Vector2d> goal;
   std::optional<std::string> out;
   bool view = false;
+  std::optional<std::string> mount;  ///< --mount FILE.ini
+  bool auto_mount = false;
 };
 
 // The command line; the default configs are looked up only when not given.
 LiveOptions parseLiveOptions(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--config", "--nav-config", "--oni", "--navigate", "--frames", "--output"},
-                  {"--view"});
+  const Args args(argv, {"--config", "--nav-config", "--oni", "--navigate", "--frames", "--output",
+                         "--mount"},
+                  {"--view", "--auto-mount"});
   if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
   LiveOptions o;
   const auto config = args.str("--config");
@@ -90,6 +98,8 @@ LiveOptions parseLiveOptions(const std::vector<std::string>& argv) {
   if (const auto g = args.str("--navigate")) o.goal = parseGoal(*g);
   o.out = args.str("--output");
   o.view = args.flag("--view");
+  o.mount = args.str("--mount");
+  o.auto_mount = args.flag("--auto-mount");
   return o;
 }
 
@@ -256,9 +266,18 @@ int finishLive(const LiveOptions& o, const LiveTally& t, const maps::Traversabil
 }
 
 // Runs the camera through the loop until it stops.
-int runCamera(const LiveOptions& o, const nav::NavConfig& config) {
+int runCamera(const LiveOptions& o, nav::NavConfig config) {
   openni2::OpenNI2Camera camera(o.oni);  // one line and status 1 if none
   std::printf("camera: %s\n", camera.description().c_str());
+  if (o.auto_mount) {  // the mount from the floor in the first frames, or no run
+    config.camera = autoMount(
+        [&](core::PointCloud& c) {
+          openni2::DepthFrame f;
+          if (camera.read(f)) core::depthToCloud(f.depth, f.K, c);
+          return !c.empty();
+        },
+        config.camera, kAutoMountFrames);
+  }
   LiveRun run(o, config);
   LiveTally t;
   {
@@ -289,7 +308,8 @@ int runCamera(const LiveOptions& o, const nav::NavConfig&) {
 int runLive(const std::vector<std::string>& argv) {
   const LiveOptions o = parseLiveOptions(argv);
   loadRunConfig(o.config_path);  // the shared robot config, checked strictly as every command does
-  const nav::NavConfig config = nav::loadNavConfig(o.config_path, o.nav_path);
+  nav::NavConfig config = nav::loadNavConfig(o.config_path, o.nav_path);
+  if (o.mount) loadMountFile(*o.mount, config.camera);
   if (o.view && !nav::displayAvailable()) {
     throw std::runtime_error("--view needs a display (neither DISPLAY nor WAYLAND_DISPLAY is set)");
   }

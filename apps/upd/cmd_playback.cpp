@@ -4,6 +4,7 @@
 // summary.json. A ground-truth grid next to the rawlog (as `upd simulate` writes it) is used
 // to score the map (maps::evaluateGrid). A damaged rawlog keeps the maps of its good frames and
 // exits kExitPartial (playback_damage.h).
+#include "calibrate_mount.h"
 #include "cli.h"
 #include "commands.h"
 #include "playback_damage.h"
@@ -65,6 +66,8 @@ const char* const kPlaybackUsage =
     "                      instead of the rawlog's odometry\n"
     "  --truth FILE.yaml   ground-truth traversability grid to score the map against\n"
     "                      (default: RAWLOG's .truth.yaml sidecar when present)\n"
+    "  --mount FILE.ini    put the camera on this [CameraMountParams] (upd calibrate-mount\n"
+    "                      --output) instead of the recorded sensor pose\n"
     "  --ply               also write every frame's scored cloud as DIR/frames/NNNNNN.ply\n"
     "  --output-rawlog     also write DIR/annotated.rawlog: each frame with its non-traversable\n"
     "                      points as a CObservationPointCloud (label UPD_NON_TRAVERSABLE)\n"
@@ -90,6 +93,7 @@ struct PlaybackOptions {
   long from = 0, to = -1, every = 1;  ///< to < 0: to the end
   std::optional<std::string> poses_path;
   std::optional<std::string> truth_path;
+  std::optional<sim::CameraMountParams> mount;  ///< --mount: replaces the recorded sensor pose
   bool ply = false, output_rawlog = false, quiet = false, strict = false;
 
   /// Entry idx is inside --from/--to/--every.
@@ -100,7 +104,8 @@ struct PlaybackOptions {
 
 PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   const Args args(argv,
-                  {"--config", "--output", "--from", "--to", "--every", "--poses", "--truth"},
+                  {"--config", "--output", "--from", "--to", "--every", "--poses", "--truth",
+                   "--mount"},
                   {"--ply", "--output-rawlog", "--quiet", "--strict"});
   if (args.positionals().size() != 1) throw UsageError("expected exactly one RAWLOG");
   if (!args.has("--config")) throw UsageError("--config FILE.ini is required");
@@ -121,6 +126,7 @@ PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   }
   o.poses_path = args.str("--poses");
   o.truth_path = args.str("--truth");
+  if (const auto m = args.str("--mount")) loadMountFile(*m, o.mount.emplace());
   o.ply = args.flag("--ply");
   o.output_rawlog = args.flag("--output-rawlog");
   o.quiet = args.flag("--quiet");
@@ -431,6 +437,7 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
       continue;
     }
     const core::Stopwatch frame_clock;
+    if (o.mount) remount(*entry.observation, *o.mount);
     observer.observe(*entry.observation, pose.pose_world_robot, res);
     if (!res.ok()) {
       ++run.skipped[res.skipped_reason];
