@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "playback_damage.h"
+#include "playback_tum.h"
 #include "run_config.h"
 
 #include "upd/core/stopwatch.h"
@@ -50,7 +51,7 @@
 namespace upd::app {
 
 const char* const kPlaybackUsage =
-    "usage: upd playback RAWLOG --config FILE.ini --output DIR [options]\n"
+    "usage: upd playback RAWLOG|TUM_DIR --config FILE.ini --output DIR [options]\n"
     "  Replays RAWLOG (either rawlog layout): UPD for every 3D observation in the world frame,\n"
     "  fused over time into a 2.5D traversability grid and an OctoMap tree. Writes into DIR:\n"
     "  map.png (colour, with legend), map.pgm + map.yaml (ROS map_server), map.ot (OctoMap\n"
@@ -78,6 +79,11 @@ const char* const kPlaybackUsage =
     "damage: the maps of the observations before it are written, summary.json records the\n"
     "damage (object index, byte offset in the decompressed stream, reason) and one line on\n"
     "stderr names it. Damage before the first observation writes nothing.\n\n"
+    "TUM RGB-D folder: upd playback DIR ... plays DIR/depth.txt's 16-bit depth PNGs (5000 per m)\n"
+    "with the camera poses of DIR/groundtruth.txt (a z-up world), written as DIR_OUT/sequence\n"
+    ".rawlog first. Its options: --intrinsics F.yaml (OpenCV/ROS YAML) or --tum-camera\n"
+    "freiburg1|freiburg2|freiburg3|ros (default: the freiburgN in DIR's name), --depth-scale S\n"
+    "(metres per unit, default 0.0002), --poses FILE instead of groundtruth.txt.\n\n"
     "exit status: 0 done; 1 failed, nothing written; 2 usage error; 3 partial: the rawlog is\n"
     "damaged and the maps of its good frames were written (not with --strict).\n";
 
@@ -542,6 +548,7 @@ void printSummary(const PlaybackOptions& o, const json& summary, double toleranc
 }  // namespace
 
 int runPlayback(const std::vector<std::string>& argv) {
+  if (isTumPlayback(argv)) return runTumPlayback(argv);  // converts, then plays the rawlog
   const core::Stopwatch wall;
   const PlaybackOptions options = parsePlaybackOptions(argv);
   const RunConfig config = loadRunConfig(options.config_path);

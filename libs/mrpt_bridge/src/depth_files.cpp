@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <ostream>
 #include <stdexcept>
 #include <vector>
@@ -52,12 +54,19 @@ int intField(const cv::FileStorage& fs, const std::string& file, const char* key
 cv::FileStorage openCalibration(const std::string& file) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) fail(file, "not found");
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  if (!(text << in.rdbuf())) fail(file, "unreadable");
+  // OpenCV's parser wants its directive, which ROS's camera_info files do not carry.
+  std::string yaml = text.str();
+  if (yaml.rfind("%YAML", 0) != 0) yaml = "%YAML:1.0\n---\n" + yaml;
   try {
-    cv::FileStorage fs(file, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+    cv::FileStorage fs(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY |
+                                 cv::FileStorage::FORMAT_YAML);
     if (!fs.isOpened()) fail(file, "unreadable");
     return fs;
   } catch (const cv::Exception& e) {
-    fail(file, "not valid YAML (" + e.msg + ")");
+    fail(file, "not valid YAML (" + e.err + ")");
   }
 }
 
