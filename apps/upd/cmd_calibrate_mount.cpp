@@ -182,12 +182,7 @@ sim::CameraMountParams autoMount(const std::function<bool(core::PointCloud&)>& n
     if (!next_cloud(c)) break;
     views.push_back(&c);
   }
-  const sim::MountCalibration cal = sim::calibrateMount(views, configured);
-  if (!cal.ok()) {
-    throw std::runtime_error(cal.summary() +
-                             "; the camera mount is unknown, not navigating (put the robot on a "
-                             "level floor with the floor in view, or give --mount FILE.ini)");
-  }
+  const sim::MountCalibration cal = sim::requireCalibratedMount(views, configured);
   std::printf("auto mount: %s\n", cal.summary().c_str());
   return cal.mount;
 }

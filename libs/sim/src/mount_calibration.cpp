@@ -39,16 +39,16 @@ MountCalibration calibrateMount(const std::vector<const core::PointCloud*>& clou
   return c;
 }
 
-CameraMountParams requireCalibratedMount(
+MountCalibration requireCalibratedMount(
     const std::vector<const core::PointCloud*>& clouds_in_camera,
     const CameraMountParams& configured, const core::FloorPlaneParams& params) {
-  const MountCalibration c = calibrateMount(clouds_in_camera, configured, params);
+  MountCalibration c = calibrateMount(clouds_in_camera, configured, params);
   if (!c.ok()) {
     throw std::runtime_error(c.summary() +
                              "; the camera mount is unknown, not navigating (put the robot on "
-                             "a level floor with the floor in view, or give the mount)");
+                             "a level floor with the floor in view, or give the mount: --mount FILE.ini)");
   }
-  return c.mount;
+  return c;
 }
 
 std::string mountIniSection(const CameraMountParams& mount, const std::string& comment) {

@@ -32,9 +32,9 @@ MountCalibration calibrateMount(const std::vector<const core::PointCloud*>& clou
                                 const CameraMountParams& configured,
                                 const core::FloorPlaneParams& params = {});
 
-/// The same, or std::runtime_error("no floor found in N frames: <why>; ...") naming what to do:
-/// a run that needs the mount must not start without it.
-CameraMountParams requireCalibratedMount(
+/// The same, or std::runtime_error("no floor found in N frames: <why>; ... not navigating ...")
+/// naming what to do: a run that needs the mount must not start without it.
+MountCalibration requireCalibratedMount(
     const std::vector<const core::PointCloud*>& clouds_in_camera,
     const CameraMountParams& configured, const core::FloorPlaneParams& params = {});
 
