@@ -86,7 +86,7 @@ std::size_t writeTumFolder(const fs::path& dir) {
   const sim::WorldSpec world = sim::makeWorld("mixed");
   mrpt_bridge::SimulationParams p;
   p.camera.image_downscale = 4;  // 160 x 120: the navigation loop's frames
-  p.frame_spacing_m = 0.4;
+  p.frame_spacing_m = 0.6;
   const auto route = mrpt_bridge::planSimulatedRoute(world, p);
   const core::CameraIntrinsics K = sim::simulatedIntrinsics(p.camera);
   fs::create_directories(dir / "depth");
