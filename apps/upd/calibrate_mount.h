@@ -13,6 +13,9 @@
 namespace mrpt::obs {
 class CObservation;
 }
+namespace upd::openni2 {
+class OpenNI2Camera;
+}
 
 namespace upd::app {
 
@@ -25,6 +28,10 @@ constexpr int kAutoMountFrames = 5;
 /// is no floor: a run must not start on an unknown mount.
 sim::CameraMountParams autoMount(const std::function<bool(core::PointCloud&)>& next_cloud,
                                  const sim::CameraMountParams& configured, int frames);
+
+/// autoMount on the camera's next kAutoMountFrames frames (built with OpenNI2 only).
+sim::CameraMountParams autoMount(openni2::OpenNI2Camera& camera,
+                                 const sim::CameraMountParams& configured);
 
 /// Reads [CameraMountParams] from mount_ini (as `upd calibrate-mount --output` writes it) over
 /// mount, strictly: another section or key in the file is an error naming it.

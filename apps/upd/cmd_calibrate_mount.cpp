@@ -187,6 +187,19 @@ sim::CameraMountParams autoMount(const std::function<bool(core::PointCloud&)>& n
   return cal.mount;
 }
 
+#ifdef UPD_HAVE_OPENNI2
+sim::CameraMountParams autoMount(openni2::OpenNI2Camera& camera,
+                                 const sim::CameraMountParams& configured) {
+  const auto next = [&](core::PointCloud& c) {
+    openni2::DepthFrame f;
+    if (!camera.read(f)) return false;
+    core::depthToCloud(f.depth, f.K, c);
+    return true;
+  };
+  return autoMount(next, configured, kAutoMountFrames);
+}
+#endif
+
 int runCalibrateMount(const std::vector<std::string>& argv) {
   const CalibrateOptions o = parseCalibrateOptions(argv);
   const nav::NavConfig config =

@@ -269,15 +269,7 @@ int finishLive(const LiveOptions& o, const LiveTally& t, const maps::Traversabil
 int runCamera(const LiveOptions& o, nav::NavConfig config) {
   openni2::OpenNI2Camera camera(o.oni);  // one line and status 1 if none
   std::printf("camera: %s\n", camera.description().c_str());
-  if (o.auto_mount) {  // the mount from the floor in the first frames, or no run
-    config.camera = autoMount(
-        [&](core::PointCloud& c) {
-          openni2::DepthFrame f;
-          if (camera.read(f)) core::depthToCloud(f.depth, f.K, c);
-          return !c.empty();
-        },
-        config.camera, kAutoMountFrames);
-  }
+  if (o.auto_mount) config.camera = autoMount(camera, config.camera);  // or no run
   LiveRun run(o, config);
   LiveTally t;
   {
