@@ -5,6 +5,7 @@
 #include "upd/core/pipeline.h"
 #include "upd/io/cloud_io.h"
 #include "upd/io/json_io.h"
+#include "depth_input.h"
 #include "run_config.h"
 
 #include <cstdio>
@@ -14,8 +15,16 @@ namespace upd::app {
 
 const char* const kAnalyzeUsage =
     "usage: upd analyze INPUT [options]\n"
-    "  Scores every point of INPUT (.pcd, .ply, .xyz) with the Unevenness Point Descriptor.\n\n"
+    "  Scores every point of INPUT (.pcd, .ply, .xyz, or a 16-bit depth .png with\n"
+    "  --intrinsics) with the Unevenness Point Descriptor.\n\n"
     "options:\n"
+    "  --intrinsics F.yaml   calibration of a depth PNG (OpenCV/RTAB-Map or ROS camera_info\n"
+    "                        YAML); its local_transform, when present, moves the cloud to the\n"
+    "                        robot frame (up +z), else the cloud stays in the camera-optical\n"
+    "                        frame (up 0,-1,0: a level camera)\n"
+    "  --depth-scale S       metres per unit of a depth PNG (default 0.001: millimetres)\n"
+    "  --mount MOUNT.ini     INPUT is in the camera-optical frame: move it to the robot frame\n"
+    "                        (up +z) by this [CameraMountParams] (upd calibrate-mount --output)\n"
     "  --radius-m D          UPD search radius d_m [m] (default 0.5; 1.0 for a tractor)\n"
     "  --normal-radius-m R   PCA normal radius [m] (default 0.1)\n"
     "  --knn K               use the K nearest points (normals and UPD) instead of radii\n"
@@ -37,7 +46,7 @@ const char* const kAnalyzeUsage =
 int runAnalyze(const std::vector<std::string>& argv) {
   const Args args(argv,
                   {"--radius-m", "--normal-radius-m", "--knn", "--voxel-m", "--up", "--config",
-                   "--output", "--stats-json"},
+                   "--output", "--stats-json", "--intrinsics", "--depth-scale", "--mount"},
                   {"--no-preprocess", "--organized"});
   if (args.positionals().size() != 1) throw UsageError("expected exactly one INPUT file");
   const std::string input = args.positionals()[0];
@@ -55,7 +64,11 @@ int runAnalyze(const std::vector<std::string>& argv) {
   if (const auto v = args.vector3("--up")) params.up = *v;
   params.validate();  // before reading a possibly large file
 
-  const core::PointCloud cloud = io::readCloud(input);
+  const AnalyzeInput in = readAnalyzeInput(input, args.str("--intrinsics"),
+                                          args.number("--depth-scale").value_or(0.001),
+                                          args.str("--mount"));
+  if (in.up && !args.has("--up")) params.up = *in.up;
+  const core::PointCloud& cloud = in.cloud;
   const core::PipelineResult result = core::runPipeline(cloud, params);
   const auto summary = io::summaryJson(result, params, cloud.size());
 

@@ -5,6 +5,7 @@
 // (rawlog_writer.h) and a watchdog that stops the robot when the source stops
 // (live_watchdog.h). The base shipped is the simulated differential drive (robot_base.h):
 // integrators replace it with their robot's (docs/NAVIGATION.md, "Driving a real robot").
+#include "calibrate_mount.h"
 #include "cli.h"
 #include "commands.h"
 #include "live_options.h"
@@ -38,7 +39,7 @@ namespace upd::app {
 const char* const kLiveUsage =
     "usage: upd live [SOURCE] [--config FILE.ini] [--nav-config FILE.ini] [--view]\n"
     "                [--navigate X,Y] [--frames N] [--output DIR] [--record RUN.rawlog]\n"
-    "                [--stale-timeout S]\n"
+    "                [--stale-timeout S] [--mount FILE.ini | --auto-mount]\n"
     "  Reads a live source, runs the UPD and the traversability map on every frame and, with\n"
     "  --navigate, drives the robot base to the goal with MRPT's reactive navigator. The shipped\n"
     "  base is simulated (it moves on the velocity commands, the camera does not): see\n"
@@ -63,7 +64,11 @@ const char* const kLiveUsage =
     "                     (RUN.rawlog.part while running, renamed at the end; `upd playback`\n"
     "                     replays it)\n"
     "  --stale-timeout S  the source counts as stopped when no new frame came for S seconds\n"
-    "                     (default 1): the robot is stopped and the run ends\n\n"
+    "                     (default 1): the robot is stopped and the run ends\n"
+    "  --mount FILE.ini   camera mount [CameraMountParams] over the nav config's (as written\n"
+    "                     by upd calibrate-mount --output); applies to every source\n"
+    "  --auto-mount       measure the mount from the floor in the first frames (robot on a\n"
+    "                     level floor); no floor found: one line, exit status 1, no run\n\n"
     "exit status: 0 done; 1 error (a source that cannot be opened, ...); 2 usage error;\n"
     "3 --navigate did not reach the goal; 4 the source stopped (the robot was stopped).\n";
 
@@ -197,8 +202,9 @@ void recordFrame(LiveRun& run, const mrpt::obs::CObservation& obs, const nav::Ba
 
 // Scores one observation into the map at the base's pose, advanced to the frame's arrival;
 // nullptr (counted) when the observation gives no cloud.
-const nav::FrameEvidence* addFrame(LiveRun& run, const mrpt::obs::CObservation& obs,
+const nav::FrameEvidence* addFrame(LiveRun& run, mrpt::obs::CObservation& obs,
                                    nav::BaseState& s) {
+  if (run.opt.mount || run.opt.auto_mount) remount(obs, run.config.camera);
   run.now = Clock::now();
   const double dt = std::chrono::duration<double>(run.now - run.last).count();
   run.last = run.now;
@@ -291,11 +297,31 @@ int finishLive(const LiveOptions& o, const LiveTally& t, const maps::Traversabil
   return 0;
 }
 
+// `--auto-mount`: the mount measured from the floor in the source's first frames; throws (no
+// run) when they show no floor or the source ends or stops first.
+sim::CameraMountParams autoMountFromSource(LiveSource& source, const LiveOptions& o,
+                                           const sim::CameraMountParams& configured) {
+  const auto t0 = Clock::now();
+  const auto next = [&](core::PointCloud& cloud) {
+    LiveFrame frame;
+    while (!g_stop) {
+      const double waited = std::chrono::duration<double>(Clock::now() - t0).count();
+      if (waited > o.stale_timeout_s * (kAutoMountFrames + 1)) return false;
+      const Poll p = source.poll(frame);
+      if (p == Poll::End) return false;
+      if (p == Poll::Frame && opticalFrameCloud(*frame.observation, cloud)) return true;
+    }
+    return false;
+  };
+  return autoMount(next, configured, kAutoMountFrames);
+}
+
 // Runs the source through the loop until it stops.
-int runSource(const LiveOptions& o, const nav::NavConfig& config, const RunConfig& run_config) {
+int runSource(const LiveOptions& o, nav::NavConfig config, const RunConfig& run_config) {
   const auto source =
       openLiveSource(o, sim::mountOnRobot(config.camera), config.camera.image_downscale);
   std::printf("source: %s\n", source->description().c_str());
+  if (o.auto_mount) config.camera = autoMountFromSource(*source, o, config.camera);  // or no run
   LiveRun run(o, config, run_config.observer.source);
   LiveTally t;
   t.source = source->description();
@@ -324,7 +350,8 @@ int runLive(const std::vector<std::string>& argv) {
   // The shared robot config, checked strictly as every command does; its [SourceParams] say
   // how observations become clouds.
   const RunConfig run_config = loadRunConfig(o.config_path);
-  const nav::NavConfig config = nav::loadNavConfig(o.config_path, o.nav_path);
+  nav::NavConfig config = nav::loadNavConfig(o.config_path, o.nav_path);
+  if (o.mount) loadMountFile(*o.mount, config.camera);
   if (o.view && !nav::displayAvailable()) {
     throw std::runtime_error("--view needs a display (neither DISPLAY nor WAYLAND_DISPLAY is set)");
   }

@@ -5,6 +5,7 @@
 #include "commands.h"
 
 #include "run_config.h"
+#include "upd/core/floor_plane.h"
 #include "upd/nav/nav_config.h"
 
 #include <cstdio>
@@ -88,6 +89,11 @@ void printAllParams(std::ostream& os, bool markdown) {
     os << "\n## Navigation config (`upd navigate --nav-config`, e.g. `config/dune-nav.ini`)\n";
   }
   printNavParams(os, markdown);
+  if (markdown) os << "\n## Mount calibration (`upd calibrate-mount --floor-config`)\n";
+  core::FloorPlaneParams floor;
+  printSections(os, markdown, [&](auto&& f) {
+    f("FloorPlaneParams", "How the floor is found under the camera.", floor);
+  });
 }
 
 int runParams(const std::vector<std::string>& argv) {

@@ -4,11 +4,13 @@
 // summary.json. A ground-truth grid next to the rawlog (as `upd simulate` writes it) is used
 // to score the map (maps::evaluateGrid). A damaged rawlog keeps the maps of its good frames and
 // exits kExitPartial (playback_damage.h).
+#include "calibrate_mount.h"
 #include "cli.h"
 #include "commands.h"
 #include "map_folder.h"
 #include "playback_damage.h"
 #include "playback_merge.h"
+#include "playback_tum.h"
 #include "run_config.h"
 
 #include "upd/core/stopwatch.h"
@@ -46,7 +48,7 @@
 namespace upd::app {
 
 const char* const kPlaybackUsage =
-    "usage: upd playback RAWLOG... --config FILE.ini --output DIR [options]\n"
+    "usage: upd playback RAWLOG...|TUM_DIR --config FILE.ini --output DIR [options]\n"
     "  Replays RAWLOG (either rawlog layout): UPD for every 3D observation in the world frame,\n"
     "  fused over time into a 2.5D traversability grid and an OctoMap tree; several RAWLOGs\n"
     "  (runs of one site in one world frame) are fused one after the other into one map.\n"
@@ -68,6 +70,8 @@ const char* const kPlaybackUsage =
     "                      northing [m]); map.tif carries it\n"
     "  --truth FILE.yaml   ground-truth traversability grid to score the map against\n"
     "                      (default: RAWLOG's .truth.yaml sidecar when present)\n"
+    "  --mount FILE.ini    put the camera on this [CameraMountParams] (upd calibrate-mount\n"
+    "                      --output) instead of the recorded sensor pose\n"
     "  --ply               also write every frame's scored cloud as DIR/frames/NNNNNN.ply\n"
     "  --output-rawlog     also write DIR/annotated.rawlog: each frame with its non-traversable\n"
     "                      points as a CObservationPointCloud (label UPD_NON_TRAVERSABLE)\n"
@@ -78,6 +82,11 @@ const char* const kPlaybackUsage =
     "damage: the maps of the observations before it are written, summary.json records the\n"
     "damage (object index, byte offset in the decompressed stream, reason) and one line on\n"
     "stderr names it. Damage before the first observation writes nothing.\n\n"
+    "TUM RGB-D folder: upd playback DIR ... plays DIR/depth.txt's 16-bit depth PNGs (5000 per m)\n"
+    "with the camera poses of DIR/groundtruth.txt (a z-up world), written as DIR_OUT/sequence\n"
+    ".rawlog first. Its options: --intrinsics F.yaml (OpenCV/ROS YAML) or --tum-camera\n"
+    "freiburg1|freiburg2|freiburg3|ros (default: the freiburgN in DIR's name), --depth-scale S\n"
+    "(metres per unit, default 0.0002), --poses FILE instead of groundtruth.txt.\n\n"
     "exit status: 0 done; 1 failed, nothing written; 2 usage error; 3 partial: the rawlog is\n"
     "damaged and the maps of its good frames were written (not with --strict).\n";
 
@@ -95,6 +104,7 @@ struct PlaybackOptions {
   std::optional<std::string> poses_path;
   std::optional<std::string> truth_path;
   int epsg = 0;  ///< CRS of map.tif (0: none)
+  std::optional<sim::CameraMountParams> mount;  ///< --mount: replaces the recorded sensor pose
   bool ply = false, output_rawlog = false, quiet = false, strict = false;
 
   /// Entry idx is inside --from/--to/--every.
@@ -106,7 +116,7 @@ struct PlaybackOptions {
 PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   const Args args(argv,
                   {"--config", "--output", "--from", "--to", "--every", "--poses", "--truth",
-                   "--epsg"},
+                   "--epsg", "--mount"},
                   {"--ply", "--output-rawlog", "--quiet", "--strict"});
   if (args.positionals().empty()) throw UsageError("expected at least one RAWLOG");
   if (!args.has("--config")) throw UsageError("--config FILE.ini is required");
@@ -129,6 +139,7 @@ PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   o.poses_path = args.str("--poses");
   o.truth_path = args.str("--truth");
   o.epsg = args.integer("--epsg").value_or(0);
+  if (const auto m = args.str("--mount")) loadMountFile(*m, o.mount.emplace());
   o.ply = args.flag("--ply");
   o.output_rawlog = args.flag("--output-rawlog");
   o.quiet = args.flag("--quiet");
@@ -392,6 +403,7 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
       continue;
     }
     const core::Stopwatch frame_clock;
+    if (o.mount) remount(*entry.observation, *o.mount);
     observer.observe(*entry.observation, pose.pose_world_robot, res);
     if (!res.ok()) {
       ++run.skipped[res.skipped_reason];
@@ -460,6 +472,7 @@ void printSummary(const PlaybackOptions& o, const json& summary, double toleranc
 }  // namespace
 
 int runPlayback(const std::vector<std::string>& argv) {
+  if (isTumPlayback(argv)) return runTumPlayback(argv);  // converts, then plays the rawlog
   const core::Stopwatch wall;
   const PlaybackOptions options = parsePlaybackOptions(argv);
   const RunConfig config = loadRunConfig(options.config_path);

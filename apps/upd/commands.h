@@ -22,6 +22,7 @@ int runPlayback(const std::vector<std::string>& args);
 int runNavigate(const std::vector<std::string>& args);
 int runLive(const std::vector<std::string>& args);
 int runMap(const std::vector<std::string>& args);
+int runCalibrateMount(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
 extern const char* const kSceneUsage;
@@ -31,5 +32,6 @@ extern const char* const kPlaybackUsage;
 extern const char* const kNavigateUsage;
 extern const char* const kLiveUsage;
 extern const char* const kMapUsage;
+extern const char* const kCalibrateMountUsage;
 
 }  // namespace upd::app

@@ -55,8 +55,9 @@ LiveOptions parseLiveOptions(const std::vector<std::string>& argv_in) {
   const std::vector<std::string> argv = takeKinect(argv_in, o);
   const Args args(argv,
                   {"--config", "--nav-config", "--oni", "--sensors", "--sensor-section",
-                   "--navigate", "--frames", "--output", "--record", "--stale-timeout"},
-                  {"--view"});
+                   "--navigate", "--frames", "--output", "--record", "--stale-timeout",
+                   "--mount"},
+                  {"--view", "--auto-mount"});
   if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
   o.config_path = args.str("--config").value_or(nav::defaultConfigDir() + "/dune-kinect.ini");
   o.nav_path = args.str("--nav-config").value_or(nav::defaultConfigDir() + "/dune-nav.ini");
@@ -75,6 +76,9 @@ LiveOptions parseLiveOptions(const std::vector<std::string>& argv_in) {
                      ": must be > 0 [s]");
   }
   o.view = args.flag("--view");
+  o.mount = args.str("--mount");
+  o.auto_mount = args.flag("--auto-mount");
+  if (o.mount && o.auto_mount) throw UsageError("choose one of --mount and --auto-mount");
   checkOneSource(o);
   return o;
 }

@@ -24,6 +24,8 @@ struct LiveOptions {
   /// The source counts as stopped when no new frame (a new device stamp) came for this long [s].
   double stale_timeout_s = 1.0;
   bool view = false;
+  std::optional<std::string> mount;  ///< --mount FILE.ini: [CameraMountParams] over the nav config's
+  bool auto_mount = false;           ///< measure the mount from the floor in the first frames
 };
 
 /// Throws UsageError naming the option and value.

@@ -13,7 +13,7 @@ namespace {
 using upd::app::Command;
 
 const Command kCommands[] = {
-    {"analyze", "score a point cloud file (.pcd, .ply, .xyz) with the UPD",
+    {"analyze", "score a point cloud file (.pcd, .ply, .xyz) or a depth PNG with the UPD",
      upd::app::kAnalyzeUsage, upd::app::runAnalyze},
     {"scene", "write a generated test scene (the paper's experiments) as PLY",
      upd::app::kSceneUsage, upd::app::runScene},
@@ -27,6 +27,8 @@ const Command kCommands[] = {
      upd::app::kLiveUsage, upd::app::runLive},
     {"map", "map folders: info, merge runs of one site, crop a region",
      upd::app::kMapUsage, upd::app::runMap},
+    {"calibrate-mount", "measure the camera's height, pitch and roll from the floor it sees",
+     upd::app::kCalibrateMountUsage, upd::app::runCalibrateMount},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };
@@ -34,7 +36,7 @@ const Command kCommands[] = {
 void printHelp(std::ostream& os) {
   os << "upd: terrain traversability with the Unevenness Point Descriptor (UPD-Nav)\n\n"
         "usage: upd COMMAND [ARGS...]   (upd COMMAND --help for its options)\n\ncommands:\n";
-  for (const auto& c : kCommands) os << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
+  for (const auto& c : kCommands) os << "  " << c.name << std::string(17 - std::strlen(c.name), ' ') << c.summary << "\n";
 }
 
 }  // namespace

@@ -23,6 +23,9 @@ void CameraMountParams::validate() const {
   core::requireParam(std::isfinite(pitch_rad) && std::abs(pitch_rad) < 80.0 * core::kDegToRad,
                "CameraMountParams", "pitch_deg", pitch_rad * core::kRadToDeg,
                "must be within (-80, 80) deg");
+  core::requireParam(std::isfinite(roll_rad) && std::abs(roll_rad) < 80.0 * core::kDegToRad,
+               "CameraMountParams", "roll_deg", roll_rad * core::kRadToDeg,
+               "must be within (-80, 80) deg");
   core::requireParam(
       image_downscale == 1 || image_downscale == 2 || image_downscale == 4 || image_downscale == 8,
       "CameraMountParams", "image_downscale", image_downscale, "must be 1, 2, 4 or 8");
@@ -31,8 +34,11 @@ void CameraMountParams::validate() const {
 Eigen::Isometry3d mountOnRobot(const CameraMountParams& mount) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.translation() = Eigen::Vector3d(mount.forward_m, mount.left_m, mount.height_m);
-  // A pitch > 0 about y turns +x towards -z: the camera looks down.
-  T.linear() = Eigen::AngleAxisd(mount.pitch_rad, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  // A pitch > 0 about y turns +x towards -z: the camera looks down; then a roll > 0 about the
+  // (pitched) optical axis turns the left side up.
+  T.linear() = (Eigen::AngleAxisd(mount.pitch_rad, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(mount.roll_rad, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
   return T;
 }
 
@@ -46,13 +52,10 @@ Eigen::Matrix3d opticalInMount() {
 }
 
 Eigen::Isometry3d cameraOnRobot(const CameraMountParams& mount) {
-  // The optical axes of a level camera looking along the robot's x, pitched down about the
-  // robot's y by +pitch (which tips +x towards -z), as mountOnRobot.
-  const Eigen::Matrix3d level = opticalInMount();
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() =
-      Eigen::AngleAxisd(mount.pitch_rad, Eigen::Vector3d::UnitY()).toRotationMatrix() * level;
-  T.translation() = Eigen::Vector3d(mount.forward_m, mount.left_m, mount.height_m);
+  // The optical axes of a level camera looking along the robot's x, pitched and rolled as
+  // mountOnRobot.
+  Eigen::Isometry3d T = mountOnRobot(mount);
+  T.linear() = T.linear() * opticalInMount();
   return T;
 }
 

@@ -46,6 +46,7 @@ struct CameraMountParams {
   double left_m = 0.0;                  ///< ... to its left [m]
   double height_m = 0.5;                ///< ... above the ground [m]
   double pitch_rad = 22.0 * core::kDegToRad;  ///< optical axis pitched down from the robot's x [rad]
+  double roll_rad = 0.0;  ///< about the optical axis, the camera's left side up > 0 [rad]
   /// The simulated image is the Kinect's 640 x 480 (fx = fy = 525) divided by this: 4 gives
   /// 160 x 120, enough for the navigation loop at a fraction of the cost.
   int image_downscale = 1;
@@ -57,6 +58,7 @@ struct CameraMountParams {
     v("left_m", left_m, "camera left of the robot origin [m]");
     v("height_m", height_m, "camera above the ground [m]");
     v.angleDeg("pitch_deg", pitch_rad, "optical axis pitched down from the robot's x [deg]");
+    v.angleDeg("roll_deg", roll_rad, "about the optical axis, the camera's left side up > 0 [deg]");
     v("image_downscale", image_downscale,
       "simulated image = Kinect 640 x 480 divided by this (1, 2, 4 or 8)");
   }

@@ -1,0 +1,185 @@
+#include "upd/mrpt_bridge/depth_files.h"
+
+#include "upd/io/atomic_file.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/core/persistence.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <ostream>
+#include <stdexcept>
+#include <vector>
+
+namespace upd::mrpt_bridge {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& file, const std::string& why) {
+  throw std::runtime_error("calibration " + file + ": " + why);
+}
+
+// The values of a matrix field: ROS/OpenCV `{rows, cols, data: [...]}` or an OpenCV matrix.
+std::vector<double> matrixValues(const cv::FileNode& node, const std::string& file,
+                                 const std::string& key, std::size_t expected) {
+  std::vector<double> v;
+  if (node.isMap() && node["data"].isSeq()) {
+    node["data"] >> v;
+  } else if (node.isSeq()) {
+    node >> v;
+  } else {
+    cv::Mat m;
+    node >> m;
+    m.reshape(1, 1).convertTo(v, CV_64F);
+  }
+  if (v.size() != expected) {
+    fail(file, "'" + key + "' has " + std::to_string(v.size()) + " values, expected " +
+                   std::to_string(expected));
+  }
+  for (double x : v) {
+    if (!std::isfinite(x)) fail(file, "'" + key + "' holds a value that is not finite");
+  }
+  return v;
+}
+
+int intField(const cv::FileStorage& fs, const std::string& file, const char* key) {
+  const cv::FileNode n = fs[key];
+  if (n.empty() || !n.isInt()) fail(file, std::string("no integer '") + key + "'");
+  return static_cast<int>(n);
+}
+
+cv::FileStorage openCalibration(const std::string& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) fail(file, "not found");
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  if (!(text << in.rdbuf())) fail(file, "unreadable");
+  // OpenCV's parser wants its directive, which ROS's camera_info files do not carry.
+  std::string yaml = text.str();
+  if (yaml.rfind("%YAML", 0) != 0) yaml = "%YAML:1.0\n---\n" + yaml;
+  try {
+    cv::FileStorage fs(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY |
+                                 cv::FileStorage::FORMAT_YAML);
+    if (!fs.isOpened()) fail(file, "unreadable");
+    return fs;
+  } catch (const cv::Exception& e) {
+    fail(file, "not valid YAML (" + e.err + ")");
+  }
+}
+
+Eigen::Isometry3d localTransform(const cv::FileNode& node, const std::string& file) {
+  const std::vector<double> v = matrixValues(node, file, "local_transform", 12);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) T.linear()(r, c) = v[r * 4 + c];
+    T.translation()(r) = v[r * 4 + 3];
+  }
+  const Eigen::Matrix3d R = T.linear();
+  if (!(R * R.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-3)) {
+    fail(file, "'local_transform' is not a rotation and a translation");
+  }
+  // Re-orthonormalize the rotation stored with 8 digits.
+  T.linear() = Eigen::Quaterniond(R).normalized().toRotationMatrix();
+  return T;
+}
+
+}  // namespace
+
+DepthCalibration loadDepthCalibration(const std::string& yaml_path) {
+  const cv::FileStorage fs = openCalibration(yaml_path);
+  DepthCalibration c;
+  c.K.width = intField(fs, yaml_path, "image_width");
+  c.K.height = intField(fs, yaml_path, "image_height");
+  const cv::FileNode km = fs["camera_matrix"];
+  if (km.empty()) fail(yaml_path, "no 'camera_matrix'");
+  const std::vector<double> k = matrixValues(km, yaml_path, "camera_matrix", 9);
+  c.K.fx = k[0];
+  c.K.cx = k[2];
+  c.K.fy = k[4];
+  c.K.cy = k[5];
+  if (!(c.K.fx > 0)) fail(yaml_path, "camera_matrix fx = " + std::to_string(c.K.fx) + ": must be > 0");
+  if (!(c.K.fy > 0)) fail(yaml_path, "camera_matrix fy = " + std::to_string(c.K.fy) + ": must be > 0");
+  if (c.K.width <= 0 || c.K.height <= 0) {
+    fail(yaml_path, "image_width x image_height = " + std::to_string(c.K.width) + " x " +
+                        std::to_string(c.K.height) + ": must be > 0");
+  }
+  const cv::FileNode dist = fs["distortion_coefficients"];
+  if (!dist.empty()) {
+    std::vector<double> d;
+    if (dist.isMap() && dist["data"].isSeq()) dist["data"] >> d;
+    for (double x : d) c.has_distortion = c.has_distortion || x != 0.0;
+  }
+  const cv::FileNode lt = fs["local_transform"];
+  if (!lt.empty()) c.camera_on_robot = localTransform(lt, yaml_path);
+  return c;
+}
+
+core::DepthImage readDepthPng(const std::string& png_path, double metres_per_unit) {
+  if (!(metres_per_unit > 0) || !std::isfinite(metres_per_unit)) {
+    throw std::invalid_argument("depth scale = " + std::to_string(metres_per_unit) +
+                                " m per unit: must be > 0");
+  }
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(png_path, ec)) {
+    throw std::runtime_error("depth image " + png_path + ": not found");
+  }
+  const cv::Mat img = cv::imread(png_path, cv::IMREAD_UNCHANGED);
+  if (img.empty()) throw std::runtime_error("depth image " + png_path + ": not a readable image");
+  if (img.type() != CV_16UC1) {
+    throw std::runtime_error("depth image " + png_path + ": " + std::to_string(img.elemSize1() * 8) +
+                             "-bit, " + std::to_string(img.channels()) +
+                             " channel(s); a depth image is 16-bit single channel");
+  }
+  core::DepthImage d;
+  d.width = img.cols;
+  d.height = img.rows;
+  d.depth_m.resize(static_cast<std::size_t>(d.width) * d.height);
+  for (int v = 0; v < d.height; ++v) {
+    const auto* row = img.ptr<std::uint16_t>(v);
+    for (int u = 0; u < d.width; ++u) {
+      d.depth_m[static_cast<std::size_t>(v) * d.width + u] =
+          static_cast<float>(row[u] * metres_per_unit);
+    }
+  }
+  return d;
+}
+
+void writeDepthPng(const std::string& png_path, const core::DepthImage& depth,
+                   double metres_per_unit) {
+  cv::Mat img(depth.height, depth.width, CV_16UC1);
+  for (int v = 0; v < depth.height; ++v) {
+    for (int u = 0; u < depth.width; ++u) {
+      const double units = std::round(depth.at(u, v) / metres_per_unit);
+      img.at<std::uint16_t>(v, u) =
+          std::isfinite(units) && units > 0 && units <= 65535 ? static_cast<std::uint16_t>(units) : 0;
+    }
+  }
+  std::vector<unsigned char> bytes;
+  if (!cv::imencode(".png", img, bytes)) {
+    throw std::runtime_error("depth image " + png_path + ": PNG encoding failed");
+  }
+  io::writeFileAtomically(png_path, [&](std::ostream& os) {
+    os.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+core::CameraIntrinsics tumIntrinsics(const std::string& name) {
+  core::CameraIntrinsics K;  // 640 x 480, the ROS default
+  if (name == "ros") return K;
+  if (name == "freiburg1") {
+    K.fx = 517.3, K.fy = 516.5, K.cx = 318.6, K.cy = 255.3;
+  } else if (name == "freiburg2") {
+    K.fx = 520.9, K.fy = 521.0, K.cx = 325.1, K.cy = 249.7;
+  } else if (name == "freiburg3") {
+    K.fx = 535.4, K.fy = 539.2, K.cx = 320.1, K.cy = 247.6;
+  } else {
+    throw std::invalid_argument("TUM camera '" + name +
+                                "': expected freiburg1, freiburg2, freiburg3 or ros");
+  }
+  return K;
+}
+
+}  // namespace upd::mrpt_bridge
