@@ -119,6 +119,7 @@ class NearestK {
     d_[pos] = d2;
   }
   bool full() const { return n_ == k_; }
+  std::size_t size() const { return n_; }
   float worst() const { return d_[n_ - 1]; }
   double meanWithoutFirst() const { return meanRootWithoutFirst(d_, n_); }
 
@@ -213,7 +214,7 @@ double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& fini
     cells.findOrInsert(detail::packKey(c[0], c[1], c[2]), inserted);
   }
   const double per_cell = static_cast<double>(finite.size()) / static_cast<double>(cells.size());
-  const double target = static_cast<double>(k + 1);
+  const double target = static_cast<double>(k + 1) * 0.33;
   return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
 }
 
@@ -279,7 +280,7 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
           }
         }
         if (ring > kMaxRing) {
-          my_rest.push_back(g.index[q]);
+          my_rest.push_back(q);
           continue;
         }
         mean_dist[g.index[q]] = best.meanWithoutFirst();
@@ -287,6 +288,26 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
     }
 #pragma omp critical(upd_outlier_rest)
     rest.insert(rest.end(), my_rest.begin(), my_rest.end());
+  }
+}
+
+// The mean distances of the few grid points at positions todo, each compared with every point
+// of the grid (cheaper than building a k-d tree for a few dozen).
+void allPairsMeanDistances(const PointGrid& g, std::size_t want,
+                           const std::vector<std::uint32_t>& todo, std::vector<double>& mean_dist) {
+  const std::size_t n = g.x.size();
+#pragma omp parallel if (todo.size() > 1)
+  {
+    NearestK best(want);
+    std::vector<float> d2(n);
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(todo.size()); ++r) {
+      const std::uint32_t q = todo[static_cast<std::size_t>(r)];
+      distances2(g.x.data(), g.y.data(), g.z.data(), n, g.x[q], g.y[q], g.z[q], d2.data());
+      best.clear();
+      for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
+      if (best.size() >= 2) mean_dist[g.index[q]] = best.meanWithoutFirst();
+    }
   }
 }
 
@@ -321,14 +342,21 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
   if (finite.empty()) return mean_dist;
   const std::size_t want = static_cast<std::size_t>(k) + 1;  // the point itself comes first
   PointGrid g;
-  std::vector<std::uint32_t> rest;  // points left to the k-d tree
   // (A k beyond NearestK's capacity, or a cloud beyond the keys' range: the k-d tree alone.)
   if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k), g)) {
-    rest = finite;
-  } else {
-    gridMeanDistances(g, want, mean_dist, rest);
+    kdTreeMeanDistances(in, k, finite, mean_dist);
+    return mean_dist;
   }
-  if (!rest.empty()) kdTreeMeanDistances(in, k, rest, mean_dist);
+  std::vector<std::uint32_t> rest;  // grid positions of the points the rings did not settle
+  gridMeanDistances(g, want, mean_dist, rest);
+  // A few left (lone points, tiny clouds): compared with every point; many: the k-d tree.
+  constexpr std::size_t kMaxAllPairs = 128;
+  if (rest.size() <= kMaxAllPairs) {
+    allPairsMeanDistances(g, want, rest, mean_dist);
+  } else {
+    for (std::uint32_t& q : rest) q = g.index[q];
+    kdTreeMeanDistances(in, k, rest, mean_dist);
+  }
   return mean_dist;
 }
 
