@@ -201,25 +201,32 @@ core::PipelineParams sensorRateParams(const Eigen::Vector3f& up) {
   return p;
 }
 
+namespace {
+// A table: its title, then one case per frame.
+template <class Case>
+json frameTable(const char* title, const std::vector<Frame>& frames, Case&& one_case) {
+  printTitle(title);
+  json cases = json::array();
+  for (const Frame& fr : frames) cases.push_back(one_case(fr));
+  return cases;
+}
+}  // namespace
+
 json paperPipelineCases(const std::vector<Frame>& frames, const Options& o, Report& report) {
-  printTitle(
+  return frameTable(
       "The paper's pipeline (config/dune-kinect.ini's steps): cut-off 0.4-5 m -> voxel 0.02 m -> "
       "outlier filter k 16, 2 sigma -> normals 0.05 m -> UPD d_m 0.5 m; ours one core and two, "
       "PCL one core (VoxelGrid, StatisticalOutlierRemoval, NormalEstimation, UPD by radius "
-      "search; the cut-off before its clock)");
-  json cases = json::array();
-  for (const Frame& fr : frames) cases.push_back(paperCase(fr, o, report));
-  return cases;
+      "search; the cut-off before its clock)",
+      frames, [&](const Frame& fr) { return paperCase(fr, o, report); });
 }
 
 json sensorRateCases(const std::vector<Frame>& frames, const Options& o, Report& report) {
-  printTitle(
+  return frameTable(
       "The sensor-rate path (config/dune-kinect-realtime.ini's settings: cut-off 0.4-5 m, "
       "normals 0.1 m, UPD d_m 0.5 m, labels, map update) against PCL's "
-      "IntegralImageNormalEstimation alone (COVARIANCE_MATRIX, smoothing 10 px), one core");
-  json cases = json::array();
-  for (const Frame& fr : frames) cases.push_back(sensorRateCase(fr, o, report));
-  return cases;
+      "IntegralImageNormalEstimation alone (COVARIANCE_MATRIX, smoothing 10 px), one core",
+      frames, [&](const Frame& fr) { return sensorRateCase(fr, o, report); });
 }
 
 }  // namespace upd::bench
