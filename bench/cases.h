@@ -55,4 +55,19 @@ json pclSettingsCases(const std::vector<Frame>& frames, const Options& o, Report
 /// 1 to 16 tiles of the rocks scene at the PCL peer's settings.
 json growthWithSizeCases(const Options& o, Report& report);
 
+// ---- The pipelines as `upd` runs them (paper_cases.cpp) ----
+
+/// The paper's pipeline (config/dune-kinect.ini's steps, normals 0.05 m): cut-off 0.4-5 m,
+/// voxel 0.02 m, outlier filter k 16 at 2 sigma, normals 0.05 m, UPD d_m 0.5 m.
+core::PipelineParams paperParams(const Eigen::Vector3f& up);
+
+/// config/dune-kinect-realtime.ini's pipeline: the cut-off alone, every pixel scored.
+core::PipelineParams sensorRateParams(const Eigen::Vector3f& up);
+
+/// The paper's pipeline on each frame, ours (one core, two) against PCL's, stage by stage.
+json paperPipelineCases(const std::vector<Frame>& frames, const Options& o, Report& report);
+
+/// The sensor-rate path on each frame against PCL's IntegralImageNormalEstimation alone.
+json sensorRateCases(const std::vector<Frame>& frames, const Options& o, Report& report);
+
 }  // namespace upd::bench

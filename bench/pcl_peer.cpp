@@ -2,6 +2,7 @@
 
 #include <pcl/features/integral_image_normal.h>
 #include <pcl/features/normal_3d.h>
+#include <pcl/filters/statistical_outlier_removal.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -54,6 +55,18 @@ PclCloud::Ptr voxelGrid(const PclCloud::Ptr& cloud, const PeerSettings& s) {
   grid.setLeafSize(leaf, leaf, leaf);
   grid.filter(*scored);
   return scored;
+}
+
+// The statistical outlier filter, when enabled; else the input itself.
+PclCloud::Ptr outlierFilter(const PclCloud::Ptr& cloud, const PeerSettings& s) {
+  if (!s.outlier_enabled) return cloud;
+  auto kept = std::make_shared<PclCloud>();
+  pcl::StatisticalOutlierRemoval<pcl::PointXYZ> sor;
+  sor.setInputCloud(cloud);
+  sor.setMeanK(s.outlier_k);
+  sor.setStddevMulThresh(s.outlier_std_mul);
+  sor.filter(*kept);
+  return kept;
 }
 
 struct OrientedNormals {
@@ -132,8 +145,11 @@ PeerResult runPclPipeline(const core::PointCloud& input, const PeerSettings& s) 
   PeerResult res;
   const core::Stopwatch total;
   core::Stopwatch stage;
-  const PclCloud::Ptr scored = voxelGrid(cloud, s);
+  const PclCloud::Ptr voxels = voxelGrid(cloud, s);
   res.voxel_ms = stage.elapsedMs();
+  stage.restart();
+  const PclCloud::Ptr scored = outlierFilter(voxels, s);
+  res.outlier_ms = stage.elapsedMs();
 
   stage.restart();
   auto tree = std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();

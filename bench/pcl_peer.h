@@ -23,15 +23,18 @@ struct PeerSettings {
   int min_neighbors = 3;                          ///< as UpdParams::min_neighbors
   Eigen::Vector3f up = Eigen::Vector3f::UnitZ();  ///< for the orientation rule of normals.h
   double vertical_band_rad = 0.0;                 ///< as NormalParams::vertical_band_rad
+  bool outlier_enabled = false;  ///< pcl::StatisticalOutlierRemoval after the voxel grid
+  int outlier_k = 16;            ///< its setMeanK
+  double outlier_std_mul = 2.0;  ///< its setStddevMulThresh
 };
 
 struct PeerResult {
-  double voxel_ms = 0, normals_ms = 0, upd_ms = 0, total_ms = 0;
+  double voxel_ms = 0, outlier_ms = 0, normals_ms = 0, upd_ms = 0, total_ms = 0;
   core::PointCloud cloud;  ///< the cloud PCL scored (after its voxel grid), for comparisons
   core::UpdResult upd;     ///< r, zeta and k per point of cloud, as computeUpd defines them
 };
 
-/// Voxel grid (optional), NormalEstimation (KdTreeFLANN radius search, normals oriented by
+/// Voxel grid (optional), StatisticalOutlierRemoval (optional), NormalEstimation (KdTreeFLANN radius search, normals oriented by
 /// upd::orientNormal as the UPD needs), then for every point a second radius search summing
 /// the neighbours' normals (eqs. 6-8). Non-finite input points are dropped first (untimed).
 PeerResult runPclPipeline(const core::PointCloud& input, const PeerSettings& settings);

@@ -25,6 +25,7 @@ struct Options {
   std::string json_path;
   bool quick = false;
   bool frames_only = false;  // the frame pipeline timings alone (one core, two cores, memory)
+  std::string only;          // "paper" or "sensor-rate": that table alone
   int repeats = 15;
 };
 
@@ -37,6 +38,10 @@ constexpr double kMaxMeanDzeta = 0.005;
 constexpr double kMinSameLabel = 0.995;
 constexpr double kMinTwoCoreSpeedup = 1.7;
 constexpr double kMaxPeakMemoryMb = 300.0;
+constexpr double kMinPaperSpeedupVsPcl = 300.0;      // the paper's whole pipeline, PCL / ours
+constexpr double kMaxPreprocessShare = 0.25;         // of our paper pipeline's frame
+constexpr double kMaxSensorRateOverIntegral = 0.2;   // sensor-rate path / PCL integral normals
+constexpr double kMinPipelineTwoCoreSpeedup = 1.8;   // those two pipelines' second core
 
 struct Target {
   std::string name;

@@ -2,13 +2,16 @@
 // PCL pipeline of the paper, on real and generated data, with the performance targets of
 // docs/PERFORMANCE.md.
 //
-// Usage: upd_bench [--data DIR] [--json OUT.json] [--quick] [--frames-only] [--repeats N]
+// Usage: upd_bench [--data DIR] [--json OUT.json] [--quick] [--frames-only] [--only TABLE]
+//                  [--repeats N]
 //   --data DIR   the shared real data (default: the build's UPD_SHARED_DATA_DIR); a missing
 //                file makes its case "skipped" in the report, never a failure
 //   --json OUT   also write the report as JSON (the same numbers as the printed tables)
 //   --quick      skip the PCL peer and use fewer exact samples (minutes instead of ~15)
 //   --frames-only  only the frame pipeline timings (one core, two cores, memory): seconds
 //   --repeats N  timed runs per case for the medians (default 15; big clouds use fewer)
+//   --only paper | sensor-rate   that table alone: the paper's whole pipeline against PCL's,
+//                or the sensor-rate path against PCL's integral-image normals
 //
 // What is timed, per case (medians over the runs after one warm-up run):
 //  - frame pipeline (organized 640 x 480): depth image (or organized cloud) -> normals -> UPD
@@ -45,6 +48,11 @@ int run(const Options& o) {
   root["map_stage"] = mapStageKind();
 
   const std::vector<Frame> frames = kinectFrames(o);
+  if (o.only == "paper" || o.only == "sensor-rate") {
+    root[o.only == "paper" ? "paper_pipeline" : "sensor_rate"] =
+        o.only == "paper" ? paperPipelineCases(frames, o, report) : sensorRateCases(frames, o, report);
+    return finish(report, o, bandwidth);
+  }
   std::vector<core::PipelineResult> frame_results;
   json frame_cases = frameTimingCases(frames, o, report, frame_results);
   if (o.frames_only) {
@@ -53,6 +61,8 @@ int run(const Options& o) {
   }
   frameAgreementCases(frames, frame_results, o, report, frame_cases);
   root["normals_alone"] = normalsAloneCases(frames, o);
+  root["sensor_rate"] = sensorRateCases(frames, o, report);
+  root["paper_pipeline"] = paperPipelineCases(frames, o, report);
   root["pcl_settings"] = pclSettingsCases(frames, o, report);
   root["growth_with_size"] = growthWithSizeCases(o, report);
   root["growth_with_radius"] = growthWithRadiusCases(frames.back(), o, report);
@@ -76,13 +86,18 @@ bool parseOptions(int argc, char** argv, Options& o) {
       o.quick = true;
     } else if (a == "--frames-only") {
       o.frames_only = true;
+    } else if (a == "--only") {
+      o.only = value();
+      if (o.only != "paper" && o.only != "sensor-rate") {
+        throw std::invalid_argument("--only takes paper or sensor-rate, not " + o.only);
+      }
     } else if (a == "--repeats") {
       o.repeats = std::stoi(value());
       if (o.repeats < 1) throw std::invalid_argument("--repeats must be >= 1");
     } else if (a == "--help" || a == "-h") {
       std::printf(
           "usage: upd_bench [--data DIR] [--json OUT.json] [--quick] [--frames-only] "
-          "[--repeats N]\n");
+          "[--only paper|sensor-rate] [--repeats N]\n");
       return false;
     } else {
       throw std::invalid_argument("unknown option " + a + " (see --help)");

@@ -8,6 +8,7 @@
 // and values in one array, load factor <= 1/2). Keys pack three signed 21-bit cell coordinates.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <stdexcept>
@@ -43,6 +44,18 @@ class CellMap {
   explicit CellMap(std::size_t expected = 64) { rehash(capacityFor(expected)); }
 
   std::size_t size() const { return size_; }
+
+  /// Empties the map for about `expected` keys, keeping its table when that has the size.
+  void clear(std::size_t expected) {
+    const std::size_t capacity = capacityFor(expected);
+    size_ = 0;
+    if (table_.size() == capacity) {
+      std::fill(table_.begin(), table_.end(), Entry{});
+    } else {
+      table_.clear();
+      rehash(capacity);
+    }
+  }
 
   /// The index stored for key, or kNoIndex.
   std::uint32_t find(std::uint64_t key) const {

@@ -1,7 +1,6 @@
 #include "upd/core/preprocess.h"
 
-#include "fast_cell_map.h"
-#include "fast_simd.h"
+#include "preprocess_internal.h"
 
 #include <algorithm>
 #include <cmath>
@@ -62,31 +61,7 @@ PointCloud dropNonFinite(const PointCloud& in) {
   return selectPoints(unorganized, keep);
 }
 
-namespace {
-// The test of cropRange for a finite point q: within the range of the sensor origin and inside
-// the box, each when enabled.
-class RangeBoxTest {
- public:
-  RangeBoxTest(const PreprocessParams& p, const Eigen::Vector3f& sensor_origin)
-      : p_(p),
-        origin_(sensor_origin),
-        rmin2_(p.range_min_m * p.range_min_m),
-        rmax2_(p.range_max_m * p.range_max_m) {}
-  bool keeps(const Eigen::Vector3f& q) const {
-    if (p_.range_enabled) {
-      const double d2 = (q - origin_).cast<double>().squaredNorm();
-      if (!(d2 >= rmin2_ && d2 <= rmax2_)) return false;
-    }
-    return !p_.box_enabled ||
-           ((q.array() >= p_.box_min_m.array()).all() && (q.array() <= p_.box_max_m.array()).all());
-  }
-
- private:
-  const PreprocessParams& p_;
-  Eigen::Vector3f origin_;
-  double rmin2_, rmax2_;
-};
-}  // namespace
+using detail::RangeBoxTest;
 
 PointCloud cropRange(const PointCloud& in, const PreprocessParams& p) {
   std::vector<char> keep(in.size(), 0);
@@ -99,70 +74,13 @@ PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
   requireParam(std::isfinite(voxel_m) && voxel_m > 0, "PreprocessParams", "voxel_m", voxel_m,
                "must be > 0");
   PointCloud out;
-  out.sensor_origin = in.sensor_origin;
-  // Voxel keys and centroids relative to the first finite point: exact far from the origin.
-  std::size_t first = 0;
-  while (first < in.size() && !in.isFinite(first)) ++first;
-  if (first == in.size()) return out;
-  const Eigen::Vector3d ref = in.point(first).cast<double>();
-  const double inv = 1.0 / voxel_m;
-  // Per voxel, in order of first appearance (the dense index of the flat hash map): the sums
-  // of the points relative to ref, of the colours, and the count.
-  struct Acc {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    double r = 0, g = 0, b = 0;
-    std::uint32_t n = 0;
-  };
-  std::vector<Acc> voxels;
-  voxels.reserve(in.size() / 4 + 16);
-  detail::CellMap map(in.size() / 4 + 16);
-  const bool colour = in.hasColor();
-  std::uint64_t last_key = 0;
-  Acc* acc = nullptr;  // the voxel of the last point: consecutive points mostly share one
-  for (std::size_t i = first; i < in.size(); ++i) {
-    if (!in.isFinite(i)) continue;
-    const Eigen::Vector3d d = in.point(i).cast<double>() - ref;
-    const std::int64_t cx = detail::floorToInt(d.x() * inv), cy = detail::floorToInt(d.y() * inv),
-                       cz = detail::floorToInt(d.z() * inv);
-    if (!detail::keyFits(cx, cy, cz)) {
-      throw std::invalid_argument(
-          "PreprocessParams.voxel_m = " + std::to_string(voxel_m) +
-          ": the cloud spans more than 2^20 voxels along an axis; use a larger voxel or a "
-          "range cut-off");
-    }
-    const std::uint64_t key = detail::packKey(cx, cy, cz);
-    if (acc == nullptr || key != last_key) {
-      bool inserted = false;
-      const std::uint32_t id = map.findOrInsert(key, inserted);
-      if (inserted) voxels.emplace_back();
-      acc = &voxels[id];
-      last_key = key;
-    }
-    acc->sum += d;
-    ++acc->n;
-    if (colour) {
-      acc->r += in.r[i];
-      acc->g += in.g[i];
-      acc->b += in.b[i];
-    }
-  }
-  // Output in order of first appearance: deterministic.
-  out.reserve(voxels.size());
-  for (const Acc& v : voxels) {
-    const Eigen::Vector3d c = ref + v.sum / v.n;
-    if (colour) {
-      const auto avg = [&](double s) { return static_cast<std::uint8_t>(std::lround(s / v.n)); };
-      out.push_back(static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()),
-                    avg(v.r), avg(v.g), avg(v.b));
-    } else {
-      out.push_back(static_cast<float>(c.x()), static_cast<float>(c.y()),
-                    static_cast<float>(c.z()));
-    }
-  }
+  detail::voxelize(in, voxel_m, nullptr, out);
   return out;
 }
 
-PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul) {
+namespace {
+// The outlier filter's verdict per point: its mean neighbour distance within mu + std_mul sigma.
+std::vector<char> outlierKeepMask(const PointCloud& in, int k, double std_mul) {
   requireParam(k >= 1, "PreprocessParams", "outlier_k", k, "must be >= 1");
   const std::vector<double> mean_dist = meanNeighbourDistances(in, k);
   double s = 0, s2 = 0;
@@ -174,7 +92,7 @@ PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul
     ++n;
   }
   std::vector<char> keep(in.size(), 0);
-  if (n == 0) return selectPoints(in, keep);
+  if (n == 0) return keep;
   const double mu = s / n;
   const double sigma = std::sqrt(std::max(0.0, s2 / n - mu * mu));
   const double limit = mu + std_mul * sigma;
@@ -182,10 +100,20 @@ PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul
     // A point alone has no neighbour distance: it is an outlier by definition.
     keep[i] = !std::isnan(mean_dist[i]) && mean_dist[i] <= limit;
   }
-  return selectPoints(in, keep);
+  return keep;
+}
+}  // namespace
+
+PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul) {
+  return selectPoints(in, outlierKeepMask(in, k, std_mul));
 }
 
 PointCloud preprocess(const PointCloud& in, const PreprocessParams& p, PreprocessStats* stats) {
+  if (p.voxel_enabled) {  // (in one pass: preprocessVoxelized)
+    PointCloud out;
+    preprocess(in, p, out, stats);
+    return out;
+  }
   p.validate();
   PreprocessStats st;
   st.points_in = in.size();
@@ -199,8 +127,7 @@ PointCloud preprocess(const PointCloud& in, const PreprocessParams& p, Preproces
   PointCloud cloud = (p.range_enabled || p.box_enabled) ? cropRange(in, p) : in;
   const std::size_t after_crop = cloud.countFinite();
   st.range_removed = finite - after_crop;
-  if (p.voxel_enabled) cloud = voxelDownsample(cloud, p.voxel_m);
-  st.after_voxel = cloud.countFinite();
+  st.after_voxel = after_crop;
   if (p.outlier_enabled && !cloud.empty()) {
     cloud = removeStatisticalOutliers(cloud, p.outlier_k, p.outlier_std_mul);
     st.outliers_removed = st.after_voxel - cloud.countFinite();
@@ -236,11 +163,39 @@ std::size_t cropOrganizedInPlace(PointCloud& c, const PreprocessParams& p) {
 }
 }  // namespace
 
+namespace {
+// The chain with the voxel grid into out: the cut-off and the voxel grid in one pass over the
+// input, the outlier filter on the centroids in place. The same points and centroids as the
+// steps one after the other (cropRange, voxelDownsample, removeStatisticalOutliers).
+void preprocessVoxelized(const PointCloud& in, const PreprocessParams& p, PointCloud& out,
+                         PreprocessStats& st) {
+  const std::size_t finite = in.countFinite();
+  st.points_in = in.size();
+  st.non_finite = in.size() - finite;
+  const RangeBoxTest test(p, in.sensor_origin);
+  const std::size_t passed = detail::voxelize(in, p.voxel_m, test.enabled() ? &test : nullptr, out);
+  st.range_removed = finite - passed;
+  st.after_voxel = out.size();
+  if (p.outlier_enabled && !out.empty()) {
+    detail::compactInPlace(out, outlierKeepMask(out, p.outlier_k, p.outlier_std_mul));
+    st.outliers_removed = st.after_voxel - out.size();
+  }
+  st.points_out = out.size();
+}
+}  // namespace
+
 void preprocess(const PointCloud& in, const PreprocessParams& p, PointCloud& out,
                 PreprocessStats* stats) {
-  // The voxel grid, the outlier filter and an unorganized cloud's compaction build new clouds;
-  // the rest (a sensor-rate config: the range cut alone, or nothing) reuses out's buffers.
-  if (p.voxel_enabled || p.outlier_enabled ||
+  if (p.voxel_enabled) {
+    p.validate();
+    PreprocessStats st;
+    preprocessVoxelized(in, p, out, st);
+    if (stats) *stats = st;
+    return;
+  }
+  // The outlier filter and an unorganized cloud's compaction build new clouds; the rest (a
+  // sensor-rate config: the range cut alone, or nothing) reuses out's buffers.
+  if (p.outlier_enabled ||
       ((p.range_enabled || p.box_enabled) && !in.isOrganized())) {
     out = preprocess(in, p, stats);
     return;

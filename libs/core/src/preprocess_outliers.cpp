@@ -1,6 +1,6 @@
 // The statistical outlier filter's neighbour search, meanNeighbourDistances: the mean distance
-// of every point to its k nearest, by a grid of cells (CellGrid) where that settles them and
-// by the k-d tree elsewhere.
+// of every point to its k nearest, by a grid of cells (CellGrid) where that settles them, by
+// comparing with every point for the few left, and by the k-d tree when many are left.
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
@@ -119,6 +119,7 @@ class NearestK {
     d_[pos] = d2;
   }
   bool full() const { return n_ == k_; }
+  std::size_t size() const { return n_; }
   float worst() const { return d_[n_ - 1]; }
   double meanWithoutFirst() const { return meanRootWithoutFirst(d_, n_); }
 
@@ -189,8 +190,10 @@ const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
   return table[static_cast<std::size_t>(ring)];
 }
 
-// How many points per occupied cell the grid aims at: the k + 1 nearest of a point on a
-// surface then lie within about half a cell, inside the 3 x 3 x 3 block around its cell.
+// The cell edge: about (k + 1) / 3 points per occupied cell. On a surface the k + 1 nearest of a
+// point then lie within about a cell's edge, mostly inside the 3 x 3 x 3 block around its cell,
+// which holds ~80 points (cells of k + 1 points made blocks of ~210, each compared with every
+// point of the cell: 1.4 times the instructions on a voxelized Kinect frame).
 double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
@@ -213,15 +216,15 @@ double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& fini
     cells.findOrInsert(detail::packKey(c[0], c[1], c[2]), inserted);
   }
   const double per_cell = static_cast<double>(finite.size()) / static_cast<double>(cells.size());
-  const double target = static_cast<double>(k + 1);
+  const double target = static_cast<double>(k + 1) / 3.0;
   return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
 }
 
 // The k + 1 nearest of every point by the grid g, their mean distance into mean_dist: every
 // point of a cell is compared with the points of the 27 cells around (gathered once per cell);
 // the answer is exact where the (k + 1)-th distance is within the block's margin. Where it is
-// not (the edge of the data, a lone point), the block grows ring by ring up to kMaxRing; the
-// points still unsettled go to rest (the k-d tree's).
+// not (the edge of the data, a lone point), the block grows ring by ring up to kMaxRing (each
+// ring looked up once per cell); the points still unsettled go to rest (their grid positions).
 void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>& mean_dist,
                        std::vector<std::uint32_t>& rest) {
   constexpr int kMaxRing = 3;
@@ -234,6 +237,7 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
     BlockPoints block;                         // the points of ring1, nearest cells first
     std::vector<float> bd2;
     std::vector<std::uint32_t> my_rest;
+    std::vector<std::uint32_t> outer[kMaxRing + 1];  // the current cell's outer rings, as needed
     // The cells at Chebyshev distance `ring` from (cx, cy, cz), nearest first: the nearer
     // points come first, so that NearestK rejects most later ones with one comparison. Ring 0
     // and 1 make a cell's block (copied once per cell); the outer rings are scanned only for
@@ -255,6 +259,7 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
       ring1.insert(ring1.end(), around.begin(), around.end());
       block.fill(g, ring1);
       bd2.resize(block.x.size());
+      int outer_done = 1;  // outer[2 .. outer_done] hold this cell's rings
       for (std::uint32_t q = g.start[c]; q < g.start[c + 1]; ++q) {
         const float qx = g.x[q], qy = g.y[q], qz = g.z[q];
         best.clear();
@@ -267,8 +272,12 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
           const double margin = blockMargin(g, qx, qy, qz, cx, cy, cz, ring);
           if (best.full() && static_cast<double>(best.worst()) <= margin * margin) break;
           if (++ring > kMaxRing) break;
-          shell(cx, cy, cz, ring);
-          for (const std::uint32_t b : around) {
+          if (ring > outer_done) {  // (looked up once per cell, for its first point needing it)
+            shell(cx, cy, cz, ring);
+            outer[ring].swap(around);
+            outer_done = ring;
+          }
+          for (const std::uint32_t b : outer[ring]) {
             // A cell whose box lies beyond the k-th distance so far holds none of the k.
             if (best.full() && g.boxDistance2(b, qx, qy, qz) > best.worst()) continue;
             const std::size_t n = g.start[b + 1] - g.start[b];
@@ -279,7 +288,7 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
           }
         }
         if (ring > kMaxRing) {
-          my_rest.push_back(g.index[q]);
+          my_rest.push_back(q);
           continue;
         }
         mean_dist[g.index[q]] = best.meanWithoutFirst();
@@ -287,6 +296,26 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
     }
 #pragma omp critical(upd_outlier_rest)
     rest.insert(rest.end(), my_rest.begin(), my_rest.end());
+  }
+}
+
+// The mean distances of the few grid points at positions todo, each compared with every point
+// of the grid (cheaper than building a k-d tree for a few dozen).
+void allPairsMeanDistances(const PointGrid& g, std::size_t want,
+                           const std::vector<std::uint32_t>& todo, std::vector<double>& mean_dist) {
+  const std::size_t n = g.x.size();
+#pragma omp parallel if (todo.size() > 1)
+  {
+    NearestK best(want);
+    std::vector<float> d2(n);
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(todo.size()); ++r) {
+      const std::uint32_t q = todo[static_cast<std::size_t>(r)];
+      distances2(g.x.data(), g.y.data(), g.z.data(), n, g.x[q], g.y[q], g.z[q], d2.data());
+      best.clear();
+      for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
+      if (best.size() >= 2) mean_dist[g.index[q]] = best.meanWithoutFirst();
+    }
   }
 }
 
@@ -321,14 +350,21 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
   if (finite.empty()) return mean_dist;
   const std::size_t want = static_cast<std::size_t>(k) + 1;  // the point itself comes first
   PointGrid g;
-  std::vector<std::uint32_t> rest;  // points left to the k-d tree
   // (A k beyond NearestK's capacity, or a cloud beyond the keys' range: the k-d tree alone.)
   if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k), g)) {
-    rest = finite;
-  } else {
-    gridMeanDistances(g, want, mean_dist, rest);
+    kdTreeMeanDistances(in, k, finite, mean_dist);
+    return mean_dist;
   }
-  if (!rest.empty()) kdTreeMeanDistances(in, k, rest, mean_dist);
+  std::vector<std::uint32_t> rest;  // grid positions of the points the rings did not settle
+  gridMeanDistances(g, want, mean_dist, rest);
+  // A few left (lone points, tiny clouds): compared with every point; many: the k-d tree.
+  constexpr std::size_t kMaxAllPairs = 128;
+  if (rest.size() <= kMaxAllPairs) {
+    allPairsMeanDistances(g, want, rest, mean_dist);
+  } else {
+    for (std::uint32_t& q : rest) q = g.index[q];
+    kdTreeMeanDistances(in, k, rest, mean_dist);
+  }
   return mean_dist;
 }
 

@@ -65,9 +65,10 @@ PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul
 
 /// What the outlier filter thresholds: every finite point's mean distance to its k nearest
 /// other points (NaN for a point that is not finite or has no other point). The neighbours
-/// come from a grid of cells sized for about k + 1 points each (the cells around a point's
-/// own, ring by ring until the k-th distance is certain), and from a k-d tree for the few
-/// points whose neighbours lie beyond 3 rings: the k-d tree's answer, up to float rounding.
+/// come from a grid of cells sized for about (k + 1) / 3 points each (the cells around a
+/// point's own, ring by ring until the k-th distance is certain); the few points whose
+/// neighbours lie beyond 3 rings are compared with every point (a k-d tree answers when there
+/// are many). The exact k nearest: the k-d tree's answer up to float rounding.
 std::vector<double> meanNeighbourDistances(const PointCloud& in, int k);
 
 /// The whole chain. With every step disabled the input is returned unchanged (organized, NaNs
@@ -75,7 +76,10 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k);
 PointCloud preprocess(const PointCloud& in, const PreprocessParams& p,
                       PreprocessStats* stats = nullptr);
 
-/// The same into out, whose buffers are reused when no step is enabled (the input is copied).
+/// The same into out, whose buffers are reused when no step or the cut-off alone is enabled
+/// (the input is copied) and when the voxel grid is: then the cut-off and the voxel grid run
+/// in one pass over the input and the outlier filter on the centroids in place. The output is
+/// the steps' one after the other, bit for bit.
 void preprocess(const PointCloud& in, const PreprocessParams& p, PointCloud& out,
                 PreprocessStats* stats = nullptr);
 
