@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "playback_damage.h"
 #include "run_config.h"
+#include "whole_run.h"
 
 #include "upd/core/stopwatch.h"
 #include "upd/io/atomic_file.h"
@@ -545,8 +546,12 @@ int runPlayback(const std::vector<std::string>& argv) {
 
   Playback run(config);
   playFrames(options, config, tracker, run);
+  json memory = runMemoryJson(run.grid, run.tree);  // the working set at the end of the run
+  switchToWholeRun(run.grid, run.tree);            // every export covers the whole run
   exportMaps(run, options.out_dir);
-  const json summary = summaryJson(options, config, run, truth, wall.elapsedMs() / 1000.0);
+  json summary = summaryJson(options, config, run, truth, wall.elapsedMs() / 1000.0);
+  memory["vm_hwm_with_exports_bytes"] = peakResidentBytes();
+  summary["memory"] = memory;
   io::writeJsonAtomically((options.out_dir / "summary.json").string(), summary);
   printSummary(options, summary, config.evaluation.tolerance_m);
   if (run.damage) {

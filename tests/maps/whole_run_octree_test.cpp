@@ -142,6 +142,9 @@ TEST(WholeRunOctree, EqualsOneFixedBoxTreeFedTheSameFrames) {
     const auto want = leaves(fixed);
     EXPECT_GT(want.size(), 5000u);
     EXPECT_EQ(leaves(*whole), want);
+    roll.mergeKeptTiles();  // the same, in place
+    EXPECT_EQ(roll.keptTiles(), 0u);
+    EXPECT_EQ(leaves(roll), want);
     std::printf("%d-voxel tiles: %zu tiles, %zu leaves, %.1f bytes per leaf, %.0f per tile\n",
                 tile_voxels, roll.keptTiles(), roll.keptLeaves(),
                 double(roll.keptTileBytes()) / std::max<std::size_t>(1, roll.keptLeaves()),

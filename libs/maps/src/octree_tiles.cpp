@@ -247,6 +247,14 @@ void TraversabilityOcTree::restoreKeptTiles(const octomap::OcTreeKey& min_key,
   }
 }
 
+void TraversabilityOcTree::mergeKeptTiles() {
+  if (!kept_) return;
+  for (const auto& tile : kept_->keys()) {
+    for (const detail::LeafRecord& r : kept_->take(tile)) setNodeAt(r.key, r.depth, fromRecord(r));
+  }
+  updateInnerOccupancy();
+}
+
 std::size_t TraversabilityOcTree::keptTiles() const { return kept_ ? kept_->tiles() : 0; }
 std::size_t TraversabilityOcTree::keptLeaves() const { return kept_ ? kept_->leaves() : 0; }
 std::size_t TraversabilityOcTree::keptTileBytes() const { return kept_ ? kept_->bytes() : 0; }

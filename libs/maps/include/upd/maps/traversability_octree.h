@@ -185,6 +185,9 @@ class TraversabilityOcTree : public octomap::OccupancyOcTreeBase<TraversabilityO
   std::size_t keptTileBytes() const;  ///< their compressed bytes plus a per-tile allowance
   /// The tree and every kept subtree as one tree (inner nodes updated), for the exports.
   std::unique_ptr<TraversabilityOcTree> wholeRun() const;
+  /// The same in place: every kept tile is put back into this tree (which then holds the
+  /// whole run, and its memory).
+  void mergeKeptTiles();
 
  protected:
   void updateInnerOccupancyRecurs(TraversabilityOcTreeNode* node, unsigned int depth);
