@@ -49,12 +49,10 @@ std::vector<Pose2> readTum(const fs::path& path) {
 TEST(LongRun, ThreeHundredMetresPlayBackIntoOneMapOfTheWholeRun) {
   const upd::test::TempDir tmp("long");
   const fs::path& dir = tmp.path();
-  // The CI-friendly resolution: 160 x 120 frames every 0.5 m.
-  std::ofstream(dir / "sim.ini") << "[SimulationParams]\nframe_spacing_m = 0.5\n"
-                                 << "[CameraMountParams]\nimage_downscale = 4\n";
+  // The README's commands. The CI-friendly resolution: 160 x 120 frames every 0.5 m.
   const std::string rawlog = (dir / "loop.rawlog").string();
-  const CmdResult sim = runUpd("simulate --world loop --distance-m 300 --config " +
-                               (dir / "sim.ini").string() + " --output " + rawlog);
+  const CmdResult sim = runUpd(std::string("simulate --world loop --distance-m 300 --config ") +
+                               UPD_SOURCE_DIR + "/config/sim-long-run.ini --output " + rawlog);
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
   EXPECT_NE(sim.output.find("over 300.0 m"), std::string::npos) << sim.output;
 
