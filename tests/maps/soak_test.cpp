@@ -1,10 +1,11 @@
 // A soak test of the maps: 10,000 generated frames of a robot lapping a 190 m circular course
 // (21 laps). Once the course has been seen the maps' memory stays flat (the window, the box and
 // the same kept tiles), and so does the process's peak memory; the tree written at the end
-// equals one built in two halves with a save to a .ot file and a reload between them.
+// equal ones built in two halves with a save to a file (.ot, grid state) and a reload between.
 #include "maps/frames.h"
 #include "temp_dir.h"
 #include "upd/maps/grid_fusion.h"
+#include "upd/maps/grid_state.h"
 #include "upd/maps/traversability_grid.h"
 #include "upd/maps/traversability_octree.h"
 
@@ -160,4 +161,64 @@ TEST(Soak, TreeBuiltInTwoHalvesWithASaveAndReloadEqualsOneBuiltInOneGo) {
   const Leaves want = leaves(one_go);
   EXPECT_GT(want.size(), 50000u);
   EXPECT_TRUE(leaves(*second) == want);
+}
+
+TEST(Soak, GridBuiltInTwoHalvesWithASaveAndReloadEqualsOneBuiltInOneGo) {
+  constexpr int kHalf = 2500, kAll = 5000;  // 5,000 frames: 10 laps
+  GridParams gp;
+  gp.cell_size_m = 0.1;
+  gp.extent_m = 20.0;
+  gp.extent_y_m = 16.0;
+  gp.tile_cells = 48;
+  const auto feed = [](TraversabilityGrid& g, int from, int to) {
+    for (int k = from; k < to; ++k) {
+      Eigen::Vector3d sensor;
+      const Frame f = frameAt(k, sensor);
+      upd::maps::integrateScan(g, f.view(), sensor.head<2>(), k, FusionParams{});
+    }
+  };
+  TraversabilityGrid one_go(gp);
+  feed(one_go, 0, kAll);
+
+  const upd::test::TempDir tmp("soak-grid");
+  const std::string path = (tmp.path() / "half.grid").string();
+  {
+    TraversabilityGrid first(gp);
+    feed(first, 0, kHalf);
+    upd::maps::writeGridState(first, path);
+  }
+  TraversabilityGrid second = upd::maps::readGridState(path);
+  feed(second, kHalf, kAll);
+
+  const TraversabilityGrid a = one_go.wholeRun(), b = second.wholeRun();
+  ASSERT_EQ(a.originI(), b.originI());
+  ASSERT_EQ(a.originJ(), b.originJ());
+  ASSERT_EQ(a.sizeX(), b.sizeX());
+  ASSERT_EQ(a.sizeY(), b.sizeY());
+  std::size_t observed = 0;
+  for (int cy = 0; cy < a.sizeY(); ++cy) {
+    for (int cx = 0; cx < a.sizeX(); ++cx) {
+      const upd::maps::GridCell &p = a.at(cx, cy), &q = b.at(cx, cy);
+      observed += p.observed();
+      ASSERT_EQ(std::memcmp(&p.logodds_nontrav, &q.logodds_nontrav, 7 * sizeof(float)), 0);
+      ASSERT_EQ(p.hits, q.hits);
+      ASSERT_EQ(p.zeta_count, q.zeta_count);
+      ASSERT_EQ(p.cost_count, q.cost_count);
+      ASSERT_EQ(std::memcmp(&p.last_seen_s, &q.last_seen_s, sizeof p.last_seen_s), 0);
+    }
+  }
+  EXPECT_GT(observed, 30000u);
+}
+
+TEST(Soak, GridStateFileErrorsNameTheFile) {
+  const upd::test::TempDir tmp("soak-bad");
+  const std::string path = (tmp.path() / "bad.grid").string();
+  std::ofstream(path) << "UPD grid state 1\ncell_size_m 0.1\n";
+  try {
+    upd::maps::readGridState(path);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.grid"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(upd::maps::readGridState((tmp.path() / "none.grid").string()), std::runtime_error);
 }

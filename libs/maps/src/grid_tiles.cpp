@@ -88,6 +88,17 @@ void GridTileStore::store(const TileKey& key, const std::vector<GridCell>& cells
   tiles_.emplace(key, std::move(packed));
 }
 
+const std::vector<std::uint8_t>* GridTileStore::packed(const TileKey& key) const {
+  const auto it = tiles_.find(key);
+  return it == tiles_.end() ? nullptr : &it->second;
+}
+
+void GridTileStore::putPacked(const TileKey& key, std::vector<std::uint8_t> bytes) {
+  erase(key);
+  bytes_ += bytes.size();
+  tiles_.emplace(key, std::move(bytes));
+}
+
 void GridTileStore::erase(const TileKey& key) {
   const auto it = tiles_.find(key);
   if (it == tiles_.end()) return;

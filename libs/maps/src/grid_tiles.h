@@ -39,6 +39,10 @@ class GridTileStore {
   void forEachKey(F&& f) const {
     for (const auto& kv : tiles_) f(kv.first);
   }
+  /// The tile's compressed bytes as stored (nullptr: none), and storing such bytes back (a
+  /// grid state file; load() checks them).
+  const std::vector<std::uint8_t>* packed(const TileKey& key) const;
+  void putPacked(const TileKey& key, std::vector<std::uint8_t> bytes);
 
  private:
   static constexpr std::size_t kEntryBytes = 96;  // std::map node + vector header, rounded up
@@ -53,3 +57,17 @@ inline std::int64_t floorDiv(std::int64_t a, std::int64_t b) {
 }
 
 }  // namespace upd::maps::detail
+
+namespace upd::maps {
+
+/// What the grid state file (grid_state.cpp) needs of the grid's insides
+/// (traversability_grid.cpp).
+struct GridStateAccess {
+  /// Every observed cell as tiles: the kept ones with the window's cells written in.
+  static detail::GridTileStore allCells(const TraversabilityGrid& grid);
+  /// Places the window at world cell (i0, j0) and fills it and the kept tiles from `tiles`.
+  static void restore(TraversabilityGrid& grid, std::int64_t i0, std::int64_t j0,
+                      detail::GridTileStore tiles);
+};
+
+}  // namespace upd::maps

@@ -282,6 +282,26 @@ std::size_t TraversabilityGrid::maxTileBytes() const {
   return detail::GridTileStore::maxTileBytes(params_.tile_cells);
 }
 
+detail::GridTileStore GridStateAccess::allCells(const TraversabilityGrid& grid) {
+  TraversabilityGrid::Impl copy = *grid.impl_;
+  TraversabilityGrid::Impl nowhere;  // a window covering nothing: every cell leaves
+  nowhere.i0 = nowhere.j0 = std::numeric_limits<std::int64_t>::min() / 2;
+  copy.keepCellsLeavingFor(nowhere);
+  return std::move(copy.tiles);
+}
+
+void GridStateAccess::restore(TraversabilityGrid& grid, std::int64_t i0, std::int64_t j0,
+                              detail::GridTileStore tiles) {
+  TraversabilityGrid::Impl& w = *grid.impl_;
+  w.i0 = i0;
+  w.j0 = j0;
+  w.allocate(grid.cellSize());
+  w.tiles = std::move(tiles);
+  TraversabilityGrid::Impl nowhere;  // every cell of the window enters it
+  nowhere.i0 = nowhere.j0 = std::numeric_limits<std::int64_t>::min() / 2;
+  w.restoreCellsEnteringFrom(nowhere);
+}
+
 namespace {
 
 // Bounding box of observed world cells [i_lo, i_hi] x [j_lo, j_hi]; empty while i_lo > i_hi.

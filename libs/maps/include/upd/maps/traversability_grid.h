@@ -206,6 +206,7 @@ class TraversabilityGrid {
   TraversabilityGrid wholeRun() const;
 
  private:
+  friend struct GridStateAccess;  // grid_state.cpp: every cell to a file and back
   struct Impl;
   GridParams params_;
   std::unique_ptr<Impl> impl_;
