@@ -1,6 +1,6 @@
 // A soak test of the maps: 10,000 generated frames of a robot lapping a 190 m circular course
 // (21 laps). Once the course has been seen the maps' memory stays flat (the window, the box and
-// the same kept tiles), and so does the process's peak memory; the tree written at the end
+// the same kept tiles), and so does the process's peak memory; the maps written at the end
 // equal ones built in two halves with a save to a file (.ot, grid state) and a reload between.
 #include "maps/frames.h"
 #include "temp_dir.h"
