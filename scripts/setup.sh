@@ -8,7 +8,7 @@ UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 UPD_BUILD="${UPD_BUILD:-$UPD_ROOT/build}"
 PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
-          libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev
+          libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev zlib1g-dev
           octomap-tools cloudcompare)  # the last two: tests open our files in them
 
 missing=()
