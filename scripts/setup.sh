@@ -8,7 +8,7 @@ UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 UPD_BUILD="${UPD_BUILD:-$UPD_ROOT/build}"
 PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
-          libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev
+          libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev zlib1g-dev
           libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
           octomap-tools cloudcompare gdal-bin mrpt-apps)  # the last four: tests open our files in them
 

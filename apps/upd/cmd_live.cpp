@@ -340,7 +340,7 @@ int runSource(const LiveOptions& o, nav::NavConfig config, const RunConfig& run_
   t.frames = run.frames;
   t.score_ms = run.score_ms;
   t.skipped = run.skipped;
-  return finishLive(o, t, run.loop.grid());
+  return finishLive(o, t, run.loop.grid().wholeRun());  // the map of the whole run
 }
 
 }  // namespace

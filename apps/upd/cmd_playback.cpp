@@ -12,6 +12,7 @@
 #include "playback_merge.h"
 #include "playback_tum.h"
 #include "run_config.h"
+#include "whole_run.h"
 
 #include "upd/core/stopwatch.h"
 #include "upd/gdal/geotiff.h"
@@ -494,8 +495,12 @@ int runPlayback(const std::vector<std::string>& argv) {
   for (std::size_t k = 0; k < runs.size() && !run.damage; ++k) {
     playFrames(per_run[k], config, trackers[k], run);
   }
+  json memory = runMemoryJson(run.grid, run.tree);  // the working set at the end of the run
+  switchToWholeRun(run.grid, run.tree);            // every export covers the whole run
   writeMapFiles(run.grid, run.tree, run.trajectory, options.out_dir, options.epsg);
-  const json summary = summaryJson(options, config, run, truth, wall.elapsedMs() / 1000.0);
+  json summary = summaryJson(options, config, run, truth, wall.elapsedMs() / 1000.0);
+  memory["vm_hwm_with_exports_bytes"] = peakResidentBytes();
+  summary["memory"] = memory;
   io::writeJsonAtomically((options.out_dir / "summary.json").string(), summary);
   printSummary(options, summary, config.evaluation.tolerance_m);
   if (run.damage) {

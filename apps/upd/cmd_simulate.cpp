@@ -14,24 +14,32 @@ namespace upd::app {
 
 const char* const kSimulateUsage =
     "usage: upd simulate --world NAME --output FILE.rawlog [--config FILE.ini] [--frames N]\n"
+    "                    [--distance-m D]\n"
     "  Drives a virtual Dune ([RobotBodyParams], a Kinect on it as [CameraMountParams])\n"
-    "  from the world's start to its goal and back, and records a real MRPT rawlog: 640 x 480\n"
+    "  from the world's start to its goal and back (round its course: loop), and records a\n"
+    "  real MRPT rawlog: 640 x 480\n"
     "  CObservation3DRangeScan frames with Kinect noise and odometry with drift. Beside it:\n"
     "  FILE.gt.tum (ground-truth poses, TUM format) and FILE.truth.pgm/.yaml (the world's\n"
     "  ground-truth traversability grid, ROS map_server format).\n\n"
     "options:\n"
-    "  --world NAME      mixed, rocks, ramp, ditch, corridor, trapped (default mixed)\n"
+    "  --world NAME      mixed, rocks, ramp, ditch, corridor, trapped, loop (default mixed)\n"
     "  --output FILE     the rawlog to write (required)\n"
     "  --config FILE     [SimulationParams] (speed, frame spacing, drift, seed),\n"
     "                    [RobotBodyParams] and [CameraMountParams] (the robot and its camera)\n"
-    "  --frames N        stop after N frames (default: the whole route)\n";
+    "  --frames N        stop after N frames (default: the whole route)\n"
+    "  --distance-m D    drive D metres, repeating the route (laps of loop's 140 m course);\n"
+    "                    overrides [SimulationParams] distance_m\n";
 
 int runSimulate(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--world", "--output", "--config", "--frames"}, {});
+  const Args args(argv, {"--world", "--output", "--config", "--frames", "--distance-m"}, {});
   if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
   const auto out = args.str("--output");
   if (!out) throw UsageError("--output FILE.rawlog is required");
-  const RunConfig config = args.has("--config") ? loadRunConfig(*args.str("--config")) : RunConfig{};
+  RunConfig config = args.has("--config") ? loadRunConfig(*args.str("--config")) : RunConfig{};
+  if (const auto d = args.number("--distance-m")) {
+    if (!(*d > 0)) throw UsageError("option --distance-m = " + std::to_string(*d) + ": must be > 0");
+    config.simulation.distance_m = *d;
+  }
   const int frames = args.integer("--frames").value_or(0);
   if (frames < 0) throw UsageError("option --frames = " + std::to_string(frames) + ": must be >= 0");
   const sim::WorldSpec world = sim::makeWorld(args.str("--world").value_or("mixed"));

@@ -223,6 +223,7 @@ TEST(GridFusion, WindowFollowsTheRobotWithBoundedMemory) {
   gp.cell_size_m = 0.2;
   gp.extent_m = 20.0;
   gp.follow_robot = true;
+  gp.keep_outside_window = false;  // the window alone (whole_run_test.cpp: with the tiles)
   TraversabilityGrid g(gp);
   const std::size_t memory0 = g.memoryBytes();
   const std::size_t cells = static_cast<std::size_t>(g.sizeX()) * g.sizeY();
@@ -256,6 +257,7 @@ TEST(GridFusion, WindowFollowsTheRobotWithBoundedMemory) {
 
 TEST(GridFusion, RecentringKeepsCellsAtTheirWorldPosition) {
   GridParams gp = smallGrid(true);
+  gp.keep_outside_window = false;
   TraversabilityGrid g(gp);
   Frame rock;
   rock.fillCell(3.0, 1.0, kCell, 10, core::Label::NonTraversable);

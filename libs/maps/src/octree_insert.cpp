@@ -79,7 +79,14 @@ bool updateBox(TraversabilityOcTree& tree, const Eigen::Vector3d& sensor,
   tree.setBBXMin(bmin);
   tree.setBBXMax(bmax);
   tree.useBBXLimit(true);
-  tree.cropToKeyBox(clampedKey(tree, bmin), clampedKey(tree, bmax));
+  const octomap::OcTreeKey kmin = clampedKey(tree, bmin), kmax = clampedKey(tree, bmax);
+  if (params.keep_outside_box) {
+    // What was kept of the new box comes back first; then what lies outside it is kept.
+    tree.restoreKeptTiles(kmin, kmax);
+    tree.cropToKeyBoxKeeping(kmin, kmax, params.tile_voxels);
+  } else {
+    tree.cropToKeyBox(kmin, kmax);
+  }
   return true;
 }
 

@@ -3,6 +3,8 @@
 #include "upd/io/atomic_file.h"
 #include "upd/maps/grid_export.h"
 
+#include "octree_tiles.h"
+
 #include <octomap/AbstractOcTree.h>
 #include <octomap/ColorOcTree.h>
 
@@ -124,6 +126,8 @@ void OctreeParams::validate() const {
                "must be finite");
   core::requireParam(recenter_fraction > 0 && recenter_fraction < 0.5, "OctreeParams",
                "recenter_fraction", recenter_fraction, "must be in (0, 0.5)");
+  core::requireParam(tile_voxels >= 8 && tile_voxels <= 4096 && (tile_voxels & (tile_voxels - 1)) == 0,
+                     "OctreeParams", "tile_voxels", tile_voxels, "must be a power of two in [8, 4096]");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -203,7 +207,8 @@ void TraversabilityOcTree::cropToKeyBox(const octomap::OcTreeKey& min_key,
 
 bool TraversabilityOcTree::cropRecurs(TraversabilityOcTreeNode* node, const octomap::OcTreeKey& key,
                                       unsigned int depth, const octomap::OcTreeKey& min_key,
-                                      const octomap::OcTreeKey& max_key) {
+                                      const octomap::OcTreeKey& max_key,
+                                      detail::OctreeTileStore* keep) {
   // Keys covered by the node: a leaf covers its own key; a node at depth d < tree_depth covers
   // [key - half, key + half - 1] with half = tree_max_val >> d (children at key +- half / 2).
   bool inside = true;
@@ -214,7 +219,10 @@ bool TraversabilityOcTree::cropRecurs(TraversabilityOcTreeNode* node, const octo
       lo = key[a] - half;
       hi = key[a] + half - 1;
     }
-    if (hi < min_key[a] || lo > max_key[a]) return true;  // entirely outside
+    if (hi < min_key[a] || lo > max_key[a]) {  // entirely outside
+      if (keep != nullptr) keepSubtree(node, key, depth, *keep);
+      return true;
+    }
     if (lo < min_key[a] || hi > max_key[a]) inside = false;
   }
   if (inside) return false;
@@ -228,7 +236,7 @@ bool TraversabilityOcTree::cropRecurs(TraversabilityOcTreeNode* node, const octo
     octomap::OcTreeKey child_key;
     octomap::computeChildKey(i, offset, key, child_key);
     TraversabilityOcTreeNode* child = getNodeChild(node, i);
-    if (cropRecurs(child, child_key, depth + 1, min_key, max_key)) {
+    if (cropRecurs(child, child_key, depth + 1, min_key, max_key, keep)) {
       deleteNodeRecurs(child);
       node->children[i] = nullptr;
     }

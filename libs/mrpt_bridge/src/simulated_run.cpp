@@ -41,6 +41,8 @@ void SimulationParams::validate() const {
                "must be >= 0");
   core::requireParam(truth_cell_m > 0, s, "truth_cell_m", truth_cell_m, "must be > 0");
   core::requireParam(seed >= 0, s, "seed", seed, "must be >= 0");
+  core::requireParam(std::isfinite(distance_m) && distance_m >= 0, s, "distance_m", distance_m,
+                     "must be >= 0");
 }
 
 namespace {
@@ -286,15 +288,57 @@ std::string truthMapPath(const std::string& rawlog_path) {
   return stemOf(rawlog_path) + ".truth.yaml";
 }
 
+namespace {
+
+// The stops of the route: start, the course or the goal, and back to start when the route
+// is closed (return_to_start, a course, or a run of distance_m).
+std::vector<Eigen::Vector2d> routeStops(const sim::WorldSpec& world, const SimulationParams& p) {
+  const Eigen::Vector2d start = world.start_xy_yaw.head<2>();
+  std::vector<Eigen::Vector2d> stops = {start};
+  if (world.course.empty()) {
+    stops.push_back(world.goal_xy);
+  } else {
+    stops.insert(stops.end(), world.course.begin(), world.course.end());
+  }
+  if (p.return_to_start || !world.course.empty() || p.distance_m > 0) stops.push_back(start);
+  return stops;
+}
+
+// The closed polyline `lap` repeated until it is distance_m long, cut there.
+std::vector<Eigen::Vector2d> repeatTo(const std::vector<Eigen::Vector2d>& lap, double distance_m) {
+  std::vector<Eigen::Vector2d> way = {lap.front()};
+  double length = 0;
+  for (std::size_t k = 1;; k = k % (lap.size() - 1) + 1) {
+    const Eigen::Vector2d a = way.back(), b = lap[k];
+    const double seg = (b - a).norm();
+    if (length + seg >= distance_m) {
+      way.push_back(a + (b - a) * ((distance_m - length) / seg));
+      return way;
+    }
+    if (seg > 0) way.push_back(b);
+    length += seg;
+  }
+}
+
+}  // namespace
+
 std::vector<RoutePose> planSimulatedRoute(const sim::WorldSpec& world, const SimulationParams& p) {
   p.validate();
   const PlanRaster raster(world.terrain);
-  const Eigen::Vector2d start = world.start_xy_yaw.head<2>();
-  std::vector<Eigen::Vector2d> way =
-      planLeg(raster, start, world.goal_xy, p.clearance_m, world.description);
-  if (p.return_to_start) {
-    const auto back = planLeg(raster, world.goal_xy, start, p.clearance_m, world.description);
-    way.insert(way.end(), back.begin() + 1, back.end());
+  const std::vector<Eigen::Vector2d> stops = routeStops(world, p);
+  std::vector<Eigen::Vector2d> way = {stops.front()};
+  for (std::size_t k = 1; k < stops.size(); ++k) {
+    const auto leg = planLeg(raster, stops[k - 1], stops[k], p.clearance_m, world.description);
+    way.insert(way.end(), leg.begin() + 1, leg.end());
+  }
+  if (p.distance_m > 0) {
+    double lap_m = 0;
+    for (std::size_t k = 1; k < way.size(); ++k) lap_m += (way[k] - way[k - 1]).norm();
+    if (!(lap_m > 0)) {
+      throw std::invalid_argument("SimulationParams.distance_m: the route of world '" +
+                                  world.description + "' has no length to repeat");
+    }
+    way = repeatTo(way, p.distance_m);
   }
   return sampleRoute(way, world, p);
 }

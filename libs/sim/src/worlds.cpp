@@ -3,6 +3,7 @@
 
 #include "terrain_internal.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -167,10 +168,58 @@ WorldSpec trappedWorld() {
           "the goal (7, 0) is enclosed by a closed square of 0.8 m walls: unreachable"};
 }
 
+// Obstacles beside one straight side of the loop from a to b: every 5 m a rock, a step, a
+// taller rock or a ditch, alternately 1.6 m left and right of the lane; every 7 m a 4 cm pebble
+// 0.5 m off the lane centre, which the wheels roll over.
+void lineTheSide(Terrain& t, const Eigen::Vector2d& a, const Eigen::Vector2d& b, int& k) {
+  const double len = (b - a).norm();
+  const Eigen::Vector2d dir = (b - a) / len, left(-dir.y(), dir.x());
+  const double yaw = std::atan2(dir.y(), dir.x());
+  for (double s = 4.0; s <= len - 4.0; s += 5.0, ++k) {
+    const Eigen::Vector2d c = a + s * dir + (k % 2 == 0 ? 1.6 : -1.6) * left;
+    switch (k % 4) {
+      case 0: t.add(rock(c.x(), c.y(), 0.30, 0.30, 0.25, yaw)); break;
+      case 1: t.add(block(c.x(), c.y(), 0.6, 0.6, 0.15)); break;
+      case 2: t.add(rock(c.x(), c.y(), 0.35, 0.25, 0.30, yaw + 0.5)); break;
+      default: {
+        Ditch d;
+        d.center_xy = c;
+        d.yaw_rad = yaw;
+        d.length_m = 1.5;
+        d.width_m = 0.5;
+        d.depth_m = 0.3;
+        t.add(d);
+      }
+    }
+  }
+  for (double s = 7.0; s <= len - 3.0; s += 7.0) {
+    const Eigen::Vector2d c = a + s * dir + 0.5 * left;
+    t.add(rock(c.x(), c.y(), 0.12, 0.12, 0.04));
+  }
+}
+
+WorldSpec loopWorld() {
+  Terrain t({0.0, 0.0}, {60.0, 30.0});
+  const std::vector<Eigen::Vector2d> corners = {{5.0, 5.0}, {55.0, 5.0}, {55.0, 25.0}, {5.0, 25.0}};
+  int k = 0;
+  for (std::size_t c = 0; c < corners.size(); ++c) {
+    lineTheSide(t, corners[c], corners[(c + 1) % corners.size()], k);
+  }
+  WorldSpec w{t,
+              {5.0, 5.0, 0.0},
+              corners[1],
+              "60 x 30 m flat ground with a 140 m rectangular lap (corners (5, 5), (55, 5), "
+              "(55, 25), (5, 25), anticlockwise); every 5 m beside the lane, 1.6 m left or "
+              "right, a 0.25 m rock, a 0.15 m step, a 0.3 m rock or a 0.6 m wide ditch; 4 cm "
+              "pebbles in the lane"};
+  w.course = {corners[1], corners[2], corners[3]};
+  return w;
+}
+
 }  // namespace
 
 std::vector<std::string> worldNames() {
-  return {"mixed", "rocks", "ramp", "ditch", "corridor", "trapped"};
+  return {"mixed", "rocks", "ramp", "ditch", "corridor", "trapped", "loop"};
 }
 
 WorldSpec makeWorld(const std::string& name) {
@@ -180,6 +229,7 @@ WorldSpec makeWorld(const std::string& name) {
   if (name == "ditch") return ditchWorld();
   if (name == "corridor") return corridorWorld();
   if (name == "trapped") return trappedWorld();
+  if (name == "loop") return loopWorld();
   std::string valid;
   for (const std::string& n : worldNames()) valid += (valid.empty() ? "" : ", ") + n;
   throw std::invalid_argument("unknown world '" + name + "'; valid names: " + valid);

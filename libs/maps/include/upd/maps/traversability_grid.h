@@ -15,12 +15,17 @@
 //  - hits: labelled (Traversable or NonTraversable) points ever integrated in the cell;
 //  - last_seen_s: time of the last frame that updated the cell [s], in the caller's clock.
 //
-// Bounded memory: the grid always has the same number of cells (extent_m / cell_size_m per
-// side). With follow_robot the window is re-centred on the robot whenever the robot gets more
-// than recenter_fraction * extent_m from the window centre along x or y; cells that scroll out
-// are dropped (their evidence is lost) and cells that scroll in are unknown. Without
-// follow_robot the window is fixed around (center_x_m, center_y_m) and points outside it are
-// dropped (counted by integrateScan). Cell (i, j) covers
+// Bounded memory: the window always has the same number of cells (extent_m / cell_size_m along
+// x, extent_y_m / cell_size_m along y). With follow_robot the window is re-centred on the robot
+// whenever the robot gets more than recenter_fraction of the extent from the window centre
+// along x or y. With keep_outside_window (the default) the cells that scroll out are kept in
+// compressed tiles of tile_cells x tile_cells cells and come back, bit for bit, when the window
+// returns over them: a revisited area continues fusing onto its old evidence, and wholeRun()
+// gives every cell ever observed as one fixed window. Memory is the window plus at most
+// maxTileBytes() per stored tile (docs/MAPS.md gives measured sizes). Without it the cells that
+// scroll out are dropped and cells that scroll in are unknown. Without follow_robot the window
+// is fixed around (center_x_m, center_y_m) and points outside it are dropped (counted by
+// integrateScan). Cell (i, j) covers
 // [i * cell_size_m, (i + 1) * cell_size_m) x [j * cell_size_m, (j + 1) * cell_size_m) in the
 // world, whatever the window: re-centring moves whole cells, never resamples.
 #pragma once
@@ -41,7 +46,8 @@ namespace upd::maps {
 /// Geometry of the grid and how its cells are read as labels. Loaded from [GridParams].
 struct GridParams {
   double cell_size_m = 0.1;  ///< side of a cell [m/cell]
-  double extent_m = 40.0;    ///< side of the square window [m]; rounded to whole cells
+  double extent_m = 40.0;    ///< side of the window along x [m]; rounded to whole cells
+  double extent_y_m = 0.0;   ///< side of the window along y [m]; 0: extent_m (a square)
   bool follow_robot = true;  ///< true: the window follows the robot; false: fixed window
   double center_x_m = 0.0;   ///< window centre [m, world]: fixed, or the initial one
   double center_y_m = 0.0;
@@ -51,12 +57,17 @@ struct GridParams {
   /// A known cell is non-traversable when its probability is >= this (ROS occupied_thresh).
   double p_nontrav_threshold = 0.65;
   int min_hits_known = 1;  ///< a cell with fewer hits is reported Unknown
+  /// true: cells that leave the window are kept (compressed tiles) and come back when the
+  /// window returns; false: they are dropped.
+  bool keep_outside_window = true;
+  int tile_cells = 64;  ///< side of a kept tile [cells] (8..1024)
 
   void validate() const;
   template <class V>
   void visit(V& v) {
     v("cell_size_m", cell_size_m, "side of a grid cell [m]");
-    v("extent_m", extent_m, "side of the square map window [m] (memory bound)");
+    v("extent_m", extent_m, "side of the map window along x [m] (memory bound)");
+    v("extent_y_m", extent_y_m, "side of the map window along y [m]; 0: extent_m");
     v("follow_robot", follow_robot, "true: the window follows the robot; false: fixed window");
     v("center_x_m", center_x_m, "window centre x [m, world] (fixed, or initial)");
     v("center_y_m", center_y_m, "window centre y [m, world] (fixed, or initial)");
@@ -65,10 +76,15 @@ struct GridParams {
     v("p_nontrav_threshold", p_nontrav_threshold,
       "probability at or above which a known cell is non-traversable (0..1)");
     v("min_hits_known", min_hits_known, "points a cell needs before it counts as known (>= 1)");
+    v("keep_outside_window", keep_outside_window,
+      "true: cells leaving the window are kept in compressed tiles and restored on return "
+      "(whole-run maps); false: dropped");
+    v("tile_cells", tile_cells, "side of a kept tile [cells] (8..1024)");
   }
 
-  /// Cells per side of the window.
+  /// Cells of the window along x (cellsPerSide) and along y.
   int cellsPerSide() const;
+  int cellsY() const;
 };
 
 /// One cell's layers (see the header comment). Default-constructed = never observed.
@@ -174,14 +190,30 @@ class TraversabilityGrid {
   /// Makes every cell unknown (the window stays where it is).
   void clear();
 
-  /// Bytes held by the cells (constant for a given GridParams).
+  /// Bytes held by the window and the kept tiles: windowBytes() + storedTileBytes().
   std::size_t memoryBytes() const;
+  /// Bytes held by the window's cells (constant for a given GridParams).
+  std::size_t windowBytes() const;
+  /// Tiles kept of the cells outside the window (keep_outside_window), and their bytes.
+  std::size_t storedTiles() const;
+  std::size_t storedTileBytes() const;
+  /// The stated bound on one kept tile: storedTileBytes() <= storedTiles() * maxTileBytes().
+  std::size_t maxTileBytes() const;
+
+  /// Every cell ever observed (the window and the kept tiles) as one fixed window
+  /// (follow_robot and keep_outside_window off) over their bounding box, cells at their world
+  /// indices; the window's own geometry, fixed, when nothing was observed.
+  TraversabilityGrid wholeRun() const;
 
  private:
+  friend struct GridStateAccess;  // grid_state.cpp: every cell to a file and back
   struct Impl;
   GridParams params_;
   std::unique_ptr<Impl> impl_;
 };
+
+/// The whole run of a grid as one fixed window: grid.wholeRun(), for the exports.
+inline TraversabilityGrid wholeRunGrid(const TraversabilityGrid& grid) { return grid.wholeRun(); }
 
 /// Known = observed with at least min_hits_known hits.
 bool isKnown(const GridCell& cell, const GridParams& params);

@@ -17,8 +17,13 @@
 //
 // Bounded memory: updates are limited to a box (OctoMap's BBX limit). With follow_robot the box
 // (extent_m x extent_m x height_m) is re-centred on the sensor whenever the sensor gets farther
-// than recenter_fraction of the box size from its centre along any axis, and every node outside
-// the new box is deleted; without it the box is fixed around center_*_m.
+// than recenter_fraction of the box size from its centre along any axis; without it the box is
+// fixed around center_*_m. With keep_outside_box (the default) every subtree that leaves the box
+// is kept, as compressed leaf records in tiles of tile_voxels x tile_voxels voxels (x, y; every
+// z), and put back into the tree when the box returns over its tile, so a revisited area
+// continues fusing onto its old evidence; wholeRun() is the whole run as one tree. Memory is the
+// tree inside the box plus the kept tiles (keptTileBytes(), measured in docs/MAPS.md). Without
+// it every node outside the new box is deleted.
 //
 // Files: writeTraversabilityOt holds everything (occupancy and traversability) and reloads
 // with readTraversabilityOt, or octomap::AbstractOcTree::read in programs that link this
@@ -44,6 +49,9 @@
 namespace upd::maps {
 
 class TraversabilityOcTree;
+namespace detail {
+class OctreeTileStore;  // octree_tiles.h: the kept subtrees
+}
 
 class TraversabilityOcTreeNode : public octomap::OcTreeNode {
  public:
@@ -105,6 +113,10 @@ struct OctreeParams {
   /// The box is re-centred when the sensor is farther than this fraction of the box size from
   /// its centre along an axis (0..0.5).
   double recenter_fraction = 0.25;
+  /// true: subtrees leaving the box are kept (compressed tiles) and come back when the box
+  /// returns; false: they are deleted.
+  bool keep_outside_box = true;
+  int tile_voxels = 128;  ///< side of a kept tile along x and y [voxels]; a power of two
 
   void validate() const;
   template <class V>
@@ -126,6 +138,10 @@ struct OctreeParams {
     v("center_z_m", center_z_m, "box centre z [m, world] (fixed, or initial)");
     v("recenter_fraction", recenter_fraction,
       "re-centre when the sensor is this fraction of the box size from its centre (0..0.5)");
+    v("keep_outside_box", keep_outside_box,
+      "true: subtrees leaving the box are kept in compressed tiles and restored on return "
+      "(whole-run maps); false: deleted");
+    v("tile_voxels", tile_voxels, "side of a kept tile along x and y [voxels] (power of two, 8..4096)");
   }
 };
 
@@ -135,6 +151,9 @@ class TraversabilityOcTree : public octomap::OccupancyOcTreeBase<TraversabilityO
   explicit TraversabilityOcTree(double resolution_m);
   /// Resolution and occupancy probabilities from params (validated).
   explicit TraversabilityOcTree(const OctreeParams& params);
+  ~TraversabilityOcTree() override;
+  TraversabilityOcTree(const TraversabilityOcTree&) = delete;  // OctoMap's copy slices nodes
+  TraversabilityOcTree& operator=(const TraversabilityOcTree&) = delete;
 
   TraversabilityOcTree* create() const override { return new TraversabilityOcTree(resolution); }
   std::string getTreeType() const override { return "TraversabilityOcTree"; }
@@ -154,12 +173,39 @@ class TraversabilityOcTree : public octomap::OccupancyOcTreeBase<TraversabilityO
   /// Deletes every node that lies entirely outside the box (OcTreeKey bounds, inclusive),
   /// expanding pruned nodes that straddle it, then refreshes the inner nodes.
   void cropToKeyBox(const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key);
+  /// cropToKeyBox, but what lies outside the box is kept in tiles of tile_voxels (a power of
+  /// two) along x and y instead of deleted. Throws std::invalid_argument when tile_voxels
+  /// differs from the tiles kept so far.
+  void cropToKeyBoxKeeping(const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key,
+                           int tile_voxels);
+  /// Puts every kept tile that overlaps the box (along x and y) back into the tree.
+  void restoreKeptTiles(const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key);
+  std::size_t keptTiles() const;      ///< tiles kept from outside the box
+  std::size_t keptLeaves() const;     ///< leaves in them
+  std::size_t keptTileBytes() const;  ///< their compressed bytes plus a per-tile allowance
+  /// The tree and every kept subtree as one tree (inner nodes updated), for the exports.
+  std::unique_ptr<TraversabilityOcTree> wholeRun() const;
+  /// The same in place: every kept tile is put back into this tree (which then holds the
+  /// whole run, and its memory).
+  void mergeKeptTiles();
 
  protected:
   void updateInnerOccupancyRecurs(TraversabilityOcTreeNode* node, unsigned int depth);
   /// Returns true when the caller should delete node (nothing of it is inside the box).
+  /// keep: where the deleted subtrees go (nullptr: nowhere).
   bool cropRecurs(TraversabilityOcTreeNode* node, const octomap::OcTreeKey& key, unsigned int depth,
-                  const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key);
+                  const octomap::OcTreeKey& min_key, const octomap::OcTreeKey& max_key,
+                  detail::OctreeTileStore* keep = nullptr);
+  /// Adds the leaves of node's subtree to keep, splitting nodes larger than a tile.
+  void keepSubtree(TraversabilityOcTreeNode* node, const octomap::OcTreeKey& key,
+                   unsigned int depth, detail::OctreeTileStore& keep);
+  /// Sets the node at (key, depth) to data, creating the nodes on the way.
+  void setNodeAt(const octomap::OcTreeKey& key, unsigned int depth,
+                 const TraversabilityOcTreeNode& data);
+  /// Calls f(key, depth, node) for every leaf below node.
+  template <class F>
+  void forEachLeaf(const TraversabilityOcTreeNode* node, const octomap::OcTreeKey& key,
+                   unsigned int depth, F&& f) const;
 
   /// Registers the tree type with OctoMap's factory once (ColorOcTree's pattern).
   class StaticMemberInitializer {
@@ -168,6 +214,9 @@ class TraversabilityOcTree : public octomap::OccupancyOcTreeBase<TraversabilityO
     void ensureLinking() {}
   };
   static StaticMemberInitializer traversability_octree_member_init_;
+
+ private:
+  std::unique_ptr<detail::OctreeTileStore> kept_;
 };
 
 /// What one insertScan() call did.

@@ -38,6 +38,9 @@ struct SimulationParams {
   double truth_cell_m = 0.05;                            ///< cell of the ground-truth grid [m]
   int seed = 1;
   bool return_to_start = true;  ///< drive back to the start after the goal
+  /// > 0: drive this far [m], repeating the world's closed course (or start -> goal -> start)
+  /// as often as needed; 0: the route once.
+  double distance_m = 0.0;
 
   /// Validates this section and the body and camera (std::invalid_argument naming the field).
   void validate() const;
@@ -53,6 +56,8 @@ struct SimulationParams {
     v("truth_cell_m", truth_cell_m, "cell of the ground-truth traversability grid [m]");
     v("seed", seed, "noise seed");
     v("return_to_start", return_to_start, "drive back to the start after reaching the goal");
+    v("distance_m", distance_m,
+      "> 0: drive this far, repeating the world's course (laps); 0: the route once [m]");
   }
 };
 
@@ -65,7 +70,8 @@ struct RoutePose {
 
 /// The route of a simulated run through the world, planned on the ground truth (0.1 m cells,
 /// the world's border blocked, clearance_m kept from non-traversable or unknown truth) and
-/// straightened: poses every frame_spacing_m with the body resting on the terrain, turning in
+/// straightened: start -> goal (-> start), or round the world's course (WorldSpec::course) back
+/// to start; with distance_m > 0 the closed route repeated and cut at distance_m; poses every frame_spacing_m with the body resting on the terrain, turning in
 /// place (15 deg steps) at the corners. Throws std::invalid_argument naming the world when the
 /// start or the goal lacks the clearance or the goal cannot be reached.
 std::vector<RoutePose> planSimulatedRoute(const sim::WorldSpec& world, const SimulationParams& p);

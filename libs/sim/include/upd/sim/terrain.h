@@ -255,9 +255,13 @@ struct WorldSpec {
   Eigen::Vector3d start_xy_yaw;  ///< start pose (x [m], y [m], yaw [rad])
   Eigen::Vector2d goal_xy;       ///< goal position [m]
   std::string description;
+  /// A closed course (may be empty): a route drives start, these in order, back to start (the
+  /// goal is the first of them); runs longer than one lap repeat it.
+  std::vector<Eigen::Vector2d> course = {};
 };
 
-/// The names makeWorld accepts: "mixed", "rocks", "ramp", "ditch", "corridor", "trapped".
+/// The names makeWorld accepts: "mixed", "rocks", "ramp", "ditch", "corridor", "trapped",
+/// "loop".
 std::vector<std::string> worldNames();
 
 /// Builds a named world (default TruthParams). Every solvable world leaves 0.42 m of clearance
@@ -283,6 +287,11 @@ std::vector<std::string> worldNames();
 ///            1.65 m passages. Start (1, 0, 0), goal (11, 0).
 ///  trapped   x 0..10, y -4..4. The goal (7, 0) is inside a closed square of 0.8 m walls
 ///            (outside 2.4 m, 0.15 m thick): unreachable. Start (1, 0, 0).
+///  loop      x 0..60, y 0..30, flat. A closed course (WorldSpec::course) round the rectangle
+///            (5, 5), (55, 5), (55, 25), (5, 25): 140 m a lap, for long runs. Every 5 m along
+///            each side, 1.6 m left or right of the lane in turn: a 0.25 m rock, a 0.6 m
+///            square 0.15 m step, a 0.3 m rock, a 1.5 x 0.5 m ditch 0.3 m deep along the lane;
+///            every 7 m a 4 cm pebble 0.5 m left of the lane centre. Start (5, 5, 0).
 /// Throws std::invalid_argument listing the valid names for an unknown name.
 WorldSpec makeWorld(const std::string& name);
 
