@@ -6,6 +6,7 @@
 // exits kExitPartial (playback_damage.h).
 #include "cli.h"
 #include "commands.h"
+#include "playback_bag.h"
 #include "playback_damage.h"
 #include "run_config.h"
 
@@ -49,13 +50,15 @@
 namespace upd::app {
 
 const char* const kPlaybackUsage =
-    "usage: upd playback RAWLOG --config FILE.ini --output DIR [options]\n"
+    "usage: upd playback RAWLOG|RUN.bag --config FILE.ini --output DIR [options]\n"
     "  Replays RAWLOG (either rawlog layout): UPD for every 3D observation in the world frame,\n"
     "  fused over time into a 2.5D traversability grid and an OctoMap tree. Writes into DIR:\n"
     "  map.png (colour, with legend), map.pgm + map.yaml (ROS map_server), map.ot (OctoMap\n"
     "  ColorOcTree coloured by traversability, for every OctoMap tool; map_colour.ot is the same\n"
     "  file), map_traversability.ot (the full tree, read with upd::maps::readTraversabilityOt),\n"
-    "  map.bt (occupancy), map.3Dscene (MRPT SceneViewer3D) and summary.json.\n\n"
+    "  map.bt (occupancy), map.3Dscene (MRPT SceneViewer3D) and summary.json.\n"
+    "  A ROS 1 bag (depth Image + CameraInfo or PointCloud2, tf for the poses) is first\n"
+    "  converted to DIR/bag.rawlog and DIR/bag_poses.tum (docs/ROS.md).\n\n"
     "options:\n"
     "  --config FILE.ini   robot/sensor parameters (config/dune-kinect.ini, ...) (required)\n"
     "  --output DIR        output directory, created if missing (required)\n"
@@ -536,8 +539,13 @@ void printSummary(const PlaybackOptions& o, const json& summary, double toleranc
 
 int runPlayback(const std::vector<std::string>& argv) {
   const core::Stopwatch wall;
-  const PlaybackOptions options = parsePlaybackOptions(argv);
+  PlaybackOptions options = parsePlaybackOptions(argv);
   const RunConfig config = loadRunConfig(options.config_path);
+  if (const auto bag = convertBagInput(options.rawlog, options.out_dir)) {  // playback_bag.h
+    options.rawlog = bag->rawlog;
+    if (!options.poses_path) options.poses_path = bag->poses;
+    if (!options.quiet) std::printf("%s\n", bag->summary.c_str());
+  }
   mrpt_bridge::RobotPoseTracker tracker = poseTracker(options, config);
   const Truth truth = loadTruth(options);
   fs::create_directories(options.out_dir);
