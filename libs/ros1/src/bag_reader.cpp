@@ -76,7 +76,13 @@ BagReadStats readBag(const std::string& path, const BagTopics& topics,
     const double span_s = (all.getEndTime() - all.getBeginTime()).toSec();
     tf2::BufferCore tf(ros::Duration(span_s + 60.0));
     loadTf(bag, tf);
+    // The first CameraInfo serves the images before it: a bag orders messages of the same
+    // stamp by connection, so an image may come just before its info.
     sensor_msgs::CameraInfo::ConstPtr info;
+    for (const rosbag::MessageInstance& m :
+         rosbag::View(bag, rosbag::TopicQuery(topics.camera_info_topic))) {
+      if ((info = m.instantiate<sensor_msgs::CameraInfo>())) break;
+    }
     rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{
                                topics.depth_topic, topics.camera_info_topic, topics.points_topic}));
     BagFrame frame;
