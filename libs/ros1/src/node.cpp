@@ -92,6 +92,7 @@ struct TraversabilityNode::Impl {
   bool resolveWorldFrame(const ros::Time& stamp);
   std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
                                           const ros::Time& stamp);
+  bool basePoseKnown();
   void processPending();
   void processCloud(core::PointCloud cloud, const std_msgs::Header& header);
   void publishGrid(const ros::Time& stamp, bool force);
@@ -131,12 +132,21 @@ std::optional<Eigen::Isometry3d> TraversabilityNode::Impl::lookup(const std::str
         tf.lookupTransform(target, source, stamp, ros::Duration(params.tf_timeout_s));
     return isometryFromTransform(t.transform);
   } catch (const tf2::TransformException& e) {
-    problem("no transform " + target + " -> " + source + " at t = " +
-            std::to_string(stamp.toSec()) + ": " + e.what());
+    (void)e;  // its text holds the time: the line would differ for every frame
+    problem("no transform " + target + " -> " + source + " in tf (at the message's stamp)");
   } catch (const MessageError& e) {
     problem(std::string("transform ") + target + " -> " + source + ": " + e.what());
   }
   return std::nullopt;
+}
+
+// The loop reads the robot pose from the base for every frame and plan: without odometry
+// there is nothing to map or drive with.
+bool TraversabilityNode::Impl::basePoseKnown() {
+  nav::BaseState s;
+  if (base.readState(s)) return true;
+  problem("no robot pose: " + base.lastError());
+  return false;
 }
 
 void TraversabilityNode::Impl::processPending() {
@@ -172,6 +182,7 @@ void TraversabilityNode::Impl::processCloud(core::PointCloud cloud,
   if (!world_sensor) return;
   const auto world_base = lookup(world_frame, params.base.base_frame, header.stamp);
   if (!world_base) return;
+  if (!basePoseKnown()) return;
   const core::PointCloud cloud_world = core::transformCloud(cloud, *world_sensor);
   const nav::FrameEvidence& ev =
       loop.addFrame(cloud_world, header.stamp.toSec(), world_base->translation().z());
@@ -210,6 +221,7 @@ void TraversabilityNode::Impl::onGoal(const geometry_msgs::PoseStamped::ConstPtr
     if (!t) return;
     goal = *t * goal;
   }
+  if (!basePoseKnown()) return;
   ROS_INFO("upd: goal (%.2f, %.2f) in %s: navigating", goal.x(), goal.y(), world_frame.c_str());
   loop.navigateTo(goal.head<2>());
   driving = true;
