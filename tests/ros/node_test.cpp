@@ -82,8 +82,12 @@ std::size_t countLines(const std::string& text, const std::string& needle) {
 
 class RosNode : public ::testing::Test {
  public:
-  void SetUp() override {
+  // One master per process (ros::init once); ctest runs every test in a process of its own.
+  static void SetUpTestSuite() {
     master = std::make_unique<test::RosMasterOnLoopback>("upd_test_robot");
+  }
+  static void TearDownTestSuite() { master.reset(); }
+  void SetUp() override {
     nh = std::make_unique<ros::NodeHandle>();
     grid_sub = nh->subscribe<nav_msgs::OccupancyGrid>(
         "/upd/traversability", 1, [this](const nav_msgs::OccupancyGrid::ConstPtr& g) { out.grid = g; });
@@ -106,8 +110,11 @@ class RosNode : public ::testing::Test {
     grid_sub.shutdown();
     cloud_sub.shutdown();
     cmd_sub.shutdown();
+    depth_pub.shutdown();
+    info_pub.shutdown();
+    odom_pub.shutdown();
+    goal_pub.shutdown();
     nh.reset();
-    master.reset();
   }
 
   void publishFrame(const core::DepthImage& depth, const core::CameraIntrinsics& K,
@@ -141,7 +148,7 @@ class RosNode : public ::testing::Test {
     static_tf->sendTransform(stamped(base_camera, "base_link", "camera_optical", ros::Time::now()));
   }
 
-  std::unique_ptr<test::RosMasterOnLoopback> master;
+  static std::unique_ptr<test::RosMasterOnLoopback> master;
   std::unique_ptr<ros::NodeHandle> nh;
   ros::Subscriber grid_sub, cloud_sub, cmd_sub;
   ros::Publisher depth_pub, info_pub, odom_pub, goal_pub;
@@ -151,6 +158,8 @@ class RosNode : public ::testing::Test {
   Outputs out;
 };
 
+
+std::unique_ptr<test::RosMasterOnLoopback> RosNode::master;
 
 int knownCells(const nav_msgs::OccupancyGrid& g) {
   int n = 0;

@@ -68,15 +68,15 @@ class Child {
   int waitExit(double timeout_s) {
     if (status_ >= 0) return status_;
     const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (std::chrono::steady_clock::now() < until) {
+    for (;;) {
       int st = 0;
       if (::waitpid(pid_, &st, WNOHANG) == pid_) {
         status_ = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
         return status_;
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (std::chrono::steady_clock::now() >= until) return -1;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    return -1;
   }
   /// SIGINT to the group, then SIGKILL if it lingers.
   void stop() {

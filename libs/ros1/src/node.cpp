@@ -252,7 +252,13 @@ void TraversabilityNode::Impl::control() {
     return;
   }
   const std::size_t route_points = loop.route().path_world.size();
-  const nav::NavState state = loop.step();
+  nav::NavState state;
+  try {
+    state = loop.step();
+  } catch (const std::runtime_error& e) {  // the base lost its pose while planning
+    endGoal(NodeEnd::GoalFailed, std::string(e.what()) + ": " + base.lastError());
+    return;
+  }
   if (loop.route().path_world.size() != route_points) publishRoute();
   if (state == nav::NavState::Navigating) return;
   const nav::NavOutcome o = loop.outcome();

@@ -31,7 +31,16 @@ RosRobotBase::RosRobotBase(ros::NodeHandle& nh, const RosBaseParams& params,
     : params_(params), tf_(tf) {
   params_.validate();
   cmd_pub_ = nh.advertise<geometry_msgs::Twist>(params_.cmd_vel_topic, 1);
-  odom_sub_ = nh.subscribe(params_.odom_topic, 5, &RosRobotBase::onOdom, this);
+  ros::NodeHandle own(nh);
+  own.setCallbackQueue(&queue_);
+  odom_sub_ = own.subscribe(params_.odom_topic, 5, &RosRobotBase::onOdom, this);
+  spinner_ = std::make_unique<ros::AsyncSpinner>(1, &queue_);
+  spinner_->start();
+}
+
+RosRobotBase::~RosRobotBase() {
+  spinner_->stop();
+  odom_sub_.shutdown();
 }
 
 void RosRobotBase::onOdom(const nav_msgs::Odometry::ConstPtr& msg) {
@@ -95,17 +104,11 @@ double RosRobotBase::timeS() const { return ros::Time::now().toSec(); }
 
 namespace {
 
-// The spinner and node handle of makeRosBase's base live as long as the base.
+// The node handle of makeRosBase's base lives as long as the base.
 class OwnedRosBase : public nav::RobotBase {
  public:
-  explicit OwnedRosBase(const RosBaseParams& params)
-      : spinner_(1), base_(nh_, params, nullptr) {
-    spinner_.start();
-  }
-  ~OwnedRosBase() override {
-    base_.stop(false);
-    spinner_.stop();
-  }
+  explicit OwnedRosBase(const RosBaseParams& params) : base_(nh_, params, nullptr) {}
+  ~OwnedRosBase() override { base_.stop(false); }
   bool readState(nav::BaseState& s) override { return base_.readState(s); }
   bool sendVelocity(const nav::Twist2D& c) override { return base_.sendVelocity(c); }
   bool stop(bool e) override { return base_.stop(e); }
@@ -114,7 +117,6 @@ class OwnedRosBase : public nav::RobotBase {
 
  private:
   ros::NodeHandle nh_;
-  ros::AsyncSpinner spinner_;
   RosRobotBase base_;
 };
 

@@ -5,11 +5,14 @@
 // The pose in the world is the odometry's, or, when a tf buffer is given and it holds
 // world_frame -> base_frame, that transform (a localization on top of odometry). Odometry
 // older than odom_timeout_s makes readState() fail: the navigator then stops the robot.
-// Callbacks may run on a spinner thread: the state is guarded by a mutex.
+// Odometry is received on the base's own callback queue and spinner thread, so it stays fresh
+// while the caller's thread scores a frame or builds the navigator; the state is guarded by a
+// mutex.
 #pragma once
 
 #include "upd/nav/robot_base.h"
 
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <nav_msgs/Odometry.h>
 #include <tf2_ros/buffer.h>
@@ -38,6 +41,9 @@ class RosRobotBase : public nav::RobotBase {
   /// Advertises cmd_vel and subscribes to odom on nh. tf may be nullptr (odometry poses only)
   /// and must outlive the base.
   RosRobotBase(ros::NodeHandle& nh, const RosBaseParams& params, const tf2_ros::Buffer* tf);
+  ~RosRobotBase() override;
+  RosRobotBase(const RosRobotBase&) = delete;
+  RosRobotBase& operator=(const RosRobotBase&) = delete;
 
   bool readState(nav::BaseState& state) override;
   bool sendVelocity(const nav::Twist2D& command) override;
@@ -55,6 +61,8 @@ class RosRobotBase : public nav::RobotBase {
 
   RosBaseParams params_;
   const tf2_ros::Buffer* tf_;
+  ros::CallbackQueue queue_;
+  std::unique_ptr<ros::AsyncSpinner> spinner_;
   ros::Publisher cmd_pub_;
   ros::Subscriber odom_sub_;
   mutable std::mutex mutex_;
@@ -63,8 +71,7 @@ class RosRobotBase : public nav::RobotBase {
 };
 
 /// A RosRobotBase for `upd live --base ros`: initialises ROS as node `upd_live` when no node
-/// exists yet (ROS_MASTER_URI names the master), starts a spinner thread for its callbacks,
-/// and waits up to wait_s for the first odometry (std::runtime_error naming the topic when none
+/// exists yet (ROS_MASTER_URI names the master) and waits up to wait_s for the first odometry (std::runtime_error naming the topic when none
 /// comes).
 std::unique_ptr<nav::RobotBase> makeRosBase(const RosBaseParams& params = {}, double wait_s = 5.0);
 
