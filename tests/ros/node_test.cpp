@@ -6,6 +6,7 @@
 #include "real_frame.h"
 #include "ros_master.h"
 #include "test_data.h"
+#include "apps/run_upd.h"
 
 #include "upd/nav/nav_config.h"
 #include "upd/ros1/conversions.h"
@@ -320,6 +321,21 @@ TEST_F(RosNode, StopsTheRobotWhenTheFramesStop) {
   spinUntil([] { return false; }, 0.2);
   EXPECT_EQ(out.cmd->linear.x, 0.0);
   EXPECT_EQ(out.cmd->angular.z, 0.0);
+}
+
+// share/ros is the ROS package upd_nav: roslaunch resolves its launch file to the entry script,
+// which runs this build's `upd ros`.
+TEST(RosLaunch, TheLaunchFileResolvesToTheUpdRosNode) {
+  const std::string pkg = std::string(UPD_DATA_BUILD_DIR) + "/ros";
+  test::TempDir home;
+  const auto r = test::runCommand("ROS_HOME=" + home.path().string() + " ROS_PACKAGE_PATH=" + pkg +
+                                  " roslaunch --args /upd upd_nav upd.launch");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(pkg + "/upd_ros --config "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("dune-nav.ini"), std::string::npos) << r.output;
+  const auto help = test::runCommand(pkg + "/upd_ros --help");
+  EXPECT_EQ(help.exit_code, 0) << help.output;
+  EXPECT_NE(help.output.find("usage: upd ros"), std::string::npos) << help.output;
 }
 
 }  // namespace

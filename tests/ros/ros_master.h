@@ -110,6 +110,9 @@ class RosMasterOnLoopback {
     ::setenv("ROS_IP", "127.0.0.1", 1);
     ::setenv("ROS_HOME", home_.path().c_str(), 1);
     ::setenv("ROS_LOG_DIR", (home_.path() / "log").c_str(), 1);
+    // The navigator's PTG cache of this process and its children: two tests building the
+    // shared one at once could read each other's half-written files.
+    ::setenv("XDG_CACHE_HOME", (home_.path() / "cache").c_str(), 1);
     core_ = std::make_unique<Child>(std::vector<std::string>{"roscore", "-p", std::to_string(port)},
                                     (home_.path() / "roscore.log").string());
     int argc = 0;

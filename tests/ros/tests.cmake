@@ -9,3 +9,6 @@ foreach(t ros_bag_test ros_node_test)
     add_dependencies(${t} upd)
   endif()
 endforeach()
+if(TARGET ros_node_test)  # the launch file and the node's entry script, as the build tree holds them
+  target_compile_definitions(ros_node_test PRIVATE UPD_DATA_BUILD_DIR="${UPD_DATA_BUILD_DIR}")
+endif()
