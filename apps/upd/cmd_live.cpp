@@ -5,6 +5,7 @@
 // OpenNI2 was found (libs/openni2, UPD_HAVE_OPENNI2); without it `upd live` says so.
 #include "cli.h"
 #include "commands.h"
+#include "live_base.h"
 #include "run_config.h"
 
 #include "upd/io/json_io.h"
@@ -32,7 +33,7 @@ namespace upd::app {
 
 const char* const kLiveUsage =
     "usage: upd live [--config FILE.ini] [--nav-config FILE.ini] [--oni FILE.oni] [--view]\n"
-    "                [--navigate X,Y] [--frames N] [--output DIR]\n"
+    "                [--navigate X,Y] [--base sim|ros] [--frames N] [--output DIR]\n"
     "  Reads a Kinect or Xtion through OpenNI2 (or an .oni recording), runs the UPD and the\n"
     "  traversability map on every frame and, with --navigate, drives the robot base to the\n"
     "  goal with MRPT's reactive navigator. The shipped base is simulated (it moves on the\n"
@@ -45,6 +46,8 @@ const char* const kLiveUsage =
     "  --oni FILE         play an OpenNI2 recording instead of a live device\n"
     "  --view             3D view: cloud coloured by zeta, the map, the robot, the route\n"
     "  --navigate X,Y     goal in the map frame (the robot starts at 0,0 facing +x) [m]\n"
+    "  --base sim|ros     the base driven: simulated (default) or ROS 1 (/cmd_vel out, /odom\n"
+    "                     in; docs/ROS.md)\n"
     "  --frames N         stop after N frames (default: until the end, the goal or Ctrl-C)\n"
     "  --output DIR       write map.png, summary.json and the navlog (with --navigate) at the "
     "end\n";
@@ -71,11 +74,12 @@ struct LiveOptions {
   std::optional<Eigen::Vector2d> goal;
   std::optional<std::string> out;
   bool view = false;
+  std::string base = "sim";  ///< live_base.h
 };
 
 // The command line; the default configs are looked up only when not given.
 LiveOptions parseLiveOptions(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--config", "--nav-config", "--oni", "--navigate", "--frames", "--output"},
+  const Args args(argv, {"--config", "--nav-config", "--oni", "--navigate", "--frames", "--output", "--base"},
                   {"--view"});
   if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
   LiveOptions o;
@@ -90,6 +94,7 @@ LiveOptions parseLiveOptions(const std::vector<std::string>& argv) {
   if (const auto g = args.str("--navigate")) o.goal = parseGoal(*g);
   o.out = args.str("--output");
   o.view = args.flag("--view");
+  o.base = args.str("--base").value_or("sim");
   return o;
 }
 
@@ -162,7 +167,8 @@ struct LiveRun {
       : opt(o),
         config(c),
         base({}, c.base),
-        loop(base, c, nav::ObstacleDetector::Upd,
+        external(makeLiveBase(o.base)),
+        loop(external ? *external : base, c, nav::ObstacleDetector::Upd,
              o.out && o.goal
                  ? (std::filesystem::path(*o.out) / "navigation.reactivenavlog").string()
                  : ""),
@@ -175,6 +181,7 @@ struct LiveRun {
   const LiveOptions& opt;
   const nav::NavConfig& config;
   nav::SimulatedDiffDrive base;
+  std::unique_ptr<nav::RobotBase> external;  ///< a real base (--base ros), else nullptr
   nav::NavigationLoop loop;
   std::unique_ptr<nav::LiveView> view;
   const Eigen::Isometry3d camera_on_robot;
@@ -190,13 +197,14 @@ const nav::FrameEvidence& addFrame(LiveRun& run, const openni2::DepthFrame& raw,
   run.now = Clock::now();
   const double dt = std::chrono::duration<double>(run.now - run.last).count();
   run.last = run.now;
-  if (dt > 0) run.base.advance(dt);
-  run.base.readState(s);
+  if (dt > 0 && !run.external) run.base.advance(dt);
+  nav::RobotBase& driven = run.external ? *run.external : run.base;
+  if (!driven.readState(s)) throw std::runtime_error("the robot base does not report its pose");
   const Eigen::Vector3d xy_yaw(s.pose_world_robot.x_m, s.pose_world_robot.y_m,
                                s.pose_world_robot.yaw_rad);
   const core::PointCloud cloud_world = core::transformCloud(core::depthToCloud(frame.depth, frame.K),
                                                 sim::bodyPoseFlat(xy_yaw) * run.camera_on_robot);
-  const nav::FrameEvidence& ev = run.loop.addFrame(cloud_world, run.base.timeS());
+  const nav::FrameEvidence& ev = run.loop.addFrame(cloud_world, driven.timeS());
   run.score_ms += ev.timings.total_ms;
   ++run.frames;
   return ev;

@@ -10,6 +10,7 @@
 
 #include "upd/nav/nav_config.h"
 #include "upd/ros1/conversions.h"
+#include "upd/ros1/ros_base.h"
 #include "upd/sim/render.h"
 #include "upd/sim/robot.h"
 #include "upd/sim/terrain.h"
@@ -27,6 +28,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <thread>
 
 namespace {
 
@@ -321,6 +323,42 @@ TEST_F(RosNode, StopsTheRobotWhenTheFramesStop) {
   spinUntil([] { return false; }, 0.2);
   EXPECT_EQ(out.cmd->linear.x, 0.0);
   EXPECT_EQ(out.cmd->angular.z, 0.0);
+}
+
+// The base `upd live --base ros` drives: odometry in, Twist out; none without odometry.
+TEST_F(RosNode, LiveBaseReadsOdometryAndSendsCommands) {
+  try {
+    ros1::makeRosBase({}, 0.3);
+    ADD_FAILURE() << "a base without odometry";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no odometry on /odom"), std::string::npos) << e.what();
+  }
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(1.5, -0.5, 0);
+  pose.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  std::atomic<bool> done{false};
+  std::thread odom([&] {
+    while (!done) {
+      publishOdom(pose, 0.2, 0.1, ros::Time::now());
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  {
+    const auto base = ros1::makeRosBase({}, 5.0);
+    nav::BaseState s;
+    ASSERT_TRUE(base->readState(s));
+    EXPECT_NEAR(s.pose_world_robot.x_m, 1.5, 1e-9);
+    EXPECT_NEAR(s.pose_world_robot.yaw_rad, 0.3, 1e-9);
+    EXPECT_NEAR(s.velocity.v_mps, 0.2, 1e-9);
+    ASSERT_TRUE(base->sendVelocity({0.25, -0.1}));
+    EXPECT_TRUE(spinUntil([&] { return out.cmd && out.cmd->linear.x == 0.25; }, 5.0,
+                          [&] { base->sendVelocity({0.25, -0.1}); }));
+    EXPECT_EQ(out.cmd->angular.z, -0.1);
+  }
+  done = true;
+  odom.join();
+  EXPECT_TRUE(spinUntil([&] { return out.cmd && out.cmd->linear.x == 0.0; }, 2.0))
+      << "the base stops the robot when it goes";
 }
 
 // share/ros is the ROS package upd_nav: roslaunch resolves its launch file to the entry script,
