@@ -12,8 +12,8 @@ PACKAGES=(build-essential cmake pkg-config
           libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev
           octomap-tools cloudcompare  # these two: tests open our files in them
           ros-core libroscpp-dev librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
-          libgeometry-msgs-dev libvisualization-msgs-dev libtf2-ros-dev libtf2-msgs-dev
-          python3-rosbag python3-rostopic libmrpt-ros1bridge-dev)  # ROS 1: `upd ros`, bags
+          libgeometry-msgs-dev libvisualization-msgs-dev libtf2-ros-dev libtf2-msgs-dev)
+          # ros-core ... libtf2-msgs-dev: ROS 1, `upd ros` and bags (roscore: their tests)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

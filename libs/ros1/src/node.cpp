@@ -197,7 +197,8 @@ void TraversabilityNode::Impl::processCloud(core::PointCloud cloud,
 }
 
 void TraversabilityNode::Impl::publishGrid(const ros::Time& stamp, bool force) {
-  if (!force && !last_grid.isZero() && (stamp - last_grid).toSec() < params.grid_period_s) return;
+  const double since = (stamp - last_grid).toSec();  // < 0 after a jump back (a bag replayed)
+  if (!force && !last_grid.isZero() && since >= 0 && since < params.grid_period_s) return;
   last_grid = stamp;
   nav_msgs::OccupancyGrid msg = occupancyGridFromGrid(loop.grid());
   msg.header.frame_id = world_frame;
