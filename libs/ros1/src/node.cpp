@@ -30,23 +30,11 @@ void RosNodeParams::validate() const {
 }
 
 RosNodeParams loadRosNodeParams(const ros::NodeHandle& pnh, RosNodeParams p) {
-  pnh.param("depth_topic", p.depth_topic, p.depth_topic);
-  pnh.param("camera_info_topic", p.camera_info_topic, p.camera_info_topic);
-  pnh.param("points_topic", p.points_topic, p.points_topic);
-  pnh.param("goal_topic", p.goal_topic, p.goal_topic);
-  pnh.param("grid_topic", p.grid_topic, p.grid_topic);
-  pnh.param("cloud_topic", p.cloud_topic, p.cloud_topic);
-  pnh.param("route_topic", p.route_topic, p.route_topic);
-  pnh.param("odom_frame", p.odom_frame, p.odom_frame);
-  pnh.param("cmd_vel_topic", p.base.cmd_vel_topic, p.base.cmd_vel_topic);
-  pnh.param("odom_topic", p.base.odom_topic, p.base.odom_topic);
-  pnh.param("base_frame", p.base.base_frame, p.base.base_frame);
-  pnh.param("world_frame", p.base.world_frame, p.base.world_frame);
-  pnh.param("odom_timeout_s", p.base.odom_timeout_s, p.base.odom_timeout_s);
-  pnh.param("sensor_timeout_s", p.sensor_timeout_s, p.sensor_timeout_s);
-  pnh.param("tf_timeout_s", p.tf_timeout_s, p.tf_timeout_s);
-  pnh.param("control_rate_hz", p.control_rate_hz, p.control_rate_hz);
-  pnh.param("grid_period_s", p.grid_period_s, p.grid_period_s);
+  // Every field is the private parameter of its name; nh.param keeps the default when unset.
+  const auto read = [&pnh](const char* name, auto& value, const char*) {
+    pnh.param(name, value, value);
+  };
+  p.visit(read);
   p.validate();
   return p;
 }

@@ -42,6 +42,22 @@ struct RosNodeParams {
 
   /// Throws std::invalid_argument naming the field and value.
   void validate() const;
+  template <class V>
+  void visit(V& v) {
+    v("depth_topic", depth_topic, "depth image in (sensor_msgs/Image, 16UC1 mm or 32FC1 m)");
+    v("camera_info_topic", camera_info_topic, "its camera info in");
+    v("points_topic", points_topic, "point cloud in (sensor_msgs/PointCloud2)");
+    v("goal_topic", goal_topic, "goals in (geometry_msgs/PoseStamped)");
+    v("grid_topic", grid_topic, "the traversability grid out (nav_msgs/OccupancyGrid, latched)");
+    v("cloud_topic", cloud_topic, "the scored cloud out (x y z zeta label cost)");
+    v("route_topic", route_topic, "the route out (visualization_msgs/MarkerArray)");
+    v("odom_frame", odom_frame, "the world frame when tf has no world_frame");
+    base.visit(v);
+    v("sensor_timeout_s", sensor_timeout_s, "while driving, no frame for longer stops the robot [s]");
+    v("tf_timeout_s", tf_timeout_s, "how long a frame waits for its transform [s]");
+    v("control_rate_hz", control_rate_hz, "navigator steps per second [Hz]");
+    v("grid_period_s", grid_period_s, "the grid is published at most this often [s]");
+  }
 };
 
 /// defaults overridden by the private parameters of private_nh that are set.

@@ -34,6 +34,14 @@ struct RosBaseParams {
 
   /// Throws std::invalid_argument naming the field and value.
   void validate() const;
+  template <class V>
+  void visit(V& v) {
+    v("cmd_vel_topic", cmd_vel_topic, "velocity commands out (geometry_msgs/Twist)");
+    v("odom_topic", odom_topic, "odometry in (nav_msgs/Odometry)");
+    v("base_frame", base_frame, "the robot frame in tf");
+    v("world_frame", world_frame, "the world frame when tf has it");
+    v("odom_timeout_s", odom_timeout_s, "older odometry counts as lost [s]");
+  }
 };
 
 class RosRobotBase : public nav::RobotBase {
