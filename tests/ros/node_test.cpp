@@ -283,7 +283,9 @@ TEST_F(RosNode, DrivesASimulatedBaseToAReachableGoalAndStopsThere) {
   const sim::WorldSpec world = sim::makeWorld("mixed");  // an open lane along y = 0
   SimRobot robot(*this, config, world);
   sendStatic(sim::cameraOnRobot(config.camera));
-  node = startNode(*master, {"--exit-after-goal"});
+  // Generous timeouts: on a loaded CI machine a frame may take a second to arrive (the stale
+  // case has its own test).
+  node = startNode(*master, {"--exit-after-goal", "_sensor_timeout_s:=3.0", "_odom_timeout_s:=2.0"});
   ASSERT_TRUE(spinUntil([&] { return out.grid != nullptr; }, 30, [&] { robot.tick(); }))
       << node->log();
   const Eigen::Vector2d goal = world.start_xy_yaw.head<2>() + Eigen::Vector2d(2.5, 0.0);

@@ -212,7 +212,9 @@ void TraversabilityNode::Impl::onGoal(const geometry_msgs::PoseStamped::ConstPtr
   }
   if (!basePoseKnown()) return;
   ROS_INFO("upd: goal (%.2f, %.2f) in %s: navigating", goal.x(), goal.y(), world_frame.c_str());
-  loop.navigateTo(goal.head<2>());
+  loop.navigateTo(goal.head<2>());  // the first goal builds the navigator: seconds, no spinning
+  // Staleness counts from the goal: the robot did not move while the navigator was built.
+  if (last_frame) last_frame = ros::Time::now();
   driving = true;
   goal_end.reset();
   publishRoute();
