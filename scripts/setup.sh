@@ -9,8 +9,9 @@ UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 UPD_BUILD="${UPD_BUILD:-$UPD_ROOT/build}"
 PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
-          libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev
-          octomap-tools cloudcompare  # these two: tests open our files in them
+          libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev
+          libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
+          octomap-tools cloudcompare gdal-bin mrpt-apps  # these four: tests open our files in them
           ros-core libroscpp-dev librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
           libgeometry-msgs-dev libvisualization-msgs-dev libtf2-ros-dev libtf2-msgs-dev)
           # ros-core ... libtf2-msgs-dev: ROS 1, `upd ros` and bags (roscore: their tests)

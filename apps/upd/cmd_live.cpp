@@ -1,23 +1,28 @@
-// `upd live`: a Kinect or Xtion (or an .oni recording) through OpenNI2, the UPD and the fused
-// map at sensor rate, an optional 3D view, and navigation to a goal through a RobotBase. The
-// base shipped is the simulated differential drive (robot_base.h): integrators replace it with
-// their robot's (docs/NAVIGATION.md, "Driving a real robot"). The camera input is built when
-// OpenNI2 was found (libs/openni2, UPD_HAVE_OPENNI2); without it `upd live` says so.
+// `upd live`: frames from a live source (live_source.h: OpenNI2, libfreenect, or any MRPT
+// sensor file), each scored as `upd playback` scores a rawlog's observation (observation ->
+// cloud in the robot frame -> world frame at the base's pose) and fused into the map at sensor
+// rate, an optional 3D view, navigation to a goal through a RobotBase, an optional recording
+// (rawlog_writer.h) and a watchdog that stops the robot when the source stops
+// (live_watchdog.h). The base shipped is the simulated differential drive (robot_base.h):
+// integrators replace it with their robot's (docs/NAVIGATION.md, "Driving a real robot").
 #include "cli.h"
 #include "commands.h"
 #include "live_base.h"
+#include "live_options.h"
+#include "live_source.h"
+#include "live_watchdog.h"
 #include "run_config.h"
 
 #include "upd/io/json_io.h"
 #include "upd/maps/grid_export.h"
+#include "upd/mrpt_bridge/observation_cloud.h"
+#include "upd/mrpt_bridge/rawlog_writer.h"
 #include "upd/nav/live_view.h"
 #include "upd/nav/nav_config.h"
 #include "upd/nav/navigation_loop.h"
 #include "upd/sim/robot.h"
 
-#ifdef UPD_HAVE_OPENNI2
-#include "upd/openni2/depth_camera.h"
-#endif
+#include <mrpt/obs/CObservation.h>
 
 #include <atomic>
 #include <chrono>
@@ -25,87 +30,60 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
-#include <sstream>
 
 namespace upd::app {
 
 const char* const kLiveUsage =
-    "usage: upd live [--config FILE.ini] [--nav-config FILE.ini] [--oni FILE.oni] [--view]\n"
-    "                [--navigate X,Y] [--base sim|ros] [--frames N] [--output DIR]\n"
-    "  Reads a Kinect or Xtion through OpenNI2 (or an .oni recording), runs the UPD and the\n"
-    "  traversability map on every frame and, with --navigate, drives the robot base to the\n"
-    "  goal with MRPT's reactive navigator. The shipped base is simulated (it moves on the\n"
-    "  velocity commands, the camera does not): see docs/NAVIGATION.md to plug in a real one.\n"
-    "  Without a device (and no --oni) it says so and exits with status 1. Ctrl-C stops.\n\n"
+    "usage: upd live [SOURCE] [--config FILE.ini] [--nav-config FILE.ini] [--view]\n"
+    "                [--navigate X,Y] [--frames N] [--output DIR] [--record RUN.rawlog]\n"
+    "                [--stale-timeout S] [--base sim|ros]\n"
+    "  Reads a live source, runs the UPD and the traversability map on every frame and, with\n"
+    "  --navigate, drives the robot base to the goal with MRPT's reactive navigator. The shipped\n"
+    "  base is simulated (it moves on the velocity commands, the camera does not): see\n"
+    "  docs/NAVIGATION.md to plug in a real one. Ctrl-C stops. Devices and routes:\n"
+    "  docs/SENSORS.md.\n\n"
+    "SOURCE (one of; default: the first OpenNI2 device):\n"
+    "  --oni FILE.oni         an OpenNI2 recording (OpenNI2 devices: Xtion, Carmine, PS1080)\n"
+    "  --kinect [INDEX]       a Kinect v1 through libfreenect (default index 0)\n"
+    "  --sensors FILE.ini     a sensor section of an MRPT rawlog-grabber file (stereo cameras,\n"
+    "                         Velodyne, COpenNI2Sensor, image folders, rawlogs, ...)\n"
+    "  --sensor-section NAME  its section, when the file has several\n\n"
     "options:\n"
     "  --config FILE      robot config (default config/dune-kinect.ini)\n"
     "  --nav-config FILE  navigation config: camera mount, obstacles, navigator\n"
     "                     (default config/dune-nav.ini)\n"
-    "  --oni FILE         play an OpenNI2 recording instead of a live device\n"
     "  --view             3D view: cloud coloured by zeta, the map, the robot, the route\n"
-    "  --navigate X,Y     goal in the map frame (the robot starts at 0,0 facing +x) [m]\n"
     "  --base sim|ros     the base driven: simulated (default) or ROS 1 (/cmd_vel out, /odom\n"
     "                     in; docs/ROS.md)\n"
+    "  --navigate X,Y     goal in the map frame (the robot starts at 0,0 facing +x) [m]\n"
     "  --frames N         stop after N frames (default: until the end, the goal or Ctrl-C)\n"
-    "  --output DIR       write map.png, summary.json and the navlog (with --navigate) at the "
-    "end\n";
+    "  --output DIR       write map.png, map.pgm + map.yaml, summary.json and the navlog\n"
+    "                     (with --navigate) at the end\n"
+    "  --record RUN.rawlog  write every observation and the base's odometry as an MRPT rawlog\n"
+    "                     (RUN.rawlog.part while running, renamed at the end; `upd playback`\n"
+    "                     replays it)\n"
+    "  --stale-timeout S  the source counts as stopped when no new frame came for S seconds\n"
+    "                     (default 1): the robot is stopped and the run ends\n\n"
+    "exit status: 0 done; 1 error (a source that cannot be opened, ...); 2 usage error;\n"
+    "3 --navigate did not reach the goal; 4 the source stopped (the robot was stopped).\n";
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-Eigen::Vector2d parseGoal(const std::string& text) {
-  std::istringstream is(text);
-  double x = 0, y = 0;
-  char comma = 0;
-  if (!(is >> x >> comma >> y) || comma != ',' || !(is >> std::ws).eof() || !std::isfinite(x) ||
-      !std::isfinite(y)) {
-    throw UsageError("option --navigate = '" + text + "': expected X,Y in metres");
-  }
-  return {x, y};
-}
-
-struct LiveOptions {
-  std::string config_path, nav_path;
-  std::string oni;     ///< empty: the first connected device
-  int max_frames = 0;  ///< 0: no limit
-  std::optional<Eigen::Vector2d> goal;
-  std::optional<std::string> out;
-  bool view = false;
-  std::string base = "sim";  ///< live_base.h
-};
-
-// The command line; the default configs are looked up only when not given.
-LiveOptions parseLiveOptions(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--config", "--nav-config", "--oni", "--navigate", "--frames", "--output", "--base"},
-                  {"--view"});
-  if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
-  LiveOptions o;
-  const auto config = args.str("--config");
-  o.config_path = config ? *config : nav::defaultConfigDir() + "/dune-kinect.ini";
-  const auto nav_config = args.str("--nav-config");
-  o.nav_path = nav_config ? *nav_config : nav::defaultConfigDir() + "/dune-nav.ini";
-  o.oni = args.str("--oni").value_or("");
-  o.max_frames = args.integer("--frames").value_or(0);
-  if (o.max_frames < 0)
-    throw UsageError("option --frames = " + std::to_string(o.max_frames) + ": must be >= 0");
-  if (const auto g = args.str("--navigate")) o.goal = parseGoal(*g);
-  o.out = args.str("--output");
-  o.view = args.flag("--view");
-  o.base = args.str("--base").value_or("sim");
-  return o;
-}
-
-#ifdef UPD_HAVE_OPENNI2
+constexpr int kExitSourceStopped = 4;
 
 /// What one run did, for the summary line and summary.json.
 struct LiveTally {
-  std::string end;
+  std::string source, end;
   int frames = 0;
   double seconds = 0;
   double score_ms = 0;  ///< summed over the frames
+  std::map<std::string, std::size_t> skipped;  ///< observations that gave no cloud, by reason
+  std::optional<SourceStall> stall;
+  std::size_t recorded = 0;
   nav::NavOutcome outcome;
 };
 
@@ -113,24 +91,39 @@ void printSummary(const LiveTally& t, const maps::GridStats& stats) {
   std::printf("%s: %d frames in %.1f s (%.1f Hz), map %zu known cells (%zu non-traversable)\n",
               t.end.c_str(), t.frames, t.seconds, t.seconds > 0 ? t.frames / t.seconds : 0.0,
               stats.known, stats.non_traversable);
+  for (const auto& [reason, n] : t.skipped) std::printf("  skipped %zu: %s\n", n, reason.c_str());
   if (!t.outcome.error_code.empty()) {
     std::printf("  navigator: %s %s: %s\n", nav::toString(t.outcome.state),
                 t.outcome.error_code.c_str(), t.outcome.error_message.c_str());
   }
 }
 
-// map.png and summary.json in dir.
+nlohmann::json stallJson(const SourceStall& s, double timeout_s) {
+  return {{"detected_at_s", s.at_s},     {"silent_s", s.silent_s},
+          {"timeout_s", timeout_s},      {"new_frames", s.new_frames},
+          {"stale_frames", s.stale_frames}, {"robot_stopped", s.robot_stopped},
+          {"message", s.line()}};
+}
+
+// map.png, map.pgm + map.yaml and summary.json in dir.
 void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTally& t,
                       const maps::TraversabilityGrid& grid, const maps::GridStats& stats) {
-  std::filesystem::create_directories(dir);
-  maps::writeColourPng(grid, (std::filesystem::path(dir) / "map.png").string());
+  namespace fs = std::filesystem;
+  fs::create_directories(dir);
+  maps::writeColourPng(grid, (fs::path(dir) / "map.png").string());
+  maps::writeRosMap(grid, (fs::path(dir) / "map").string());
   nlohmann::json j;
+  j["source"] = t.source;
   j["end"] = t.end;
   j["frames"] = t.frames;
   j["seconds"] = t.seconds;
   j["mean_frame_scoring_ms"] = t.frames > 0 ? t.score_ms / t.frames : 0.0;
+  j["frames_skipped"] = nlohmann::json::object();
+  for (const auto& [reason, n] : t.skipped) j["frames_skipped"][reason] = n;
   j["map_known_cells"] = stats.known;
   j["map_non_traversable_cells"] = stats.non_traversable;
+  j["source_stopped"] = t.stall ? stallJson(*t.stall, o.stale_timeout_s) : nlohmann::json();
+  if (o.record) j["recording"] = {{"path", *o.record}, {"observations", t.recorded}};
   if (o.goal) {
     j["goal_xy_m"] = {o.goal->x(), o.goal->y()};
     j["navigator"] = {{"state", nav::toString(t.outcome.state)},
@@ -138,7 +131,7 @@ void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTa
                       {"error_code", t.outcome.error_code},
                       {"error_message", t.outcome.error_message}};
   }
-  io::writeJsonAtomically((std::filesystem::path(dir) / "summary.json").string(), j);
+  io::writeJsonAtomically((fs::path(dir) / "summary.json").string(), j);
   std::printf("  outputs in %s\n", dir.c_str());
 }
 
@@ -161,53 +154,76 @@ class StopOnSignal {
   StopOnSignal& operator=(const StopOnSignal&) = delete;
 };
 
-// The robot, the navigation loop and the view of one run, and its counters.
+// The robot, the navigation loop, the view and the recording of one run, and its counters.
 struct LiveRun {
-  LiveRun(const LiveOptions& o, const nav::NavConfig& c)
+  LiveRun(const LiveOptions& o, const nav::NavConfig& c, const mrpt_bridge::SourceParams& sp)
       : opt(o),
         config(c),
+        source_params(sp),
         base({}, c.base),
         external(makeLiveBase(o.base)),
         loop(external ? *external : base, c, nav::ObstacleDetector::Upd,
              o.out && o.goal
                  ? (std::filesystem::path(*o.out) / "navigation.reactivenavlog").string()
-                 : ""),
-        camera_on_robot(sim::cameraOnRobot(c.camera)) {
+                 : "") {
     if (o.view) view = std::make_unique<nav::LiveView>("upd live", c.body);
+    if (o.record) recorder.emplace(*o.record);
     if (o.goal) loop.navigateTo(*o.goal);
     t0 = last = last_report = now = Clock::now();  // the run starts after the set-up
+  }
+  double secondsSinceStart() const {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
   }
 
   const LiveOptions& opt;
   const nav::NavConfig& config;
+  const mrpt_bridge::SourceParams& source_params;
   nav::SimulatedDiffDrive base;
   std::unique_ptr<nav::RobotBase> external;  ///< a real base (--base ros), else nullptr
   nav::NavigationLoop loop;
   std::unique_ptr<nav::LiveView> view;
-  const Eigen::Isometry3d camera_on_robot;
+  std::optional<mrpt_bridge::RawlogWriter> recorder;
+  mrpt_bridge::ObservationCloud converted;  ///< reused frame to frame
   Clock::time_point t0, last, last_report, now;
   int frames = 0;
   double score_ms = 0;
+  std::map<std::string, std::size_t> skipped;
 };
 
-// Scores one camera frame into the map at the base's pose, advanced to the frame's arrival.
-const nav::FrameEvidence& addFrame(LiveRun& run, const openni2::DepthFrame& raw,
+// The base's pose at the frame (before it) and the observation, into the recording.
+void recordFrame(LiveRun& run, const mrpt::obs::CObservation& obs, const nav::BaseState& s) {
+  if (!run.recorder) return;
+  const double t = obs.timestamp == INVALID_TIMESTAMP ? mrpt::Clock::toDouble(mrpt::Clock::now())
+                                                       : mrpt::Clock::toDouble(obs.timestamp);
+  run.recorder->writeOdometry(s.pose_world_robot.x_m, s.pose_world_robot.y_m,
+                              s.pose_world_robot.yaw_rad, t);
+  run.recorder->write(obs);
+}
+
+// Scores one observation into the map at the base's pose, advanced to the frame's arrival;
+// nullptr (counted) when the observation gives no cloud.
+const nav::FrameEvidence* addFrame(LiveRun& run, const mrpt::obs::CObservation& obs,
                                    nav::BaseState& s) {
-  const openni2::DepthFrame frame = openni2::decimate(raw, run.config.camera.image_downscale);
   run.now = Clock::now();
   const double dt = std::chrono::duration<double>(run.now - run.last).count();
   run.last = run.now;
   if (dt > 0 && !run.external) run.base.advance(dt);
   nav::RobotBase& driven = run.external ? *run.external : run.base;
   if (!driven.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  recordFrame(run, obs, s);
+  mrpt_bridge::toCloud(obs, run.source_params, run.converted);
+  if (!run.converted.ok()) {
+    ++run.skipped[run.converted.skipped_reason];
+    return nullptr;
+  }
   const Eigen::Vector3d xy_yaw(s.pose_world_robot.x_m, s.pose_world_robot.y_m,
                                s.pose_world_robot.yaw_rad);
-  const core::PointCloud cloud_world = core::transformCloud(core::depthToCloud(frame.depth, frame.K),
-                                                sim::bodyPoseFlat(xy_yaw) * run.camera_on_robot);
+  const core::PointCloud cloud_world =
+      core::transformCloud(run.converted.cloud_in_robot, sim::bodyPoseFlat(xy_yaw));
   const nav::FrameEvidence& ev = run.loop.addFrame(cloud_world, driven.timeS());
   run.score_ms += ev.timings.total_ms;
   ++run.frames;
-  return ev;
+  return &ev;
 }
 
 // The navigator's step and the view after a frame: why the run ends, or nothing.
@@ -240,68 +256,85 @@ void reportProgress(LiveRun& run, const nav::FrameEvidence& ev, const nav::BaseS
   std::fflush(stdout);
 }
 
-// Frames until the limit, the end of the recording, the goal, the window closing or a signal.
-std::string runFrames(LiveRun& run, openni2::OpenNI2Camera& camera) {
-  openni2::DepthFrame raw;
-  while (!g_stop) {
+// Frames until the limit, the end of a recording, the goal, the window closing, a signal or
+// the source stopping (then the robot is stopped and t.stall says so).
+std::string runFrames(LiveRun& run, LiveSource& source, LiveTally& t) {
+  SourceWatchdog watchdog(run.opt.stale_timeout_s, 0.0);
+  const std::function<double()> now_s = [&run] { return run.secondsSinceStart(); };
+  LiveFrame frame;
+  while (true) {
     if (run.opt.max_frames > 0 && run.frames >= run.opt.max_frames) return "frame limit";
-    if (!camera.read(raw)) return "end of the recording";
+    SourceStall stall;
+    switch (nextFreshFrame(source, watchdog, run.base, now_s, g_stop, frame, stall)) {
+      case NextFrame::End:
+        return "end of the recording";
+      case NextFrame::Interrupted:
+        return "interrupted";
+      case NextFrame::Stalled:
+        std::fprintf(stderr, "upd live: %s: %s\n", source.description().c_str(),
+                     stall.line().c_str());
+        t.stall = stall;
+        return "source stopped";
+      case NextFrame::Fresh:
+        break;
+    }
     nav::BaseState s;
-    const nav::FrameEvidence& ev = addFrame(run, raw, s);
-    if (const auto end = afterFrame(run, ev, s)) return *end;
-    reportProgress(run, ev, s);
+    const nav::FrameEvidence* ev = addFrame(run, *frame.observation, s);
+    if (!ev) continue;
+    if (const auto end = afterFrame(run, *ev, s)) return *end;
+    reportProgress(run, *ev, s);
   }
-  return "interrupted";
 }
 
 // The summary line, the outputs and the exit status of a run.
 int finishLive(const LiveOptions& o, const LiveTally& t, const maps::TraversabilityGrid& grid) {
   const auto stats = maps::computeStats(grid);
   printSummary(t, stats);
+  if (o.record) std::printf("  recorded %zu observations to %s\n", t.recorded, o.record->c_str());
   if (o.out) writeLiveOutputs(*o.out, o, t, grid, stats);
+  if (t.stall) return kExitSourceStopped;
   if (o.goal) return t.outcome.target_reached ? 0 : 3;
   return 0;
 }
 
-// Runs the camera through the loop until it stops.
-int runCamera(const LiveOptions& o, const nav::NavConfig& config) {
-  openni2::OpenNI2Camera camera(o.oni);  // one line and status 1 if none
-  std::printf("camera: %s\n", camera.description().c_str());
-  LiveRun run(o, config);
+// Runs the source through the loop until it stops.
+int runSource(const LiveOptions& o, const nav::NavConfig& config, const RunConfig& run_config) {
+  const auto source =
+      openLiveSource(o, sim::mountOnRobot(config.camera), config.camera.image_downscale);
+  std::printf("source: %s\n", source->description().c_str());
+  LiveRun run(o, config, run_config.observer.source);
   LiveTally t;
+  t.source = source->description();
   {
     const StopOnSignal stop_on_signal;
-    t.end = runFrames(run, camera);
+    t.end = runFrames(run, *source, t);
     if (g_stop) t.end = "interrupted";
     t.outcome = run.loop.outcome();
     run.loop.finish();
   }
-  t.seconds = std::chrono::duration<double>(Clock::now() - run.t0).count();
+  if (run.recorder) {
+    t.recorded = run.recorder->written();
+    run.recorder->finish();
+  }
+  t.seconds = run.secondsSinceStart();
   t.frames = run.frames;
   t.score_ms = run.score_ms;
+  t.skipped = run.skipped;
   return finishLive(o, t, run.loop.grid());
 }
-
-#else
-
-int runCamera(const LiveOptions& o, const nav::NavConfig&) {
-  const std::string why = "upd was built without OpenNI2 (install libopenni2-dev and rebuild)";
-  throw std::runtime_error(o.oni.empty() ? "no OpenNI2 depth camera input: " + why
-                                         : "cannot play " + o.oni + ": " + why);
-}
-
-#endif
 
 }  // namespace
 
 int runLive(const std::vector<std::string>& argv) {
   const LiveOptions o = parseLiveOptions(argv);
-  loadRunConfig(o.config_path);  // the shared robot config, checked strictly as every command does
+  // The shared robot config, checked strictly as every command does; its [SourceParams] say
+  // how observations become clouds.
+  const RunConfig run_config = loadRunConfig(o.config_path);
   const nav::NavConfig config = nav::loadNavConfig(o.config_path, o.nav_path);
   if (o.view && !nav::displayAvailable()) {
     throw std::runtime_error("--view needs a display (neither DISPLAY nor WAYLAND_DISPLAY is set)");
   }
-  return runCamera(o, config);
+  return runSource(o, config, run_config);
 }
 
 }  // namespace upd::app

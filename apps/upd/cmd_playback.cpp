@@ -6,11 +6,14 @@
 // exits kExitPartial (playback_damage.h).
 #include "cli.h"
 #include "commands.h"
+#include "map_folder.h"
 #include "playback_bag.h"
 #include "playback_damage.h"
+#include "playback_merge.h"
 #include "run_config.h"
 
 #include "upd/core/stopwatch.h"
+#include "upd/gdal/geotiff.h"
 #include "upd/io/atomic_file.h"
 #include "upd/io/cloud_io.h"
 #include "upd/io/json_io.h"
@@ -22,17 +25,11 @@
 #include "upd/mrpt_bridge/simulated_run.h"
 
 #include <mrpt/io/CFileGZOutputStream.h>
-#include <mrpt/io/CMemoryStream.h>
-#include <mrpt/io/zip.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CSensoryFrame.h>
-#include <mrpt/opengl/CGridPlaneXY.h>
-#include <mrpt/opengl/COpenGLScene.h>
-#include <mrpt/opengl/CPointCloudColoured.h>
-#include <mrpt/opengl/CSetOfLines.h>
 #include <mrpt/poses/CPose2D.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -50,22 +47,28 @@
 namespace upd::app {
 
 const char* const kPlaybackUsage =
-    "usage: upd playback RAWLOG|RUN.bag --config FILE.ini --output DIR [options]\n"
+    "usage: upd playback RAWLOG... --config FILE.ini --output DIR [options]\n"
     "  Replays RAWLOG (either rawlog layout): UPD for every 3D observation in the world frame,\n"
-    "  fused over time into a 2.5D traversability grid and an OctoMap tree. Writes into DIR:\n"
-    "  map.png (colour, with legend), map.pgm + map.yaml (ROS map_server), map.ot (OctoMap\n"
+    "  fused over time into a 2.5D traversability grid and an OctoMap tree; several RAWLOGs\n"
+    "  (runs of one site in one world frame) are fused one after the other into one map.\n"
+    "  Writes into DIR: map.png (colour, with legend), map.pgm + map.yaml (ROS map_server,\n"
+    "  trinary), map_cost.pgm + map_cost.yaml (ROS, graded: mode scale), map.tif (GeoTIFF, one\n"
+    "  band per layer, for GIS tools), map.ot (OctoMap\n"
     "  ColorOcTree coloured by traversability, for every OctoMap tool; map_colour.ot is the same\n"
     "  file), map_traversability.ot (the full tree, read with upd::maps::readTraversabilityOt),\n"
     "  map.bt (occupancy), map.3Dscene (MRPT SceneViewer3D) and summary.json.\n"
-    "  A ROS 1 bag (depth Image + CameraInfo or PointCloud2, tf for the poses) is first\n"
-    "  converted to DIR/bag.rawlog and DIR/bag_poses.tum (docs/ROS.md).\n\n"
+    "  A ROS 1 bag (depth Image + CameraInfo or PointCloud2, tf for the poses; on its own) is\n"
+    "  first converted to DIR/bag.rawlog and DIR/bag_poses.tum (docs/ROS.md).\n\n"
     "options:\n"
     "  --config FILE.ini   robot/sensor parameters (config/dune-kinect.ini, ...) (required)\n"
     "  --output DIR        output directory, created if missing (required)\n"
     "  --from N --to M     observations N..M only (0-based, inclusive)\n"
     "  --every K           every K-th observation\n"
     "  --poses FILE.tum    robot poses from a ground-truth file (TUM: t x y z qx qy qz qw)\n"
-    "                      instead of the rawlog's odometry\n"
+    "                      instead of the rawlog's odometry; with several RAWLOGs one file\n"
+    "                      per rawlog, comma-separated (A.tum,B.tum)\n"
+    "  --epsg CODE         the poses are in this projected CRS (e.g. 32633: UTM 33N easting/\n"
+    "                      northing [m]); map.tif carries it\n"
     "  --truth FILE.yaml   ground-truth traversability grid to score the map against\n"
     "                      (default: RAWLOG's .truth.yaml sidecar when present)\n"
     "  --ply               also write every frame's scored cloud as DIR/frames/NNNNNN.ply\n"
@@ -87,12 +90,14 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 struct PlaybackOptions {
-  std::string rawlog;
+  std::string rawlog;                ///< the run being played (the first one until then)
+  std::vector<std::string> rawlogs;  ///< every RAWLOG given, fused into one map
   std::string config_path;
   fs::path out_dir;
   long from = 0, to = -1, every = 1;  ///< to < 0: to the end
   std::optional<std::string> poses_path;
   std::optional<std::string> truth_path;
+  int epsg = 0;  ///< CRS of map.tif (0: none)
   bool ply = false, output_rawlog = false, quiet = false, strict = false;
 
   /// Entry idx is inside --from/--to/--every.
@@ -103,13 +108,15 @@ struct PlaybackOptions {
 
 PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   const Args args(argv,
-                  {"--config", "--output", "--from", "--to", "--every", "--poses", "--truth"},
+                  {"--config", "--output", "--from", "--to", "--every", "--poses", "--truth",
+                   "--epsg"},
                   {"--ply", "--output-rawlog", "--quiet", "--strict"});
-  if (args.positionals().size() != 1) throw UsageError("expected exactly one RAWLOG");
+  if (args.positionals().empty()) throw UsageError("expected at least one RAWLOG");
   if (!args.has("--config")) throw UsageError("--config FILE.ini is required");
   if (!args.has("--output")) throw UsageError("--output DIR is required");
   PlaybackOptions o;
-  o.rawlog = args.positionals()[0];
+  o.rawlogs = args.positionals();
+  o.rawlog = o.rawlogs[0];
   o.config_path = *args.str("--config");
   o.out_dir = *args.str("--output");
   o.from = args.integer("--from").value_or(0);
@@ -124,6 +131,7 @@ PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   }
   o.poses_path = args.str("--poses");
   o.truth_path = args.str("--truth");
+  o.epsg = args.integer("--epsg").value_or(0);
   o.ply = args.flag("--ply");
   o.output_rawlog = args.flag("--output-rawlog");
   o.quiet = args.flag("--quiet");
@@ -165,53 +173,6 @@ json truthJson(const maps::TraversabilityGrid& grid, const Truth& truth, double 
           {"tolerance_m", tolerance_m},
           {"scores", scoresJson(maps::evaluateGrid(grid, label_at, tolerance_m))},
           {"scores_strict", scoresJson(maps::evaluateGrid(grid, label_at, 0.0))}};
-}
-
-std::shared_ptr<mrpt::opengl::CPointCloudColoured> gridCells(
-    const maps::TraversabilityGrid& grid) {
-  auto cells = mrpt::opengl::CPointCloudColoured::Create();
-  cells->setPointSize(4.0f);
-  maps::forEachKnownCell(grid, [&](int cx, int cy, const maps::GridCell& c) {
-    const auto xy = grid.cellCenter(cx, cy);
-    const auto rgb = maps::traversabilityColourRgb(maps::probabilityOf(c, grid.params()));
-    const float z = std::isfinite(c.elevation_m) ? c.elevation_m : 0.f;
-    cells->push_back(static_cast<float>(xy.x()), static_cast<float>(xy.y()), z, rgb[0] / 255.f,
-                     rgb[1] / 255.f, rgb[2] / 255.f);
-  });
-  return cells;
-}
-
-// The grid's known cells and the trajectory as an MRPT scene (SceneViewer3D), written as
-// COpenGLScene::saveToFile does (gzip, level 1) but through io::writeFileAtomically.
-void write3DScene(const maps::TraversabilityGrid& grid,
-                  const std::vector<Eigen::Vector3d>& trajectory, const std::string& path) {
-  mrpt::opengl::COpenGLScene scene;
-  auto plane = mrpt::opengl::CGridPlaneXY::Create(
-      static_cast<float>(grid.xMin()), static_cast<float>(grid.xMax()),
-      static_cast<float>(grid.yMin()), static_cast<float>(grid.yMax()), 0, 1.0f);
-  plane->setColor(0.7, 0.7, 0.7, 0.4);
-  scene.insert(plane);
-  scene.insert(gridCells(grid));
-  auto path_lines = mrpt::opengl::CSetOfLines::Create();
-  path_lines->setColor(0.1, 0.2, 0.9);
-  path_lines->setLineWidth(3);
-  for (std::size_t k = 1; k < trajectory.size(); ++k) {
-    const auto& a = trajectory[k - 1];
-    const auto& b = trajectory[k];
-    path_lines->appendLine(a.x(), a.y(), a.z() + 0.05, b.x(), b.y(), b.z() + 0.05);
-  }
-  scene.insert(path_lines);
-  mrpt::io::CMemoryStream mem;
-  mrpt::serialization::archiveFrom(mem) << scene;
-  const auto* bytes = static_cast<const std::uint8_t*>(mem.getRawBufferData());
-  const std::vector<std::uint8_t> raw(bytes, bytes + mem.getTotalBytesCount());
-  std::vector<std::uint8_t> gz;
-  if (!mrpt::io::zip::compress_gz_data_block(raw, gz, 1)) {
-    throw std::runtime_error("cannot compress " + path);
-  }
-  io::writeFileAtomically(path, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(gz.data()), static_cast<std::streamsize>(gz.size()));
-  });
 }
 
 // The annotated rawlog, written frame by frame to a temporary file that commit() renames over
@@ -455,42 +416,6 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
   run.pose_source = mrpt_bridge::toString(tracker.kind());
 }
 
-// Writes every map file into out_dir.
-void exportMaps(Playback& run, const fs::path& out_dir) {
-  const std::string map = (out_dir / "map").string();
-  maps::writeColourPng(run.grid, map + ".png");
-  maps::writeRosMap(run.grid, map);
-  run.tree.updateInnerOccupancy();
-  // map.ot is a standard ColorOcTree so that convert_octree, octovis and AbstractOcTree::read
-  // open it; the custom node type would need our library registered in the reading program.
-  maps::writeColourOt(run.tree, map + ".ot");
-  maps::writeColourOt(run.tree, map + "_colour.ot");  // the name earlier versions wrote
-  maps::writeTraversabilityOt(run.tree, map + "_traversability.ot");
-  maps::writeOccupancyBt(run.tree, map + ".bt");
-  write3DScene(run.grid, run.trajectory, map + ".3Dscene");
-}
-
-json gridJson(const maps::TraversabilityGrid& grid) {
-  const maps::GridStats gs = maps::computeStats(grid);
-  return {{"cell_size_m", grid.cellSize()},
-          {"cells", gs.cells},
-          {"known", gs.known},
-          {"traversable", gs.traversable},
-          {"non_traversable", gs.non_traversable},
-          {"memory_bytes", gs.memory_bytes},
-          {"x_min_m", grid.xMin()}, {"y_min_m", grid.yMin()},
-          {"x_max_m", grid.xMax()}, {"y_max_m", grid.yMax()}};
-}
-
-json octreeJson(const maps::TraversabilityOcTree& tree) {
-  const maps::OctreeStats os = maps::computeStats(tree);
-  return {{"resolution_m", tree.getResolution()},
-          {"leaves", os.leaves},
-          {"occupied_leaves", os.occupied_leaves},
-          {"non_traversable_leaves", os.non_traversable_leaves},
-          {"memory_bytes", os.memory_bytes}};
-}
-
 json summaryJson(const PlaybackOptions& o, const RunConfig& config, Playback& run,
                  const Truth& truth, double wall_time_s) {
   json summary;
@@ -514,9 +439,9 @@ json summaryJson(const PlaybackOptions& o, const RunConfig& config, Playback& ru
   if (truth.grid) {
     summary["ground_truth"] = truthJson(run.grid, truth, config.evaluation.tolerance_m);
   }
-  summary["outputs"] = {"map.png", "map.pgm",       "map.yaml",
-                        "map.ot",  "map_colour.ot", "map_traversability.ot",
-                        "map.bt",  "map.3Dscene"};
+  if (o.rawlogs.size() > 1) summary["rawlogs"] = o.rawlogs;
+  if (o.epsg != 0) summary["epsg"] = o.epsg;
+  summary["outputs"] = mapFileNames();
   return summary;
 }
 
@@ -541,19 +466,33 @@ int runPlayback(const std::vector<std::string>& argv) {
   const core::Stopwatch wall;
   PlaybackOptions options = parsePlaybackOptions(argv);
   const RunConfig config = loadRunConfig(options.config_path);
-  if (const auto bag = convertBagInput(options.rawlog, options.out_dir)) {  // playback_bag.h
-    options.rawlog = bag->rawlog;
-    if (!options.poses_path) options.poses_path = bag->poses;
-    if (!options.quiet) std::printf("%s\n", bag->summary.c_str());
+  for (auto& input : options.rawlogs) {  // a ROS 1 bag becomes a rawlog (playback_bag.h)
+    if (const auto bag = convertBagInput(input, options.out_dir)) {
+      if (options.rawlogs.size() > 1) throw UsageError("a bag is played on its own: " + input);
+      input = options.rawlog = bag->rawlog;
+      if (!options.poses_path) options.poses_path = bag->poses;
+      if (!options.quiet) std::printf("%s\n", bag->summary.c_str());
+    }
   }
-  mrpt_bridge::RobotPoseTracker tracker = poseTracker(options, config);
+  if (options.epsg != 0) gdal::validateEpsg(options.epsg);
+  const std::vector<PlaybackRun> runs =
+      playbackRuns(options.rawlogs, options.poses_path, options.ply || options.output_rawlog);
+  std::vector<PlaybackOptions> per_run(runs.size(), options);
+  std::vector<mrpt_bridge::RobotPoseTracker> trackers;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    per_run[k].rawlog = runs[k].rawlog;
+    per_run[k].poses_path = runs[k].poses_path;
+    trackers.push_back(poseTracker(per_run[k], config));
+  }
   const Truth truth = loadTruth(options);
   fs::create_directories(options.out_dir);
   if (options.ply) fs::create_directories(options.out_dir / "frames");
 
   Playback run(config);
-  playFrames(options, config, tracker, run);
-  exportMaps(run, options.out_dir);
+  for (std::size_t k = 0; k < runs.size() && !run.damage; ++k) {
+    playFrames(per_run[k], config, trackers[k], run);
+  }
+  writeMapFiles(run.grid, run.tree, run.trajectory, options.out_dir, options.epsg);
   const json summary = summaryJson(options, config, run, truth, wall.elapsedMs() / 1000.0);
   io::writeJsonAtomically((options.out_dir / "summary.json").string(), summary);
   printSummary(options, summary, config.evaluation.tolerance_m);

@@ -21,6 +21,7 @@ int runSimulate(const std::vector<std::string>& args);
 int runPlayback(const std::vector<std::string>& args);
 int runNavigate(const std::vector<std::string>& args);
 int runLive(const std::vector<std::string>& args);
+int runMap(const std::vector<std::string>& args);
 int runRos(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
@@ -30,6 +31,7 @@ extern const char* const kSimulateUsage;
 extern const char* const kPlaybackUsage;
 extern const char* const kNavigateUsage;
 extern const char* const kLiveUsage;
+extern const char* const kMapUsage;
 extern const char* const kRosUsage;
 
 }  // namespace upd::app

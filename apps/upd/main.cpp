@@ -25,6 +25,8 @@ const Command kCommands[] = {
      upd::app::kNavigateUsage, upd::app::runNavigate},
     {"live", "UPD, map and navigation on a live OpenNI2 depth camera (or an .oni file)",
      upd::app::kLiveUsage, upd::app::runLive},
+    {"map", "map folders: info, merge runs of one site, crop a region",
+     upd::app::kMapUsage, upd::app::runMap},
     {"ros", "ROS 1 node: depth/cloud topics in, map, cloud and route out, goals driven",
      upd::app::kRosUsage, upd::app::runRos},
     {"params", "list every parameter with its ini section, default and unit",

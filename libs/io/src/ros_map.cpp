@@ -38,26 +38,33 @@ core::Label RosMap::labelAt(double x, double y) const {
   return at(ix, iy);
 }
 
-void writeRosMap(const RosMap& map, const std::string& yaml_path) {
-  if (map.width < 0 || map.height < 0 ||
-      map.labels.size() != static_cast<std::size_t>(map.width) * map.height) {
-    throw std::invalid_argument(
-        "writeRosMap " + yaml_path + ": " + std::to_string(map.labels.size()) + " labels for a " +
-        std::to_string(map.width) + " x " + std::to_string(map.height) + " map");
+namespace {
+
+void checkMapShape(const std::string& yaml_path, int width, int height, std::size_t cells,
+                   double resolution_m) {
+  if (width < 0 || height < 0 || cells != static_cast<std::size_t>(width) * height) {
+    throw std::invalid_argument("writeRosMap " + yaml_path + ": " + std::to_string(cells) +
+                                " cells for a " + std::to_string(width) + " x " +
+                                std::to_string(height) + " map");
   }
-  if (!(map.resolution_m > 0) || !std::isfinite(map.resolution_m)) {
+  if (!(resolution_m > 0) || !std::isfinite(resolution_m)) {
     throw std::invalid_argument("writeRosMap " + yaml_path + ": resolution_m = " +
-                                std::to_string(map.resolution_m) + ": must be > 0");
+                                std::to_string(resolution_m) + ": must be > 0");
   }
+}
+
+// The PGM (pixel_of(ix, iy) per cell, row 0 = y max) and then the YAML naming it, each
+// atomically.
+template <class PixelOf>
+void writePgmAndYaml(const std::string& yaml_path, int w, int h, double resolution_m,
+                     const Eigen::Vector2d& origin_xy, const char* mode, PixelOf pixel_of) {
   const fs::path yaml(yaml_path);
   const std::string pgm_path = (yaml.parent_path() / yaml.stem()).string() + ".pgm";
-  const int w = map.width, h = map.height;
   std::string pixels(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), '\0');
   for (int row = 0; row < h; ++row) {
     const int iy = h - 1 - row;  // image row 0 is the top: y max
     for (int ix = 0; ix < w; ++ix) {
-      pixels[static_cast<std::size_t>(row) * w + ix] =
-          static_cast<char>(rosPixelOf(map.at(ix, iy)));
+      pixels[static_cast<std::size_t>(row) * w + ix] = static_cast<char>(pixel_of(ix, iy));
     }
   }
   writeFileAtomically(pgm_path, [&](std::ostream& os) {
@@ -66,13 +73,34 @@ void writeRosMap(const RosMap& map, const std::string& yaml_path) {
   });
   writeFileAtomically(yaml_path, [&](std::ostream& os) {
     os << std::setprecision(12) << "image: " << fs::path(pgm_path).filename().string() << "\n"
-       << "resolution: " << map.resolution_m << "\n"
-       << "origin: [" << map.origin_xy.x() << ", " << map.origin_xy.y() << ", 0.0]\n"
+       << "resolution: " << resolution_m << "\n"
+       << "origin: [" << origin_xy.x() << ", " << origin_xy.y() << ", 0.0]\n"
        << "negate: 0\n"
        << "occupied_thresh: 0.65\n"
        << "free_thresh: 0.196\n"
-       << "mode: trinary\n";
+       << "mode: " << mode << "\n";
   });
+}
+
+}  // namespace
+
+void writeRosMap(const RosMap& map, const std::string& yaml_path) {
+  checkMapShape(yaml_path, map.width, map.height, map.labels.size(), map.resolution_m);
+  writePgmAndYaml(yaml_path, map.width, map.height, map.resolution_m, map.origin_xy, "trinary",
+                  [&](int ix, int iy) { return rosPixelOf(map.at(ix, iy)); });
+}
+
+std::uint8_t rosScalePixelOf(float p_occupied) {
+  const float p = std::isnan(p_occupied) ? 0.5f : std::clamp(p_occupied, 0.f, 1.f);
+  return static_cast<std::uint8_t>(std::lround(255.f * (1.f - p)));
+}
+
+void writeRosScaleMap(const RosScaleMap& map, const std::string& yaml_path) {
+  checkMapShape(yaml_path, map.width, map.height, map.p_occupied.size(), map.resolution_m);
+  writePgmAndYaml(yaml_path, map.width, map.height, map.resolution_m, map.origin_xy, "scale",
+                  [&](int ix, int iy) {
+                    return rosScalePixelOf(map.p_occupied[static_cast<std::size_t>(iy) * map.width + ix]);
+                  });
 }
 
 namespace {

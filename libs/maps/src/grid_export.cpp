@@ -153,4 +153,20 @@ void writeRosMap(const TraversabilityGrid& grid, const std::string& path_without
   io::writeRosMap(map, path_without_ext + ".yaml");
 }
 
+void writeRosCostMap(const TraversabilityGrid& grid, const std::string& path_without_ext) {
+  io::RosScaleMap map;
+  map.resolution_m = grid.cellSize();
+  map.origin_xy = {grid.xMin(), grid.yMin()};
+  map.width = grid.sizeX();
+  map.height = grid.sizeY();
+  map.p_occupied.resize(static_cast<std::size_t>(map.width) * static_cast<std::size_t>(map.height));
+  for (int cy = 0; cy < map.height; ++cy) {
+    for (int cx = 0; cx < map.width; ++cx) {
+      map.p_occupied[static_cast<std::size_t>(cy) * map.width + cx] =
+          probabilityOf(grid.at(cx, cy), grid.params());
+    }
+  }
+  io::writeRosScaleMap(map, path_without_ext + ".yaml");
+}
+
 }  // namespace upd::maps

@@ -84,7 +84,8 @@ OpenNI2Camera::OpenNI2Camera(const std::string& oni_path) : impl_(std::make_uniq
     const auto uris = connectedDevices();
     if (uris.empty()) {
       throw std::runtime_error(
-          "no OpenNI2 depth camera connected (Kinect, Xtion): plug one in or pass --oni FILE.oni");
+          "no OpenNI2 depth camera connected (Xtion, Carmine; a Kinect v1 is read with "
+          "--kinect): plug one in or pass --oni FILE.oni");
     }
     if (d.device.open(uris.front().c_str()) != openni::STATUS_OK) {
       throw std::runtime_error("cannot open the OpenNI2 device " + uris.front() + ": " +
@@ -141,17 +142,29 @@ bool OpenNI2Camera::isRecording() const { return impl_->recording; }
 std::string OpenNI2Camera::description() const { return impl_->description; }
 
 bool OpenNI2Camera::read(DepthFrame& frame, int timeout_ms) {
+  switch (tryRead(frame, timeout_ms)) {
+    case ReadStatus::Frame:
+      return true;
+    case ReadStatus::End:
+      return false;
+    case ReadStatus::Timeout:
+      break;
+  }
+  throw std::runtime_error("the depth camera sent no frame for " + std::to_string(timeout_ms) +
+                           " ms");
+}
+
+ReadStatus OpenNI2Camera::tryRead(DepthFrame& frame, int timeout_ms) {
   auto& d = *impl_;
   openni::VideoStream* streams[] = {&d.depth};
   int ready = -1;
   if (openni::OpenNI::waitForAnyStream(streams, 1, &ready, timeout_ms) != openni::STATUS_OK) {
-    if (d.recording) return false;  // played without repeat: no frame comes after the last
-    throw std::runtime_error("the depth camera sent no frame for " + std::to_string(timeout_ms) +
-                             " ms");
+    // A recording played without repeat: no frame comes after the last.
+    return d.recording ? ReadStatus::End : ReadStatus::Timeout;
   }
   openni::VideoFrameRef ref;
   if (d.depth.readFrame(&ref) != openni::STATUS_OK || !ref.isValid()) {
-    if (d.recording) return false;
+    if (d.recording) return ReadStatus::End;
     throw std::runtime_error("reading a depth frame failed: " +
                              oneLine(openni::OpenNI::getExtendedError()));
   }
@@ -180,7 +193,7 @@ bool OpenNI2Camera::read(DepthFrame& frame, int timeout_ms) {
   frame.K = K;
   frame.index = static_cast<std::uint64_t>(ref.getFrameIndex());
   frame.device_time_s = static_cast<double>(ref.getTimestamp()) * 1e-6;
-  return true;
+  return ReadStatus::Frame;
 }
 
 }  // namespace upd::openni2

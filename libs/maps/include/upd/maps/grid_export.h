@@ -1,5 +1,5 @@
 // Writing the traversability grid as images: a colour PNG with a legend for people, and the
-// PGM + YAML pair of ROS map_server for planners.
+// PGM + YAML pairs of ROS map_server for planners (trinary labels, and a graded cost map).
 //
 // Every file is written atomically (temporary file in the same directory, then renamed); on
 // failure a one-line std::runtime_error names the file and no temporary file is left behind.
@@ -40,5 +40,10 @@ ColourPngLayout writeColourPng(const TraversabilityGrid& grid, const std::string
 /// io::writeRosMap (upd/io/ros_map.h: the PGM values io::kRosOccupied, kRosFree, kRosUnknown),
 /// each cell's label from labelOf, so the thresholds of GridParams decide.
 void writeRosMap(const TraversabilityGrid& grid, const std::string& path_without_ext);
+
+/// The graded cost map beside it: path_without_ext + ".pgm" and ".yaml" with mode: scale,
+/// each cell's grey level from its probability of being non-traversable (probabilityOf;
+/// unknown cells as the prior 0.5), through io::writeRosScaleMap.
+void writeRosCostMap(const TraversabilityGrid& grid, const std::string& path_without_ext);
 
 }  // namespace upd::maps

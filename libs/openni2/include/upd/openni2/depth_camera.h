@@ -1,4 +1,5 @@
-// A live depth camera through OpenNI2: a Kinect or an Xtion, or an .oni recording of one.
+// A live depth camera through OpenNI2: an Xtion or Carmine (PrimeSense PS1080), or an .oni
+// recording of one. Debian's OpenNI2 has no Kinect v1 driver: libs/freenect reads the Kinect v1.
 //
 // OpenNI2 is used directly (not through MRPT's COpenNI2Sensor, which aborts the process when no
 // device is attached): the constructor enumerates the devices first and fails with one line when
@@ -27,6 +28,9 @@ struct DepthFrame {
 /// intrinsics to match. Throws std::invalid_argument for downscale < 1.
 DepthFrame decimate(const DepthFrame& frame, int downscale);
 
+/// What tryRead() got.
+enum class ReadStatus { Frame, Timeout, End };
+
 class OpenNI2Camera {
  public:
   /// oni_path empty: the first connected device; otherwise an .oni recording, played frame by
@@ -40,6 +44,9 @@ class OpenNI2Camera {
   /// The next frame. False at the end of a recording; throws std::runtime_error when a device
   /// sends nothing for timeout_ms.
   bool read(DepthFrame& frame, int timeout_ms = 2000);
+  /// The next frame within timeout_ms: Frame, Timeout (a device sent nothing yet) or End (a
+  /// recording has no more frames). Throws std::runtime_error when reading a frame fails.
+  ReadStatus tryRead(DepthFrame& frame, int timeout_ms);
   bool isRecording() const;
   /// "PrimeSense Carmine 1.09 (1d27:0601)" or "recording FILE.oni (N frames)".
   std::string description() const;

@@ -1,0 +1,52 @@
+// Writes a run's observations as an MRPT rawlog while the run goes on (the observation-only
+// layout: one serialized CObservation per object, gzip-compressed), which rawlog-edit,
+// RawLogViewer and `upd playback` read.
+//
+// Crash safety: the objects go to `<path>.part`; every flush_every observations the gzip member
+// is closed and a new one appended (a gzip file may hold several members, read as one stream),
+// so the .part file on disk is a complete, replayable rawlog up to the last flush. finish()
+// closes it and renames it to path: a file at path is always whole. After a crash the .part
+// file stays; `upd playback RUN.rawlog.part` replays it up to the last flush (what follows,
+// if cut, is reported as damage and the frames before it are kept).
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+
+namespace mrpt::obs {
+class CObservation;
+}
+
+namespace upd::mrpt_bridge {
+
+class RawlogWriter {
+ public:
+  /// Opens `<path>.part` (truncated). Throws std::runtime_error naming it when it cannot be
+  /// written, std::invalid_argument for flush_every < 1.
+  explicit RawlogWriter(const std::string& path, int flush_every = 10);
+  /// Without finish() (an error unwinding), the .part file is closed and left in place.
+  ~RawlogWriter();
+  RawlogWriter(const RawlogWriter&) = delete;
+  RawlogWriter& operator=(const RawlogWriter&) = delete;
+
+  void write(const mrpt::obs::CObservation& obs);
+  /// A CObservationOdometry: the robot's planar odometry pose at time_s [s since the UNIX
+  /// epoch] (what `upd playback` takes as the robot pose of the observations after it).
+  void writeOdometry(double x_m, double y_m, double yaw_rad, double time_s);
+  /// Closes the file and renames `<path>.part` to path.
+  void finish();
+
+  std::size_t written() const { return written_; }
+  const std::string& path() const { return path_; }
+  std::string partPath() const { return path_ + ".part"; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string path_;
+  int flush_every_;
+  std::size_t written_ = 0;
+};
+
+}  // namespace upd::mrpt_bridge
