@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages UPD-Nav needs (only those missing), then configures and
 # builds the project into build/. Sourced by the quick-start scripts; safe to run repeatedly.
-# libopenni2-dev is optional (the camera input of `upd live`); the rest is required.
+# libopenni2-dev is optional (the camera input of `upd live`), and so is ROS 1 (`upd ros`, bag
+# playback); the rest is required.
 set -euo pipefail
 
 UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -10,7 +11,10 @@ PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
           libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev zlib1g-dev
           libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
-          octomap-tools cloudcompare gdal-bin mrpt-apps)  # the last four: tests open our files in them
+          octomap-tools cloudcompare gdal-bin mrpt-apps  # these four: tests open our files in them
+          ros-core libroscpp-dev librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
+          libgeometry-msgs-dev libvisualization-msgs-dev libtf2-ros-dev libtf2-msgs-dev)
+          # ros-core ... libtf2-msgs-dev: ROS 1, `upd ros` and bags (roscore: their tests)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -8,6 +8,7 @@
 #include "calibrate_mount.h"
 #include "cli.h"
 #include "commands.h"
+#include "live_base.h"
 #include "live_options.h"
 #include "live_source.h"
 #include "live_watchdog.h"
@@ -39,7 +40,7 @@ namespace upd::app {
 const char* const kLiveUsage =
     "usage: upd live [SOURCE] [--config FILE.ini] [--nav-config FILE.ini] [--view]\n"
     "                [--navigate X,Y] [--frames N] [--output DIR] [--record RUN.rawlog]\n"
-    "                [--stale-timeout S] [--mount FILE.ini | --auto-mount]\n"
+    "                [--stale-timeout S] [--mount FILE.ini | --auto-mount] [--base sim|ros]\n"
     "  Reads a live source, runs the UPD and the traversability map on every frame and, with\n"
     "  --navigate, drives the robot base to the goal with MRPT's reactive navigator. The shipped\n"
     "  base is simulated (it moves on the velocity commands, the camera does not): see\n"
@@ -56,6 +57,8 @@ const char* const kLiveUsage =
     "  --nav-config FILE  navigation config: camera mount, obstacles, navigator\n"
     "                     (default config/dune-nav.ini)\n"
     "  --view             3D view: cloud coloured by zeta, the map, the robot, the route\n"
+    "  --base sim|ros     the base driven: simulated (default) or ROS 1 (/cmd_vel out, /odom\n"
+    "                     in; docs/ROS.md)\n"
     "  --navigate X,Y     goal in the map frame (the robot starts at 0,0 facing +x) [m]\n"
     "  --frames N         stop after N frames (default: until the end, the goal or Ctrl-C)\n"
     "  --output DIR       write map.png, map.pgm + map.yaml, summary.json and the navlog\n"
@@ -163,7 +166,8 @@ struct LiveRun {
         config(c),
         source_params(sp),
         base({}, c.base),
-        loop(base, c, nav::ObstacleDetector::Upd,
+        external(makeLiveBase(o.base)),
+        loop(external ? *external : base, c, nav::ObstacleDetector::Upd,
              o.out && o.goal
                  ? (std::filesystem::path(*o.out) / "navigation.reactivenavlog").string()
                  : "") {
@@ -180,6 +184,7 @@ struct LiveRun {
   const nav::NavConfig& config;
   const mrpt_bridge::SourceParams& source_params;
   nav::SimulatedDiffDrive base;
+  std::unique_ptr<nav::RobotBase> external;  ///< a real base (--base ros), else nullptr
   nav::NavigationLoop loop;
   std::unique_ptr<nav::LiveView> view;
   std::optional<mrpt_bridge::RawlogWriter> recorder;
@@ -208,8 +213,9 @@ const nav::FrameEvidence* addFrame(LiveRun& run, mrpt::obs::CObservation& obs,
   run.now = Clock::now();
   const double dt = std::chrono::duration<double>(run.now - run.last).count();
   run.last = run.now;
-  if (dt > 0) run.base.advance(dt);
-  run.base.readState(s);
+  if (dt > 0 && !run.external) run.base.advance(dt);
+  nav::RobotBase& driven = run.external ? *run.external : run.base;
+  if (!driven.readState(s)) throw std::runtime_error("the robot base does not report its pose");
   recordFrame(run, obs, s);
   mrpt_bridge::toCloud(obs, run.source_params, run.converted);
   if (!run.converted.ok()) {
@@ -220,7 +226,7 @@ const nav::FrameEvidence* addFrame(LiveRun& run, mrpt::obs::CObservation& obs,
                                s.pose_world_robot.yaw_rad);
   const core::PointCloud cloud_world =
       core::transformCloud(run.converted.cloud_in_robot, sim::bodyPoseFlat(xy_yaw));
-  const nav::FrameEvidence& ev = run.loop.addFrame(cloud_world, run.base.timeS());
+  const nav::FrameEvidence& ev = run.loop.addFrame(cloud_world, driven.timeS());
   run.score_ms += ev.timings.total_ms;
   ++run.frames;
   return &ev;

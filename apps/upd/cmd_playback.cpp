@@ -8,6 +8,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "map_folder.h"
+#include "playback_bag.h"
 #include "playback_damage.h"
 #include "playback_merge.h"
 #include "playback_tum.h"
@@ -49,7 +50,7 @@
 namespace upd::app {
 
 const char* const kPlaybackUsage =
-    "usage: upd playback RAWLOG...|TUM_DIR --config FILE.ini --output DIR [options]\n"
+    "usage: upd playback RAWLOG...|TUM_DIR|RUN.bag --config FILE.ini --output DIR [options]\n"
     "  Replays RAWLOG (either rawlog layout): UPD for every 3D observation in the world frame,\n"
     "  fused over time into a 2.5D traversability grid and an OctoMap tree; several RAWLOGs\n"
     "  (runs of one site in one world frame) are fused one after the other into one map.\n"
@@ -58,7 +59,9 @@ const char* const kPlaybackUsage =
     "  band per layer, for GIS tools), map.ot (OctoMap\n"
     "  ColorOcTree coloured by traversability, for every OctoMap tool; map_colour.ot is the same\n"
     "  file), map_traversability.ot (the full tree, read with upd::maps::readTraversabilityOt),\n"
-    "  map.bt (occupancy), map.3Dscene (MRPT SceneViewer3D) and summary.json.\n\n"
+    "  map.bt (occupancy), map.3Dscene (MRPT SceneViewer3D) and summary.json.\n"
+    "  A ROS 1 bag (depth Image + CameraInfo or PointCloud2, tf for the poses; on its own) is\n"
+    "  first converted to DIR/bag.rawlog and DIR/bag_poses.tum (docs/ROS.md).\n\n"
     "options:\n"
     "  --config FILE.ini   robot/sensor parameters (config/dune-kinect.ini, ...) (required)\n"
     "  --output DIR        output directory, created if missing (required)\n"
@@ -475,8 +478,16 @@ void printSummary(const PlaybackOptions& o, const json& summary, double toleranc
 int runPlayback(const std::vector<std::string>& argv) {
   if (isTumPlayback(argv)) return runTumPlayback(argv);  // converts, then plays the rawlog
   const core::Stopwatch wall;
-  const PlaybackOptions options = parsePlaybackOptions(argv);
+  PlaybackOptions options = parsePlaybackOptions(argv);
   const RunConfig config = loadRunConfig(options.config_path);
+  for (auto& input : options.rawlogs) {  // a ROS 1 bag becomes a rawlog (playback_bag.h)
+    if (const auto bag = convertBagInput(input, options.out_dir)) {
+      if (options.rawlogs.size() > 1) throw UsageError("a bag is played on its own: " + input);
+      input = options.rawlog = bag->rawlog;
+      if (!options.poses_path) options.poses_path = bag->poses;
+      if (!options.quiet) std::printf("%s\n", bag->summary.c_str());
+    }
+  }
   if (options.epsg != 0) gdal::validateEpsg(options.epsg);
   const std::vector<PlaybackRun> runs =
       playbackRuns(options.rawlogs, options.poses_path, options.ply || options.output_rawlog);

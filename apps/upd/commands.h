@@ -23,6 +23,7 @@ int runNavigate(const std::vector<std::string>& args);
 int runLive(const std::vector<std::string>& args);
 int runMap(const std::vector<std::string>& args);
 int runCalibrateMount(const std::vector<std::string>& args);
+int runRos(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
 extern const char* const kSceneUsage;
@@ -33,5 +34,6 @@ extern const char* const kNavigateUsage;
 extern const char* const kLiveUsage;
 extern const char* const kMapUsage;
 extern const char* const kCalibrateMountUsage;
+extern const char* const kRosUsage;
 
 }  // namespace upd::app

@@ -26,6 +26,7 @@ struct LiveOptions {
   bool view = false;
   std::optional<std::string> mount;  ///< --mount FILE.ini: [CameraMountParams] over the nav config's
   bool auto_mount = false;           ///< measure the mount from the floor in the first frames
+  std::string base = "sim";  ///< the base driven: sim or ros (live_base.h)
 };
 
 /// Throws UsageError naming the option and value.

@@ -29,6 +29,8 @@ const Command kCommands[] = {
      upd::app::kMapUsage, upd::app::runMap},
     {"calibrate-mount", "measure the camera's height, pitch and roll from the floor it sees",
      upd::app::kCalibrateMountUsage, upd::app::runCalibrateMount},
+    {"ros", "ROS 1 node: depth/cloud topics in, map, cloud and route out, goals driven",
+     upd::app::kRosUsage, upd::app::runRos},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };
