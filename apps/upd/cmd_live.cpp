@@ -6,6 +6,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "run_config.h"
+#include "stop_signal.h"
 
 #include "upd/io/json_io.h"
 #include "upd/maps/grid_export.h"
@@ -18,10 +19,8 @@
 #include "upd/openni2/depth_camera.h"
 #endif
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -137,25 +136,6 @@ void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTa
   std::printf("  outputs in %s\n", dir.c_str());
 }
 
-std::atomic<bool> g_stop{false};
-void onSignal(int) { g_stop = true; }
-
-// Ctrl-C and SIGTERM set g_stop while it lives.
-class StopOnSignal {
- public:
-  StopOnSignal() {
-    g_stop = false;
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
-  }
-  ~StopOnSignal() {
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
-  }
-  StopOnSignal(const StopOnSignal&) = delete;
-  StopOnSignal& operator=(const StopOnSignal&) = delete;
-};
-
 // The robot, the navigation loop and the view of one run, and its counters.
 struct LiveRun {
   LiveRun(const LiveOptions& o, const nav::NavConfig& c)
@@ -235,7 +215,7 @@ void reportProgress(LiveRun& run, const nav::FrameEvidence& ev, const nav::BaseS
 // Frames until the limit, the end of the recording, the goal, the window closing or a signal.
 std::string runFrames(LiveRun& run, openni2::OpenNI2Camera& camera) {
   openni2::DepthFrame raw;
-  while (!g_stop) {
+  while (!stopRequested()) {
     if (run.opt.max_frames > 0 && run.frames >= run.opt.max_frames) return "frame limit";
     if (!camera.read(raw)) return "end of the recording";
     nav::BaseState s;
@@ -264,7 +244,7 @@ int runCamera(const LiveOptions& o, const nav::NavConfig& config) {
   {
     const StopOnSignal stop_on_signal;
     t.end = runFrames(run, camera);
-    if (g_stop) t.end = "interrupted";
+    if (stopRequested()) t.end = "interrupted";
     t.outcome = run.loop.outcome();
     run.loop.finish();
   }
