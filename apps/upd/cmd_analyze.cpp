@@ -14,7 +14,8 @@ namespace upd::app {
 
 const char* const kAnalyzeUsage =
     "usage: upd analyze INPUT [options]\n"
-    "  Scores every point of INPUT (.pcd, .ply, .xyz) with the Unevenness Point Descriptor.\n\n"
+    "  Scores every point of INPUT (.pcd, .ply, .xyz, or a KITTI .bin scan: float32 x y z\n"
+    "  intensity per point) with the Unevenness Point Descriptor.\n\n"
     "options:\n"
     "  --radius-m D          UPD search radius d_m [m] (default 0.5; 1.0 for a tractor)\n"
     "  --normal-radius-m R   PCA normal radius [m] (default 0.1)\n"
