@@ -163,9 +163,27 @@ void requireValidAsciiBody(const std::string& path, const pcl::PCLPointCloud2& h
   }
 }
 
+/// A header cut off before its DATA line (PCL takes such a file as a cloud of no points, or reads
+/// the header's own lines as ascii data).
+void requireDataLine(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  std::size_t n = 0;
+  constexpr std::size_t kMaxHeaderLines = 1000;  // a PCD header has about a dozen
+  while (n < kMaxHeaderLines && std::getline(in, line)) {
+    ++n;
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first != std::string::npos && line.compare(first, 4, "DATA") == 0) return;
+  }
+  if (n == 0) throw fileError(path, "empty file, not a PCD file (no header)");
+  throw fileError(path, "truncated or invalid PCD header: no DATA line in its first " +
+                            std::to_string(n) + " lines");
+}
+
 // Reads and checks the header, and checks the body against it before PCL parses the body (PCL
 // itself reads past a truncated one). Throws naming path.
 void checkPcdFile(const std::string& path, pcl::PCDReader& reader) {
+  requireDataLine(path);
   pcl::PCLPointCloud2 blob;
   Eigen::Vector4f origin = Eigen::Vector4f::Zero();
   Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
