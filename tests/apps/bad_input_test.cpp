@@ -9,8 +9,10 @@
 #include "temp_dir.h"
 
 #include "upd/io/cloud_io.h"
+#include "upd/mrpt_bridge/observation_cloud.h"
 
 #include <gtest/gtest.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <nlohmann/json.hpp>
 #include <sys/mount.h>
 #include <unistd.h>
@@ -226,6 +228,162 @@ TEST_F(BadInput, CoordinatesOf1e30) {
   const CmdResult n = runUpd("analyze " + in("far.xyz").string() + " --no-preprocess");
   EXPECT_EQ(n.exit_code, 1) << n.output;
   EXPECT_NE(n.output.find("NormalParams.radius_m = 0.1"), std::string::npos) << n.output;
+}
+
+// Robot configs: each bad one stops the run before any input is read, naming the file, the
+// section, the key and the value. An absent key keeps its default.
+TEST_F(BadInput, Configs) {
+  writeBytes(in("cloud.xyz"), samples::xyzText(samples::grid()));
+  const struct {
+    const char* name;
+    const char* text;  ///< nullptr: the file does not exist
+    const char* says;  ///< "" = accepted
+  } cases[] = {
+      {"missing.ini", nullptr, "missing.ini: not found"},
+      {"unknown_key.ini", "[UpdParams]\nradius = 0.5\n", "[UpdParams] unknown key 'radius'"},
+      {"unknown_section.ini", "[UPDParams]\nradius_m = 0.5\n", "unknown section [UPDParams]"},
+      {"duplicated_key.ini", "[UpdParams]\nradius_m = 0.5\n; later\nradius_m = 0.7\n",
+       "[UpdParams] radius_m is given twice (lines 2 and 4)"},
+      {"duplicated_section.ini", "[UpdParams]\nradius_m = 0.5\n[ClassifyParams]\n[UpdParams]\nradius_m = 0.7\n",
+       "[UpdParams] radius_m is given twice (lines 2 and 5)"},
+      {"out_of_range.ini", "[UpdParams]\nradius_m = -1\n", "UpdParams.radius_m = -1: must be > 0"},
+      {"out_of_range_deg.ini", "[ClassifyParams]\nmax_slope_deg = 95\n", "max_slope"},
+      {"no_value.ini", "[UpdParams]\nradius_m =\n", "[UpdParams] radius_m = '': not a number"},
+      {"not_a_number.ini", "[UpdParams]\nradius_m = half a metre\n", "radius_m = 'half a metre': not a number"},
+      {"absent_key.ini", "[UpdParams]\n", ""},
+  };
+  for (const auto& c : cases) {
+    if (c.text) writeBytes(in(c.name), c.text);
+    fs::remove_all(out());
+    fs::create_directories(out());
+    const CmdResult r = runUpd("analyze " + in("cloud.xyz").string() + " --config " +
+                               in(c.name).string() + " --output " + (out() / "s.ply").string());
+    if (!*c.says) {
+      EXPECT_EQ(r.exit_code, 0) << c.name << ": " << r.output;
+      continue;
+    }
+    EXPECT_EQ(r.exit_code, 1) << c.name << ": " << r.output;
+    EXPECT_EQ(lines(r.output), 1u) << r.output;
+    EXPECT_NE(r.output.find(in(c.name).string()), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.name << ": " << r.output;
+    EXPECT_TRUE(fs::is_empty(out())) << c.name;
+  }
+}
+
+// Range images a driver can deliver: the frame is skipped with a reason naming what is wrong
+// (playback counts it in summary.json's frames_skipped), never read out of bounds.
+TEST(BadRangeImage, ZeroSizeMismatchedOrWithoutFocalLength) {
+  auto scan = [](int w, int h, int cam_w, int cam_h, double f) {
+    mrpt::obs::CObservation3DRangeScan o;
+    o.hasRangeImage = true;
+    o.rangeImage.setZero(h, w);
+    if (w > 0 && h > 0) o.rangeImage(h / 2, w / 2) = 1000;
+    o.rangeUnits = 1e-3f;
+    o.cameraParams.ncols = cam_w;
+    o.cameraParams.nrows = cam_h;
+    o.cameraParams.fx(f);
+    o.cameraParams.fy(f);
+    o.cameraParams.cx(cam_w / 2.0);
+    o.cameraParams.cy(cam_h / 2.0);
+    return mrpt_bridge::toCloud(o);
+  };
+  const auto zero = scan(0, 0, 640, 480, 525);
+  EXPECT_FALSE(zero.ok());
+  EXPECT_EQ(zero.skipped_reason, "CObservation3DRangeScan has neither a range image nor 3D points");
+  const auto mismatched = scan(320, 240, 640, 480, 525);
+  EXPECT_FALSE(mismatched.ok());
+  EXPECT_NE(mismatched.skipped_reason.find("are for 640x480 but the range image is 320x240"),
+            std::string::npos)
+      << mismatched.skipped_reason;
+  for (double f : {0.0, -525.0, std::nan("")}) {
+    const auto no_focal = scan(64, 48, 64, 48, f);
+    EXPECT_EQ(no_focal.skipped_reason, "CObservation3DRangeScan: the depth camera has no focal length")
+        << f;
+  }
+  const auto good = scan(64, 48, 64, 48, 50);
+  ASSERT_TRUE(good.ok()) << good.skipped_reason;
+  EXPECT_EQ(good.cloud_in_robot.size(), 64u * 48u);
+}
+
+// A tmpfs mounted for the test (root only): read-only, or of a few kB to fill up.
+class ScratchMount {
+ public:
+  ScratchMount(const fs::path& where, const std::string& options) : where_(where) {
+    fs::create_directories(where);
+    mounted_ = ::geteuid() == 0 &&
+               ::mount("tmpfs", where.c_str(), "tmpfs", 0, options.c_str()) == 0;
+  }
+  ~ScratchMount() {
+    if (mounted_) ::umount2(where_.c_str(), MNT_DETACH);
+  }
+  ScratchMount(const ScratchMount&) = delete;
+  ScratchMount& operator=(const ScratchMount&) = delete;
+  bool mounted() const { return mounted_; }
+
+ private:
+  fs::path where_;
+  bool mounted_ = false;
+};
+
+// Nothing but whole files: no temporary file left, every file there non-empty.
+void expectNoPartialFiles(const fs::path& dir) {
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+    if (e.is_regular_file()) {
+      EXPECT_GT(e.file_size(), 0u) << e.path();
+    }
+  }
+}
+
+TEST_F(BadInput, OutputFolderNotWritable) {
+  writeBytes(in("cloud.xyz"), samples::xyzText(samples::grid()));
+  writeBytes(out() / "a_file", "x");
+  const fs::path under_file = out() / "a_file" / "scored.ply";
+  CmdResult r = runUpd("analyze " + in("cloud.xyz").string() + " --output " + under_file.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(lines(r.output), 1u) << r.output;
+  EXPECT_NE(r.output.find(under_file.string()), std::string::npos) << r.output;
+
+  const fs::path ro = dir_.path() / "read_only";
+  const ScratchMount mount(ro, "ro,size=64k");
+  if (!mount.mounted()) {
+    fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+    if (::geteuid() == 0) GTEST_SKIP() << "read-only case: cannot mount a tmpfs (not permitted here)";
+  }
+  r = runUpd("analyze " + in("cloud.xyz").string() + " --output " + (ro / "scored.ply").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(lines(r.output), 1u) << r.output;
+  EXPECT_NE(r.output.find((ro / "scored.ply").string()), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::is_empty(ro));
+  if (!mount.mounted()) fs::permissions(ro, fs::perms::owner_all);
+}
+
+// A disk that fills up while the outputs are written: one line naming the file that did not
+// fit, exit 1, no temporary or partial file on the full disk.
+TEST_F(BadInput, FullDisk) {
+  if (::geteuid() != 0) GTEST_SKIP() << "full-disk case needs root to mount a 64 kB tmpfs";
+  const fs::path disk = dir_.path() / "full";
+  const ScratchMount mount(disk, "size=64k");
+  if (!mount.mounted()) GTEST_SKIP() << "full-disk case: cannot mount a tmpfs (not permitted here)";
+  const CmdResult scene = runUpd("scene rocks --output " + in("rocks.ply").string());
+  ASSERT_EQ(scene.exit_code, 0) << scene.output;
+  const fs::path ply = disk / "scored.ply";
+  CmdResult r = runUpd("analyze " + in("rocks.ply").string() + " --output " + ply.string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(lines(r.output), 1u) << r.output;
+  EXPECT_NE(r.output.find(ply.string()), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::is_empty(disk)) << "left on the full disk";
+
+  const fs::path rawlog = dir_.path() / "run.rawlog";
+  const CmdResult sim = runUpd("simulate --world mixed --frames 3 --output " + rawlog.string());
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  r = runUpd("playback " + rawlog.string() + " --config " + kConfig + " --quiet --output " +
+             (disk / "maps").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(lines(r.output), 1u) << r.output;
+  EXPECT_NE(r.output.find((disk / "maps").string()), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(disk / "maps" / "summary.json"));
+  expectNoPartialFiles(disk);
 }
 
 }  // namespace
