@@ -9,7 +9,8 @@ UPD_BUILD="${UPD_BUILD:-$UPD_ROOT/build}"
 PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
           libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev
-          octomap-tools cloudcompare)  # the last two: tests open our files in them
+          octomap-tools cloudcompare   # tests open our files in them
+          clang-14 libclang-rt-14-dev)  # libFuzzer: scripts/fuzz.sh
 
 missing=()
 for p in "${PACKAGES[@]}"; do
