@@ -99,8 +99,19 @@ void requireCompleteBody(const std::string& path, const pcl::PCLPointCloud2& hea
     if (!in.read(reinterpret_cast<char*>(sizes), 8)) {
       throw fileError(path, "cannot read the binary_compressed block header");
     }
-    std::uint32_t compressed = 0;
+    std::uint32_t compressed = 0, uncompressed = 0;
     for (int i = 3; i >= 0; --i) compressed = (compressed << 8) | sizes[i];  // little-endian
+    for (int i = 7; i >= 4; --i) uncompressed = (uncompressed << 8) | sizes[i];
+    // PCL allocates the uncompressed size before it decompresses: a corrupt one must not make
+    // it allocate gigabytes. The fields hold at most points * point_step bytes, and LZF expands
+    // a block at most 88 times (a 3-byte back-reference copies up to 264 bytes).
+    const std::uintmax_t fields = points * header.point_step;
+    if (uncompressed > fields || uncompressed > std::uintmax_t{compressed} * 88 + 64) {
+      throw fileError(path, "corrupt PCD: the binary_compressed block says " +
+                                std::to_string(uncompressed) + " bytes uncompressed from " +
+                                std::to_string(compressed) + ", the header's " +
+                                std::to_string(points) + " points hold " + std::to_string(fields));
+    }
     const std::uintmax_t need = std::uintmax_t{data_idx} + 8 + compressed;
     if (file_size < need) {
       throw fileError(path, "truncated PCD: the binary_compressed block needs " +
