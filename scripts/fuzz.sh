@@ -8,7 +8,9 @@
 # and the small clouds and rawlogs of ../shared/data (rawlogs decompressed, so the fuzzer
 # mutates the object stream and not the gzip layer). The corpus grows in build-fuzz/corpus/
 # from run to run. A crash stops with its input saved as build-fuzz/crashes/<target>-crash-*
-# and the command that replays it; turn it into a regression test (tests/io/regressions/).
+# and the command that replays it; turn it into a regression: a reader's input into
+# tests/io/regressions/ (a ctest case), any target's into tests/fuzz/regressions/<target>/
+# (replayed first by every run of that target).
 set -euo pipefail
 UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${UPD_FUZZ_BUILD:-$UPD_ROOT/build-fuzz}"
@@ -55,6 +57,7 @@ for t in "${TARGETS[@]}"; do
   echo "fuzz: $t for ${SECS} s"
   if ! "$BUILD/tests/fuzz/fuzz_$t" -max_total_time="$SECS" -timeout=20 -rss_limit_mb=2048 \
         -print_final_stats=1 -artifact_prefix="$BUILD/crashes/$t-" "$corpus" "$seeds/$t" \
+        $( [ -d "$UPD_ROOT/tests/fuzz/regressions/$t" ] && echo "$UPD_ROOT/tests/fuzz/regressions/$t") \
         >"$BUILD/fuzz_$t.log" 2>&1; then
     failed+=("$t")
     tail -40 "$BUILD/fuzz_$t.log"

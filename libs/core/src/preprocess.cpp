@@ -122,9 +122,12 @@ PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
   for (std::size_t i = first; i < in.size(); ++i) {
     if (!in.isFinite(i)) continue;
     const Eigen::Vector3d d = in.point(i).cast<double>() - ref;
-    const std::int64_t cx = detail::floorToInt(d.x() * inv), cy = detail::floorToInt(d.y() * inv),
-                       cz = detail::floorToInt(d.z() * inv);
-    if (!detail::keyFits(cx, cy, cz)) {
+    // Checked before the conversion to integers, which is undefined beyond 2^63 (1e30 m).
+    const bool in_range = (d * inv).cwiseAbs().maxCoeff() < 1e15;
+    const std::int64_t cx = in_range ? detail::floorToInt(d.x() * inv) : 0,
+                       cy = in_range ? detail::floorToInt(d.y() * inv) : 0,
+                       cz = in_range ? detail::floorToInt(d.z() * inv) : 0;
+    if (!in_range || !detail::keyFits(cx, cy, cz)) {
       throw std::invalid_argument(
           "PreprocessParams.voxel_m = " + std::to_string(voxel_m) +
           ": the cloud spans more than 2^20 voxels along an axis; use a larger voxel or a "

@@ -105,8 +105,14 @@ void requireCompleteBody(const std::string& path, const pcl::PCLPointCloud2& hea
     // PCL allocates the uncompressed size before it decompresses: a corrupt one must not make
     // it allocate gigabytes. The fields hold at most points * point_step bytes, and LZF expands
     // a block at most 88 times (a 3-byte back-reference copies up to 264 bytes).
+    // And PCL copies every field of every point out of the block: it must hold them all.
+    std::uintmax_t field_bytes = 0;
+    for (const auto& f : header.fields) {
+      field_bytes += static_cast<std::uintmax_t>(pcl::getFieldSize(f.datatype)) * f.count;
+    }
     const std::uintmax_t fields = points * header.point_step;
-    if (uncompressed > fields || uncompressed > std::uintmax_t{compressed} * 88 + 64) {
+    if (uncompressed > fields || uncompressed < points * field_bytes ||
+        uncompressed > std::uintmax_t{compressed} * 88 + 64) {
       throw fileError(path, "corrupt PCD: the binary_compressed block says " +
                                 std::to_string(uncompressed) + " bytes uncompressed from " +
                                 std::to_string(compressed) + ", the header's " +
