@@ -13,7 +13,8 @@ PACKAGES=(build-essential cmake pkg-config
           libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
           octomap-tools cloudcompare gdal-bin mrpt-apps  # these four: tests open our files in them
           ros-core libroscpp-dev librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
-          libgeometry-msgs-dev libvisualization-msgs-dev libtf2-ros-dev libtf2-msgs-dev)
+          libgeometry-msgs-dev libvisualization-msgs-dev libtf2-ros-dev libtf2-msgs-dev
+          clang-14 libclang-rt-14-dev)  # libFuzzer and the sanitizers: scripts/fuzz.sh, sanitize.sh
           # ros-core ... libtf2-msgs-dev: ROS 1, `upd ros` and bags (roscore: their tests)
 
 missing=()

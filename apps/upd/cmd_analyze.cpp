@@ -15,8 +15,9 @@ namespace upd::app {
 
 const char* const kAnalyzeUsage =
     "usage: upd analyze INPUT [options]\n"
-    "  Scores every point of INPUT (.pcd, .ply, .xyz, or a 16-bit depth .png with\n"
-    "  --intrinsics) with the Unevenness Point Descriptor.\n\n"
+    "  Scores every point of INPUT (.pcd, .ply, .xyz, a KITTI .bin scan: float32 x y z\n"
+    "  intensity per point, or a 16-bit depth .png with --intrinsics) with the Unevenness\n"
+    "  Point Descriptor.\n\n"
     "options:\n"
     "  --intrinsics F.yaml   calibration of a depth PNG (OpenCV/RTAB-Map or ROS camera_info\n"
     "                        YAML); its local_transform, when present, moves the cloud to the\n"

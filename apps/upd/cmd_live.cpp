@@ -13,6 +13,7 @@
 #include "live_source.h"
 #include "live_watchdog.h"
 #include "run_config.h"
+#include "stop_signal.h"
 
 #include "upd/io/json_io.h"
 #include "upd/maps/grid_export.h"
@@ -25,10 +26,8 @@
 
 #include <mrpt/obs/CObservation.h>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -139,25 +138,6 @@ void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTa
   io::writeJsonAtomically((fs::path(dir) / "summary.json").string(), j);
   std::printf("  outputs in %s\n", dir.c_str());
 }
-
-std::atomic<bool> g_stop{false};
-void onSignal(int) { g_stop = true; }
-
-// Ctrl-C and SIGTERM set g_stop while it lives.
-class StopOnSignal {
- public:
-  StopOnSignal() {
-    g_stop = false;
-    std::signal(SIGINT, onSignal);
-    std::signal(SIGTERM, onSignal);
-  }
-  ~StopOnSignal() {
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
-  }
-  StopOnSignal(const StopOnSignal&) = delete;
-  StopOnSignal& operator=(const StopOnSignal&) = delete;
-};
 
 // The robot, the navigation loop, the view and the recording of one run, and its counters.
 struct LiveRun {
@@ -271,7 +251,7 @@ std::string runFrames(LiveRun& run, LiveSource& source, LiveTally& t) {
   while (true) {
     if (run.opt.max_frames > 0 && run.frames >= run.opt.max_frames) return "frame limit";
     SourceStall stall;
-    switch (nextFreshFrame(source, watchdog, run.base, now_s, g_stop, frame, stall)) {
+    switch (nextFreshFrame(source, watchdog, run.base, now_s, stopRequested, frame, stall)) {
       case NextFrame::End:
         return "end of the recording";
       case NextFrame::Interrupted:
@@ -310,7 +290,7 @@ sim::CameraMountParams autoMountFromSource(LiveSource& source, const LiveOptions
   const auto t0 = Clock::now();
   const auto next = [&](core::PointCloud& cloud) {
     LiveFrame frame;
-    while (!g_stop) {
+    while (!stopRequested()) {
       const double waited = std::chrono::duration<double>(Clock::now() - t0).count();
       if (waited > o.stale_timeout_s * (kAutoMountFrames + 1)) return false;
       const Poll p = source.poll(frame);
@@ -334,7 +314,7 @@ int runSource(const LiveOptions& o, nav::NavConfig config, const RunConfig& run_
   {
     const StopOnSignal stop_on_signal;
     t.end = runFrames(run, *source, t);
-    if (g_stop) t.end = "interrupted";
+    if (stopRequested()) t.end = "interrupted";
     t.outcome = run.loop.outcome();
     run.loop.finish();
   }

@@ -3,7 +3,8 @@
 // PGM + YAML, .ot/.bt, .3Dscene, optional per-frame PLY and an annotated rawlog) with a
 // summary.json. A ground-truth grid next to the rawlog (as `upd simulate` writes it) is used
 // to score the map (maps::evaluateGrid). A damaged rawlog keeps the maps of its good frames and
-// exits kExitPartial (playback_damage.h).
+// exits kExitPartial (playback_damage.h), as does a run stopped by Ctrl-C or SIGTERM after the
+// frame in progress (stop_signal.h).
 #include "calibrate_mount.h"
 #include "cli.h"
 #include "commands.h"
@@ -14,6 +15,7 @@
 #include "playback_tum.h"
 #include "run_config.h"
 #include "whole_run.h"
+#include "stop_signal.h"
 
 #include "upd/core/stopwatch.h"
 #include "upd/gdal/geotiff.h"
@@ -91,8 +93,12 @@ const char* const kPlaybackUsage =
     ".rawlog first. Its options: --intrinsics F.yaml (OpenCV/ROS YAML) or --tum-camera\n"
     "freiburg1|freiburg2|freiburg3|ros (default: the freiburgN in DIR's name), --depth-scale S\n"
     "(metres per unit, default 0.0002), --poses FILE instead of groundtruth.txt.\n\n"
+    "Ctrl-C (SIGINT) or SIGTERM stops after the frame in progress: the maps of the frames\n"
+    "processed so far are written and summary.json says \"end\": \"interrupted\" (a second\n"
+    "Ctrl-C ends at once, writing nothing more).\n\n"
     "exit status: 0 done; 1 failed, nothing written; 2 usage error; 3 partial: the rawlog is\n"
-    "damaged and the maps of its good frames were written (not with --strict).\n";
+    "damaged (not with --strict) or the run was interrupted, and the maps of the frames\n"
+    "processed were written.\n";
 
 namespace {
 
@@ -312,6 +318,7 @@ struct Playback {
   std::size_t read = 0, processed = 0, points_scored = 0;
   std::string pose_source;  ///< where the robot poses came from
   std::optional<RawlogDamage> damage;  ///< set when the rawlog ended in damage (not --strict)
+  int interrupted_by = 0;  ///< the signal that stopped the frame loop early, 0 if none
 
   explicit Playback(const RunConfig& config) : grid(config.grid), tree(config.octree) {}
 };
@@ -393,7 +400,7 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
 
   mrpt_bridge::RawlogEntry entry;
   mrpt_bridge::ObserverResult res;  // reused frame to frame
-  while (nextIntact(reader, entry, o.strict, run)) {
+  while (!stopRequested() && nextIntact(reader, entry, o.strict, run)) {
     ++run.read;
     // Every entry updates the pose tracker, so odometry between selected frames is kept.
     const mrpt_bridge::RobotPose pose = tracker.update(entry);
@@ -424,6 +431,7 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
     progress.update(run.read);
   }
   progress.finish();
+  run.interrupted_by = stopSignal();
   if (annotated) annotated->commit();
   for (const auto& [reason, n] : reader.stats().skipped) run.skipped[reason] += n;
   run.pose_source = mrpt_bridge::toString(tracker.kind());
@@ -448,6 +456,7 @@ json summaryJson(const PlaybackOptions& o, const RunConfig& config, Playback& ru
   summary["wall_time_s"] = wall_time_s;
   summary["grid"] = gridJson(run.grid);
   summary["octree"] = octreeJson(run.tree);
+  summary["end"] = run.interrupted_by ? "interrupted" : run.damage ? "damaged" : "complete";
   if (run.damage) summary["damage"] = damageJson(*run.damage);
   if (truth.grid) {
     summary["ground_truth"] = truthJson(run.grid, truth, config.evaluation.tolerance_m);
@@ -503,8 +512,11 @@ int runPlayback(const std::vector<std::string>& argv) {
   if (options.ply) fs::create_directories(options.out_dir / "frames");
 
   Playback run(config);
-  for (std::size_t k = 0; k < runs.size() && !run.damage; ++k) {
-    playFrames(per_run[k], config, trackers[k], run);
+  {
+    const StopOnSignal stop_on_signal;  // Ctrl-C ends the frame loop, the maps are written
+    for (std::size_t k = 0; k < runs.size() && !run.damage && !stopRequested(); ++k) {
+      playFrames(per_run[k], config, trackers[k], run);
+    }
   }
   json memory = runMemoryJson(run.grid, run.tree);  // the working set at the end of the run
   switchToWholeRun(run.grid, run.tree);            // every export covers the whole run
@@ -516,6 +528,13 @@ int runPlayback(const std::vector<std::string>& argv) {
   printSummary(options, summary, config.evaluation.tolerance_m);
   if (run.damage) {
     std::fprintf(stderr, "%s\n", damageLine(*run.damage, options.out_dir.string()).c_str());
+    return kExitPartial;
+  }
+  if (run.interrupted_by) {
+    std::fprintf(stderr, "upd playback: interrupted by %s after %zu frames read; maps of the %zu "
+                 "processed written to %s (partial, exit %d)\n",
+                 stopSignalName(run.interrupted_by), run.read, run.processed,
+                 options.out_dir.string().c_str(), kExitPartial);
     return kExitPartial;
   }
   return 0;

@@ -40,9 +40,9 @@ std::string SourceStall::line() const {
 }
 
 NextFrame nextFreshFrame(LiveSource& source, SourceWatchdog& watchdog, nav::RobotBase& base,
-                         const std::function<double()>& now_s, const std::atomic<bool>& stop,
+                         const std::function<double()>& now_s, const std::function<bool()>& stop,
                          LiveFrame& frame, SourceStall& stall) {
-  while (!stop) {
+  while (!stop()) {
     const Poll p = source.poll(frame);
     if (p == Poll::End) return NextFrame::End;
     const double now = now_s();

@@ -58,7 +58,7 @@ enum class NextFrame { Fresh, End, Stalled, Interrupted };
 /// becoming true (Interrupted), or the watchdog expiring (Stalled: base.stop(true) was called
 /// and stall says what happened). now_s is the clock the watchdog runs on [s].
 NextFrame nextFreshFrame(LiveSource& source, SourceWatchdog& watchdog, nav::RobotBase& base,
-                         const std::function<double()>& now_s, const std::atomic<bool>& stop,
+                         const std::function<double()>& now_s, const std::function<bool()>& stop,
                          LiveFrame& frame, SourceStall& stall);
 
 }  // namespace upd::app

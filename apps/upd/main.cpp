@@ -13,7 +13,7 @@ namespace {
 using upd::app::Command;
 
 const Command kCommands[] = {
-    {"analyze", "score a point cloud file (.pcd, .ply, .xyz) or a depth PNG with the UPD",
+    {"analyze", "score a point cloud (.pcd, .ply, .xyz, KITTI .bin) or a depth PNG with the UPD",
      upd::app::kAnalyzeUsage, upd::app::runAnalyze},
     {"scene", "write a generated test scene (the paper's experiments) as PLY",
      upd::app::kSceneUsage, upd::app::runScene},

@@ -60,7 +60,7 @@ struct Pulled {
 Pulled pull(upd::app::LiveSource& source, double& clock_s, upd::nav::RobotBase& base,
          double timeout_s) {
   upd::app::SourceWatchdog watchdog(timeout_s, clock_s);
-  const std::atomic<bool> stop{false};
+  const std::function<bool()> stop = [] { return false; };
   Pulled r;
   LiveFrame f;
   for (int i = 0; i < 1000; ++i) {

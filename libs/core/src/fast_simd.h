@@ -34,9 +34,11 @@ template <int Steps = 3>
 inline float rsqrtNewton(float x) {
   std::int32_t i;
   std::memcpy(&i, &x, sizeof i);
-  i = 0x5f375a86 - (i >> 1);
+  // In unsigned arithmetic: the same bits for every x, without the signed overflow a
+  // non-positive x (-0, a rounding error below zero) would be.
+  const std::uint32_t u = 0x5f375a86u - static_cast<std::uint32_t>(i >> 1);
   float y;
-  std::memcpy(&y, &i, sizeof y);
+  std::memcpy(&y, &u, sizeof y);
   const float h = 0.5f * x;
   for (int s = 0; s < Steps; ++s) y = y * (1.5f - h * y * y);
   return y;

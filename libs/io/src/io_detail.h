@@ -17,6 +17,10 @@ inline std::runtime_error fileError(const std::string& path, const std::string& 
 /// Throws fileError unless path names an existing regular file.
 void requireReadableFile(const std::string& path);
 
+/// What the first bytes of a file (head) say it is: "a PLY file", "a PCD file",
+/// "gzip-compressed data", "text", or "" when none of these (binary data of no known kind).
+std::string sniffFormat(const std::string& head);
+
 constexpr bool kHostIsLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
 
 inline void reverseBytes(unsigned char* p, std::size_t n) {

@@ -99,8 +99,25 @@ void requireCompleteBody(const std::string& path, const pcl::PCLPointCloud2& hea
     if (!in.read(reinterpret_cast<char*>(sizes), 8)) {
       throw fileError(path, "cannot read the binary_compressed block header");
     }
-    std::uint32_t compressed = 0;
+    std::uint32_t compressed = 0, uncompressed = 0;
     for (int i = 3; i >= 0; --i) compressed = (compressed << 8) | sizes[i];  // little-endian
+    for (int i = 7; i >= 4; --i) uncompressed = (uncompressed << 8) | sizes[i];
+    // PCL allocates the uncompressed size before it decompresses: a corrupt one must not make
+    // it allocate gigabytes. The fields hold at most points * point_step bytes, and LZF expands
+    // a block at most 88 times (a 3-byte back-reference copies up to 264 bytes).
+    // And PCL copies every field of every point out of the block: it must hold them all.
+    std::uintmax_t field_bytes = 0;
+    for (const auto& f : header.fields) {
+      field_bytes += static_cast<std::uintmax_t>(pcl::getFieldSize(f.datatype)) * f.count;
+    }
+    const std::uintmax_t fields = points * header.point_step;
+    if (uncompressed > fields || uncompressed < points * field_bytes ||
+        uncompressed > std::uintmax_t{compressed} * 88 + 64) {
+      throw fileError(path, "corrupt PCD: the binary_compressed block says " +
+                                std::to_string(uncompressed) + " bytes uncompressed from " +
+                                std::to_string(compressed) + ", the header's " +
+                                std::to_string(points) + " points hold " + std::to_string(fields));
+    }
     const std::uintmax_t need = std::uintmax_t{data_idx} + 8 + compressed;
     if (file_size < need) {
       throw fileError(path, "truncated PCD: the binary_compressed block needs " +
@@ -163,9 +180,27 @@ void requireValidAsciiBody(const std::string& path, const pcl::PCLPointCloud2& h
   }
 }
 
+/// A header cut off before its DATA line (PCL takes such a file as a cloud of no points, or reads
+/// the header's own lines as ascii data).
+void requireDataLine(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  std::size_t n = 0;
+  constexpr std::size_t kMaxHeaderLines = 1000;  // a PCD header has about a dozen
+  while (n < kMaxHeaderLines && std::getline(in, line)) {
+    ++n;
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first != std::string::npos && line.compare(first, 4, "DATA") == 0) return;
+  }
+  if (n == 0) throw fileError(path, "empty file, not a PCD file (no header)");
+  throw fileError(path, "truncated or invalid PCD header: no DATA line in its first " +
+                            std::to_string(n) + " lines");
+}
+
 // Reads and checks the header, and checks the body against it before PCL parses the body (PCL
 // itself reads past a truncated one). Throws naming path.
 void checkPcdFile(const std::string& path, pcl::PCDReader& reader) {
+  requireDataLine(path);
   pcl::PCLPointCloud2 blob;
   Eigen::Vector4f origin = Eigen::Vector4f::Zero();
   Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();

@@ -491,7 +491,8 @@ void writeBinaryPly(const std::string& path, std::size_t n, const std::vector<Pl
                     const std::vector<std::string>& comments, bool drop_non_finite_xyz) {
   if (drop_non_finite_xyz &&
       (columns.size() < 3 || columns[0].name != "x" || columns[1].name != "y" ||
-       columns[2].name != "z" || !columns[0].f || !columns[1].f || !columns[2].f)) {
+       columns[2].name != "z" ||
+       (n > 0 && (!columns[0].f || !columns[1].f || !columns[2].f)))) {
     throw std::invalid_argument("writeBinaryPly: drop_non_finite_xyz needs x, y, z first");
   }
   auto keep = [&](std::size_t i) {

@@ -10,6 +10,7 @@
 #include <charconv>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -22,6 +23,31 @@ std::string trim(std::string s) {
   s.erase(std::find_if(s.rbegin(), s.rend(), not_space).base(), s.end());
   return s;
 }
+
+// MRPT keeps the last of two values of one key (also across two [Section] blocks of the same
+// name) without a word: a key given twice is an error naming both lines.
+void requireNoDuplicateKeys(const std::string& path) {
+  std::ifstream in(path);
+  std::map<std::string, std::size_t> first_line;  // "section\nkey" -> line
+  std::string line, section;
+  for (std::size_t n = 1; std::getline(in, line); ++n) {
+    line = trim(line);
+    if (line.empty() || line[0] == ';' || line[0] == '#' || line.rfind("//", 0) == 0) continue;
+    if (line[0] == '[') {
+      section = trim(line.substr(1, line.find(']') - 1));
+      continue;
+    }
+    const auto eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    const std::string key = trim(line.substr(0, eq));
+    const auto [it, fresh] = first_line.emplace(section + "\n" + key, n);
+    if (!fresh) {
+      throw std::invalid_argument("config file " + path + ": [" + section + "] " + key +
+                                  " is given twice (lines " + std::to_string(it->second) +
+                                  " and " + std::to_string(n) + ")");
+    }
+  }
+}
 }  // namespace
 
 IniReader::IniReader(const std::string& path) : path_(path) {
@@ -30,6 +56,7 @@ IniReader::IniReader(const std::string& path) : path_(path) {
     throw std::runtime_error("config file " + path + ": not found");
   }
   if (!std::ifstream(path).good()) throw std::runtime_error("config file " + path + ": unreadable");
+  requireNoDuplicateKeys(path);
   auto cfg = std::make_unique<mrpt::config::CConfigFile>(path);
   cfg->discardSavingChanges();  // never rewrite the user's file
   cfg_ = std::move(cfg);

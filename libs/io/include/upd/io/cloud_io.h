@@ -33,8 +33,9 @@
 namespace upd::io {
 
 /// Reads a cloud, choosing the format by the extension (case-insensitive): .pcd, .ply,
-/// .xyz or .txt (XYZ text). Any other extension throws std::runtime_error naming the file
-/// and the supported extensions.
+/// .xyz or .txt (XYZ text), .bin (a KITTI scan, kitti_bin.h). Any other extension throws
+/// std::runtime_error naming the file and the supported extensions; so does a PCD, PLY or
+/// gzip file under another extension (naming what it is).
 core::PointCloud readCloud(const std::string& path);
 
 /// PCD of any DATA kind (ascii, binary, binary_compressed). Fields x, y, z are required (any

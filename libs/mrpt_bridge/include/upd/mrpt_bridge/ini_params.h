@@ -2,9 +2,9 @@
 //
 // Each options struct is read from the [Section] named after it (MRPT's convention), through the
 // struct's visit(), so the key names, units and defaults are written once, in the struct. A
-// missing file, an unknown section or key, or a value that does not parse stops with one line
-// naming the file, section, key and value; a value that parses but breaks a rule is reported by
-// the struct's validate(), prefixed with the file.
+// missing file, an unknown section or key, a key given twice, or a value that does not parse
+// stops with one line naming the file, section, key and value; a value that parses but breaks a
+// rule is reported by the struct's validate(), prefixed with the file.
 #pragma once
 
 #include "upd/core/params.h"
