@@ -89,6 +89,10 @@ class VoxelPass {
       const double dx = static_cast<double>(in_.x[i]) - ref_.x(),
                    dy = static_cast<double>(in_.y[i]) - ref_.y(),
                    dz = static_cast<double>(in_.z[i]) - ref_.z();
+      // Checked before the conversion to integers, which is undefined beyond 2^63 (1e30 m).
+      if (!(std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) * inv_ < 1e15)) {
+        throwSpan(voxel_m_);
+      }
       const std::int64_t cx = floorToInt(dx * inv_), cy = floorToInt(dy * inv_),
                          cz = floorToInt(dz * inv_);
       if (!keyFits(cx, cy, cz)) throwSpan(voxel_m_);
