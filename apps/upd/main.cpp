@@ -29,6 +29,10 @@ const Command kCommands[] = {
      upd::app::kMapUsage, upd::app::runMap},
     {"calibrate-mount", "measure the camera's height, pitch and roll from the floor it sees",
      upd::app::kCalibrateMountUsage, upd::app::runCalibrateMount},
+    {"render", "draw a scored cloud to a PNG, coloured by zeta (or label, cost, ...)",
+     upd::app::kRenderUsage, upd::app::runRender},
+    {"histogram", "plot the distribution of zeta at several d_m to a PNG",
+     upd::app::kHistogramUsage, upd::app::runHistogram},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };
