@@ -21,10 +21,12 @@ const char* const kRenderUsage =
     "  --color C             zeta (default: green = plane, blue = discontinuity, zeta from 1\n"
     "                        down to sqrt(2)/2), label, cost, slope (0-45 deg) or height\n"
     "  --normals             draw normals as short dark segments (at most ~1500)\n"
-    "  --view-from X,Y,Z     camera position in the cloud frame (default: behind (-x), to the\n"
-    "                        side and above the cloud's centre, far enough to see all of it)\n"
+    "  --view-from X,Y,Z     camera position in the cloud frame (default: 35 deg above the\n"
+    "                        cloud's centre, behind (-x) and to the side, or from the diagonal\n"
+    "                        that sees the front of most surfaces; far enough to see it all)\n"
     "  --look-at X,Y,Z       the point the camera looks at (default: the cloud's centre)\n"
-    "  --up X,Y,Z            the cloud's up vector (default 0,0,1; 0,-1,0 for a camera frame)\n"
+    "  --up X,Y,Z            the cloud's up vector (default 0,0,1; 0,-1,0 for a level camera's\n"
+    "                        optical frame): the view is drawn upright, a raw cloud scored with it\n"
     "  --size WxH            image size in pixels (default 1280x900)\n"
     "  --title TEXT          caption at the top left (default: INPUT and the colouring)\n";
 
@@ -64,10 +66,11 @@ int runRender(const std::vector<std::string>& argv) {
   opt.view_from = args.vector3("--view-from");
   opt.look_at = args.vector3("--look-at");
   if (const auto up = args.vector3("--up")) opt.up = *up;
+  if (!(opt.up.norm() > 0)) throw UsageError("--up must not be the zero vector");
   if (const auto size = args.str("--size")) std::tie(opt.width, opt.height) = parseSize(*size);
   opt.title = args.str("--title").value_or(baseName(input) + ": " + color);
 
-  const nav::ScoredCloud cloud = nav::loadScoredCloud(input);
+  const nav::ScoredCloud cloud = nav::loadScoredCloud(input, opt.up);
   nav::renderFigure(cloud, opt, *output);
   std::printf("%s: %zu points drawn by %s to %s (%dx%d)\n", input.c_str(), cloud.size(), color.c_str(),
               output->c_str(), opt.width, opt.height);

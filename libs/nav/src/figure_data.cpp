@@ -98,9 +98,11 @@ ScoredCloud readScoredPly(std::istream& in, const PlyLayout& l, const std::strin
   return c;
 }
 
-ScoredCloud scoreRawCloud(const std::string& path) {
+ScoredCloud scoreRawCloud(const std::string& path, const Eigen::Vector3f& up) {
   const core::PointCloud raw = io::readCloud(path);
-  const core::PipelineParams params;
+  core::PipelineParams params;
+  params.up = up.normalized();
+  params.validate();
   const core::PipelineResult res = core::runPipeline(raw, params);
   ScoredCloud c;
   for (std::size_t i = 0; i < res.cloud.size(); ++i) {
@@ -126,7 +128,7 @@ FigureColor parseFigureColor(const std::string& name) {
   throw std::invalid_argument("unknown colouring '" + name + "' (zeta, label, cost, slope, height)");
 }
 
-ScoredCloud loadScoredCloud(const std::string& path) {
+ScoredCloud loadScoredCloud(const std::string& path, const Eigen::Vector3f& up) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot open the file");
   ScoredCloud c;
@@ -135,9 +137,9 @@ ScoredCloud loadScoredCloud(const std::string& path) {
     std::getline(in, magic);
     if (magic.rfind("ply", 0) != 0) throw std::runtime_error(path + ": not a PLY file");
     const PlyLayout l = readPlyHeader(in, path);
-    c = l.props.count("scalar_zeta") ? readScoredPly(in, l, path) : scoreRawCloud(path);
+    c = l.props.count("scalar_zeta") ? readScoredPly(in, l, path) : scoreRawCloud(path, up);
   } else {
-    c = scoreRawCloud(path);
+    c = scoreRawCloud(path, up);
   }
   if (c.size() == 0) throw std::runtime_error(path + ": no valid points to draw");
   return c;

@@ -41,9 +41,9 @@ struct ScoredCloud {
 };
 
 /// Reads a scored PLY (the file `upd analyze --output` writes: it has scalar_zeta), or reads a
-/// raw cloud (.pcd, .ply, .xyz) and scores it with the default pipeline parameters (up +z).
-/// Points with a non-finite position are dropped. Throws when the file is missing or bad.
-ScoredCloud loadScoredCloud(const std::string& path);
+/// raw cloud (.pcd, .ply, .xyz) and scores it with the default pipeline parameters and this up
+/// vector. Points with a non-finite position are dropped. Throws when the file is missing or bad.
+ScoredCloud loadScoredCloud(const std::string& path, const Eigen::Vector3f& up = Eigen::Vector3f::UnitZ());
 
 /// The colour of zeta on the documented map (see the header comment).
 struct Rgb {
