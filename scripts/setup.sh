@@ -10,6 +10,7 @@ PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
           libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev
           libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
+          libegl1 libgl1-mesa-dri  # upd render: CFBORender through EGL, Mesa's software renderer
           octomap-tools cloudcompare gdal-bin mrpt-apps)  # the last four: tests open our files in them
 
 missing=()

@@ -154,7 +154,7 @@ void tick(mrpt::img::CImage& img, int x, int y, const std::string& text) {
   img.textOut(x + 10, y - 7, text, mrpt::img::TColor(30, 30, 30));
 }
 
-void drawBar(mrpt::img::CImage& img, const ScoredCloud& c, const Frame& f, const RenderOptions& o) {
+void drawBar(mrpt::img::CImage& img, const Frame& f, const RenderOptions& o) {
   const int x0 = o.width - kPanelWidth + 20, top = 60, bottom = o.height - 60, w = 26;
   img.selectTextFont("9x15");
   const char* names[] = {"zeta (UPD)", "label", "cost", "slope [deg]", "height [m]"};
@@ -194,7 +194,6 @@ void drawBar(mrpt::img::CImage& img, const ScoredCloud& c, const Frame& f, const
     img.textOut(x0 - 6, top - 24, "regular", mrpt::img::TColor(40, 140, 60));
     img.textOut(x0 - 6, bottom + 12, "discontinuity", mrpt::img::TColor(30, 60, 200));
   }
-  (void)c;
 }
 
 }  // namespace
@@ -212,16 +211,23 @@ void renderFigure(const ScoredCloud& cloud, const RenderOptions& o, const std::s
   // CFBORender reads the pixels back with OpenGL's default 4-byte row alignment: an RGB row
   // of a width that is not a multiple of 4 overruns the image (heap corruption in MRPT 2.5).
   const int w3d = (o.width - kPanelWidth) / 4 * 4;
-  mrpt::opengl::CFBORender fbo(unsigned(w3d), unsigned(o.height));
-  fbo.getCamera(scene) = camera(f, o, double(w3d) / o.height);
+  const mrpt::opengl::CCamera cam = camera(f, o, double(w3d) / o.height);
   mrpt::img::CImage view;
-  fbo.render_RGB(scene, view);
+  try {
+    mrpt::opengl::CFBORender fbo(unsigned(w3d), unsigned(o.height));
+    fbo.getCamera(scene) = cam;
+    fbo.render_RGB(scene, view);
+  } catch (const std::exception& e) {  // MRPT's messages span lines (with a call trace)
+    std::string first = e.what();
+    first = first.substr(0, first.find('\n'));
+    throw std::runtime_error("off-screen rendering (CFBORender, EGL) failed: " + first);
+  }
 
   mrpt::img::CImage out(o.width, o.height, mrpt::img::CH_RGB);
   out.filledRectangle(0, 0, o.width - 1, o.height - 1, mrpt::img::TColor(255, 255, 255));
   out.drawImage(0, 0, view);
   out.line(w3d, 20, w3d, o.height - 20, mrpt::img::TColor(210, 210, 210));
-  drawBar(out, cloud, f, o);
+  drawBar(out, f, o);
   if (!o.title.empty()) {
     out.selectTextFont("10x20");
     out.textOut(16, 12, o.title, mrpt::img::TColor(20, 20, 20));
