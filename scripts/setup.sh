@@ -11,6 +11,7 @@ PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
           libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev zlib1g-dev
           libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
+          libegl1 libgl1-mesa-dri  # upd render: CFBORender through EGL, Mesa's software renderer
           octomap-tools cloudcompare gdal-bin mrpt-apps  # these four: tests open our files in them
           ros-core libroscpp-dev librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
           libgeometry-msgs-dev libvisualization-msgs-dev libtf2-ros-dev libtf2-msgs-dev

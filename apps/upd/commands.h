@@ -24,6 +24,8 @@ int runLive(const std::vector<std::string>& args);
 int runMap(const std::vector<std::string>& args);
 int runCalibrateMount(const std::vector<std::string>& args);
 int runRos(const std::vector<std::string>& args);
+int runRender(const std::vector<std::string>& args);
+int runHistogram(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
 extern const char* const kSceneUsage;
@@ -35,5 +37,7 @@ extern const char* const kLiveUsage;
 extern const char* const kMapUsage;
 extern const char* const kCalibrateMountUsage;
 extern const char* const kRosUsage;
+extern const char* const kRenderUsage;
+extern const char* const kHistogramUsage;
 
 }  // namespace upd::app

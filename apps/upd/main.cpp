@@ -31,6 +31,10 @@ const Command kCommands[] = {
      upd::app::kCalibrateMountUsage, upd::app::runCalibrateMount},
     {"ros", "ROS 1 node: depth/cloud topics in, map, cloud and route out, goals driven",
      upd::app::kRosUsage, upd::app::runRos},
+    {"render", "draw a scored cloud to a PNG, coloured by zeta (or label, cost, ...)",
+     upd::app::kRenderUsage, upd::app::runRender},
+    {"histogram", "plot the distribution of zeta at several d_m to a PNG",
+     upd::app::kHistogramUsage, upd::app::runHistogram},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };
