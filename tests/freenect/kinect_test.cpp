@@ -157,3 +157,27 @@ TEST(Kinect, ADeviceRepeatingItsFrameStopsTheRobot) {
   EXPECT_GE(summary["source_stopped"]["stale_frames"].get<int>(), 1);
   EXPECT_GT(summary["source_stopped"]["silent_s"].get<double>(), 0.2);
 }
+
+// `upd live --auto-mount` on the Kinect route: the mount measured from the first frames is the
+// camera's (0.6 m up, 30 deg down), and the floor it then maps is traversable.
+TEST(Kinect, AutoMountMeasuresTheFloorAndMapsItTraversable) {
+  if (!fs::exists(kFakenect)) GTEST_SKIP() << kFakenect << " not installed (libfreenect-bin)";
+  const upd::test::TempDir dir;
+  const fs::path rec = dir.path() / "rec";
+  fs::create_directories(rec);
+  for (int i = 0; i < 8; ++i) fn::writeFakenectDepth(rec.string(), floorFrame(i), 0.01 * i, 1000 + 33 * i);
+  const auto r = liveUnderFakenect(dir, rec.string(), "--auto-mount --output " + dir.file("out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.output, m,
+                                std::regex("auto mount: floor found in 5 frames: height ([-0-9.]+) m, "
+                                           "pitch ([-0-9.]+) deg")))
+      << r.output;
+  EXPECT_NEAR(std::stod(m[1]), 0.6, 0.03) << r.output;
+  EXPECT_NEAR(std::abs(std::stod(m[2])), 0.52 * 180 / M_PI, 1.5) << r.output;
+  std::ifstream in(dir.file("out") + "/summary.json");
+  const auto j = nlohmann::json::parse(in);
+  const double known = j.at("map_known_cells").get<double>();
+  EXPECT_GT(known, 100) << j.dump();
+  EXPECT_LE(j.at("map_non_traversable_cells").get<double>(), 0.02 * known) << j.dump();
+}
