@@ -11,6 +11,10 @@
 
 #include <gtest/gtest.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -31,6 +35,13 @@ using upd::maps::TraversabilityOcTree;
 using upd::test::Frame;
 
 namespace {
+
+// The soak measures memory, not speed: on one thread its thousands of small frames do not spin
+// against the other tests of a parallel ctest run (with two threads each it took ten times as
+// long on a loaded machine).
+#ifdef _OPENMP
+const int kOneThread = (omp_set_num_threads(1), 1);
+#endif
 
 constexpr int kFrames = 10000;
 constexpr double kRadius_m = 30.0;  // the course: a circle of 188 m
