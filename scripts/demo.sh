@@ -11,4 +11,5 @@ UPD="$UPD_BUILD/apps/upd/upd"
 "$UPD" simulate --world mixed --output "$OUT/mixed.rawlog"
 "$UPD" playback "$OUT/mixed.rawlog" --config "$UPD_ROOT/config/dune-kinect.ini" \
   --poses "$OUT/mixed.gt.tum" --output "$OUT/maps"
-echo "demo: maps in $OUT/maps (map.png, map.pgm/.yaml, map.ot/.bt, map_traversability.ot, map.3Dscene, summary.json)"
+echo "demo: maps in $OUT/maps (map.png, map.tif, map.pgm/.yaml, map_cost.pgm/.yaml, map.ot/.bt,"
+echo "      map_traversability.ot, map.3Dscene, summary.json)"
