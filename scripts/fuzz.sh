@@ -4,6 +4,9 @@
 # kitti_bin), the robot config (ini), a rawlog object stream (rawlog) and the core pipeline on
 # arbitrary float clouds (pipeline). docs/RELIABILITY.md, "Fuzzing".
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     e.g. scripts/fuzz.sh 600 pcd ply
+# UPD_FUZZ_RUNS=N stops each target after N inputs as well (what comes first), and
+# UPD_FUZZ_SEED=S fixes libFuzzer's random seed: with both, a run is repeatable (what CI uses,
+# so that CI does not turn red on a finding of chance; longer runs hunt without them).
 # Seeds are made at run time: generated samples and scenes (fuzz_seeds), the shipped configs,
 # and the small clouds and rawlogs of ../shared/data (rawlogs decompressed, so the fuzzer
 # mutates the object stream and not the gzip layer). The corpus grows in build-fuzz/corpus/
@@ -55,7 +58,11 @@ for t in "${TARGETS[@]}"; do
   corpus="$BUILD/corpus/$t"
   mkdir -p "$corpus" "$BUILD/crashes" "$seeds/$t"
   echo "fuzz: $t for ${SECS} s"
+  repeatable=()
+  [ -n "${UPD_FUZZ_RUNS:-}" ] && repeatable+=(-runs="$UPD_FUZZ_RUNS")
+  [ -n "${UPD_FUZZ_SEED:-}" ] && repeatable+=(-seed="$UPD_FUZZ_SEED")
   if ! "$BUILD/tests/fuzz/fuzz_$t" -max_total_time="$SECS" -timeout=20 -rss_limit_mb=2048 \
+        "${repeatable[@]}" \
         -print_final_stats=1 -artifact_prefix="$BUILD/crashes/$t-" "$corpus" "$seeds/$t" \
         $( [ -d "$UPD_ROOT/tests/fuzz/regressions/$t" ] && echo "$UPD_ROOT/tests/fuzz/regressions/$t") \
         >"$BUILD/fuzz_$t.log" 2>&1; then

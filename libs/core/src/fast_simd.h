@@ -15,14 +15,23 @@ namespace upd::core::detail {
 constexpr int kLanes = 16;
 
 /// floor(v) as an integer: baseline x86-64 has no rounding instruction, and std::floor is then
-/// a library call, a cost per point that this one-compare version avoids.
+/// a library call, a cost per point that this one-compare version avoids. v beyond +-4.6e18
+/// (and NaN) is clamped first, so that the conversion stays defined and the caller's range check
+/// of the result (keyFits) refuses the point: a coordinate of 1e30 m is an error, not undefined
+/// behaviour.
 inline std::int64_t floorToInt(double v) {
+  constexpr double kLimit = 4.6e18;  // < 2^62
+  v = v > -kLimit ? v : -kLimit;     // NaN goes to -kLimit
+  v = v < kLimit ? v : kLimit;
   const auto t = static_cast<std::int64_t>(v);  // truncates towards zero
   return t - (v < static_cast<double>(t) ? 1 : 0);
 }
 
-/// The same for a float with |v| < 2^31.
+/// The same for a float; clamped to +-2e9 (NaN to -2e9).
 inline std::int32_t floorToInt32(float v) {
+  constexpr float kLimit = 2.0e9f;  // < 2^31
+  v = v > -kLimit ? v : -kLimit;
+  v = v < kLimit ? v : kLimit;
   const auto t = static_cast<std::int32_t>(v);  // truncates towards zero
   return t - (v < static_cast<float>(t) ? 1 : 0);
 }

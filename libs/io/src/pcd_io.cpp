@@ -249,6 +249,14 @@ core::PointCloud cloudFromBlob(const std::string& path, const pcl::PCLPointCloud
   if (!fc) fc = findField(blob, "rgba");
   if (fc && pcl::getFieldSize(fc->datatype) != 4) fc = nullptr;
 
+  // Every field read must lie within the point's bytes (a corrupt header can say otherwise).
+  for (const pcl::PCLPointField* f : {fx, fy, fz, fc}) {
+    if (f && std::uintmax_t{f->offset} + pcl::getFieldSize(f->datatype) > blob.point_step) {
+      throw fileError(path, "corrupt PCD: field '" + f->name + "' at byte " +
+                                std::to_string(f->offset) + " lies outside the point's " +
+                                std::to_string(blob.point_step) + " bytes");
+    }
+  }
   core::PointCloud cloud;
   cloud.x.resize(n);
   cloud.y.resize(n);
