@@ -24,8 +24,6 @@ const char* const kHistogramUsage =
     "  --size WxH            image size in pixels (default 1000x620)\n"
     "  --title TEXT          caption above the plot (default: INPUT)\n";
 
-std::pair<int, int> parseImageSize(const std::string& s);  // cmd_render.cpp
-
 namespace {
 
 std::vector<double> parseRadii(const std::string& s) {

@@ -32,13 +32,6 @@ const char* const kRenderUsage =
 
 namespace {
 
-std::pair<int, int> parseSize(const std::string& s) {
-  static const std::regex re("([0-9]{1,5})x([0-9]{1,5})");
-  std::smatch m;
-  if (!std::regex_match(s, m, re)) throw UsageError("--size '" + s + "': expected WxH, e.g. 1280x900");
-  return {std::stoi(m[1]), std::stoi(m[2])};
-}
-
 std::string baseName(const std::string& path) {
   const auto slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
@@ -46,7 +39,12 @@ std::string baseName(const std::string& path) {
 
 }  // namespace
 
-std::pair<int, int> parseImageSize(const std::string& s) { return parseSize(s); }
+std::pair<int, int> parseImageSize(const std::string& s) {
+  static const std::regex re("([0-9]{1,5})x([0-9]{1,5})");
+  std::smatch m;
+  if (!std::regex_match(s, m, re)) throw UsageError("--size '" + s + "': expected WxH, e.g. 1280x900");
+  return {std::stoi(m[1]), std::stoi(m[2])};
+}
 
 int runRender(const std::vector<std::string>& argv) {
   const Args args(argv, {"--output", "--color", "--view-from", "--look-at", "--up", "--size", "--title"},
@@ -67,7 +65,7 @@ int runRender(const std::vector<std::string>& argv) {
   opt.look_at = args.vector3("--look-at");
   if (const auto up = args.vector3("--up")) opt.up = *up;
   if (!(opt.up.norm() > 0)) throw UsageError("--up must not be the zero vector");
-  if (const auto size = args.str("--size")) std::tie(opt.width, opt.height) = parseSize(*size);
+  if (const auto size = args.str("--size")) std::tie(opt.width, opt.height) = parseImageSize(*size);
   opt.title = args.str("--title").value_or(baseName(input) + ": " + color);
 
   const nav::ScoredCloud cloud = nav::loadScoredCloud(input, opt.up);

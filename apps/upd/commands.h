@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace upd::app {
@@ -39,5 +40,8 @@ extern const char* const kCalibrateMountUsage;
 extern const char* const kRosUsage;
 extern const char* const kRenderUsage;
 extern const char* const kHistogramUsage;
+
+/// The --size WxH option of `upd render` and `upd histogram`; throws UsageError naming it.
+std::pair<int, int> parseImageSize(const std::string& s);
 
 }  // namespace upd::app

@@ -7,36 +7,6 @@
 
 namespace upd::openni2 {
 
-DepthFrame decimate(const DepthFrame& frame, int downscale) {
-  if (downscale < 1) {
-    throw std::invalid_argument("decimate: downscale = " + std::to_string(downscale) +
-                                ": must be >= 1");
-  }
-  if (downscale == 1) return frame;
-  DepthFrame out;
-  out.index = frame.index;
-  out.device_time_s = frame.device_time_s;
-  out.depth.width = frame.depth.width / downscale;
-  out.depth.height = frame.depth.height / downscale;
-  out.depth.depth_m.resize(static_cast<std::size_t>(out.depth.width) * out.depth.height);
-  for (int v = 0; v < out.depth.height; ++v) {
-    for (int u = 0; u < out.depth.width; ++u) {
-      out.depth.depth_m[static_cast<std::size_t>(v) * out.depth.width + u] =
-          frame.depth.at(u * downscale, v * downscale);
-    }
-  }
-  // Pixel (u, v) of the output is pixel (d u, d v) of the input.
-  const double d = downscale;
-  out.K = frame.K;
-  out.K.width = out.depth.width;
-  out.K.height = out.depth.height;
-  out.K.fx = frame.K.fx / d;
-  out.K.fy = frame.K.fy / d;
-  out.K.cx = frame.K.cx / d;
-  out.K.cy = frame.K.cy / d;
-  return out;
-}
-
 namespace {
 
 // OpenNI2 is initialized once per process and never shut down while a camera may use it.

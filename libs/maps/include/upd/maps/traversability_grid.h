@@ -212,8 +212,6 @@ class TraversabilityGrid {
   std::unique_ptr<Impl> impl_;
 };
 
-/// The whole run of a grid as one fixed window: grid.wholeRun(), for the exports.
-inline TraversabilityGrid wholeRunGrid(const TraversabilityGrid& grid) { return grid.wholeRun(); }
 
 /// Known = observed with at least min_hits_known hits.
 bool isKnown(const GridCell& cell, const GridParams& params);

@@ -24,10 +24,6 @@ struct DepthFrame {
   double device_time_s = 0;  ///< the device's timestamp [s]
 };
 
-/// Keeps every downscale-th pixel of every downscale-th row (1: unchanged) and scales the
-/// intrinsics to match. Throws std::invalid_argument for downscale < 1.
-DepthFrame decimate(const DepthFrame& frame, int downscale);
-
 /// What tryRead() got.
 enum class ReadStatus { Frame, Timeout, End };
 
