@@ -9,6 +9,7 @@
 #include "upd/sim/terrain.h"
 
 #include <cstdio>
+#include <filesystem>
 
 namespace upd::app {
 
@@ -23,7 +24,7 @@ const char* const kSimulateUsage =
     "  ground-truth traversability grid, ROS map_server format).\n\n"
     "options:\n"
     "  --world NAME      mixed, rocks, ramp, ditch, corridor, trapped, loop (default mixed)\n"
-    "  --output FILE     the rawlog to write (required)\n"
+    "  --output FILE     the rawlog to write (required; its folder is made when missing)\n"
     "  --config FILE     [SimulationParams] (speed, frame spacing, drift, seed),\n"
     "                    [RobotBodyParams] and [CameraMountParams] (the robot and its camera)\n"
     "  --frames N        stop after N frames (default: the whole route)\n"
@@ -43,6 +44,9 @@ int runSimulate(const std::vector<std::string>& argv) {
   const int frames = args.integer("--frames").value_or(0);
   if (frames < 0) throw UsageError("option --frames = " + std::to_string(frames) + ": must be >= 0");
   const sim::WorldSpec world = sim::makeWorld(args.str("--world").value_or("mixed"));
+  // As `upd playback --output DIR` makes its folder, the rawlog's folder is made when missing.
+  const std::filesystem::path folder = std::filesystem::path(*out).parent_path();
+  if (!folder.empty()) std::filesystem::create_directories(folder);
   const core::Stopwatch watch;
   const auto s = mrpt_bridge::simulateRun(world, config.simulation, *out, frames);
   const double secs = watch.elapsedMs() / 1000.0;
