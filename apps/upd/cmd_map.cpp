@@ -9,6 +9,7 @@
 #include "upd/gdal/geotiff.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -45,10 +46,13 @@ void printExtent(const maps::TraversabilityGrid& g) {
     x1 = std::max(x1, g.xMin() + (cx + 1) * g.cellSize());
     y1 = std::max(y1, g.yMin() + (cy + 1) * g.cellSize());
   });
-  std::printf("  grid: %d x %d cells of %.3g m over x [%.2f, %.2f] y [%.2f, %.2f] m\n", g.sizeX(),
+  std::printf("  grid window: %d x %d cells of %.3g m over x [%.2f, %.2f] y [%.2f, %.2f] m\n", g.sizeX(),
               g.sizeY(), g.cellSize(), g.xMin(), g.xMax(), g.yMin(), g.yMax());
   if (x0 <= x1) {
-    std::printf("  known area: x [%.2f, %.2f] y [%.2f, %.2f] m\n", x0, x1, y0, y1);
+    // The image exports (map.pgm, map_cost.pgm, map.png, map.tif) cover the known area only.
+    std::printf("  known area: %d x %d cells, x [%.2f, %.2f] y [%.2f, %.2f] m (the image exports)\n",
+                static_cast<int>(std::lround((x1 - x0) / g.cellSize())),
+                static_cast<int>(std::lround((y1 - y0) / g.cellSize())), x0, x1, y0, y1);
   }
 }
 

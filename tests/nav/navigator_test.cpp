@@ -10,8 +10,14 @@
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/serialization/CSerializable.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
 
 namespace upd::nav {
 namespace {
@@ -127,6 +133,40 @@ TEST_F(NavNavigatorRun, ABlockedGoalEndsWithTheNavigatorsError) {
   EXPECT_FALSE(o.target_reached);
   EXPECT_EQ(o.error_code, "ERR_CANNOT_REACH_TARGET");
   EXPECT_LT(base.timeS(), 59.0);  // ended by the navigator, not by the test's limit
+}
+
+// The PTG cache is shared by every process: the first one builds it in a private directory and
+// renames it into place, so the cache directory is either absent or whole, and nothing else
+// is left beside it; the next navigator reuses it.
+TEST_F(NavNavigatorRun, PtgCacheAppearsWholeAndIsReused) {
+  SimulatedDiffDrive base({0.0, 0.0, 0.0});
+  ObstacleSource obstacles;
+  const fs::path cache = dir_ / "cache";
+  // Another process's view while the grids are built: the fewest files the cache ever showed.
+  std::atomic<bool> built{false};
+  std::size_t fewest_seen = SIZE_MAX;
+  std::thread watcher([&] {
+    while (!built) {
+      std::error_code ec;
+      std::size_t n = 0;
+      for (fs::directory_iterator it(cache, ec), end; !ec && it != end; it.increment(ec)) ++n;
+      if (!ec) fewest_seen = std::min(fewest_seen, n);
+    }
+  });
+  { Navigator nav(base, obstacles, setup()); }
+  built = true;
+  watcher.join();
+  ASSERT_TRUE(fs::is_directory(cache));
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(cache)) files.push_back(e.path().filename());
+  EXPECT_FALSE(files.empty());
+  if (fewest_seen != SIZE_MAX) EXPECT_EQ(fewest_seen, files.size());
+  for (const auto& e : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+  }
+  const auto stamp = fs::last_write_time(cache / files.front());
+  { Navigator nav(base, obstacles, setup()); }
+  EXPECT_EQ(fs::last_write_time(cache / files.front()), stamp);
 }
 
 TEST_F(NavNavigatorRun, BadConfigsAreReportedWithTheFile) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
@@ -84,6 +85,23 @@ std::string readWholeFile(const std::string& path) {
   return os.str();
 }
 
+// The collision grids are built once per PTG file and shared by every process through the
+// cache directory. MRPT writes them while it initializes, so a process that finds no cache
+// builds it in a private directory and renames that into place afterwards: another process
+// never reads grids that are still being written.
+std::string ptgBuildDir(const std::string& cache_dir) {
+  if (fs::exists(cache_dir)) return cache_dir;
+  std::random_device rd;
+  return cache_dir + ".tmp." + std::to_string(rd()) + std::to_string(rd());
+}
+
+void publishPtgCache(const std::string& build_dir, const std::string& cache_dir) {
+  if (build_dir == cache_dir) return;
+  std::error_code ec;
+  fs::rename(build_dir, cache_dir, ec);  // fails when another process published first
+  if (ec) fs::remove_all(build_dir, ec);
+}
+
 }  // namespace
 
 struct Navigator::Impl {
@@ -129,11 +147,12 @@ Navigator::Navigator(RobotBase& base, const ObstacleSource& obstacles, const Nav
       setup.params.no_progress_timeout_s;
 
   std::error_code ec;
-  fs::create_directories(setup.ptg_cache_dir, ec);
+  const std::string ptg_build_dir = ptgBuildDir(setup.ptg_cache_dir);
+  fs::create_directories(ptg_build_dir, ec);
   if (ec) {
-    throw std::runtime_error("PTG cache directory " + setup.ptg_cache_dir + ": " + ec.message());
+    throw std::runtime_error("PTG cache directory " + ptg_build_dir + ": " + ec.message());
   }
-  nav.params_abstract_ptg_navigator.ptg_cache_files_directory = setup.ptg_cache_dir;
+  nav.params_abstract_ptg_navigator.ptg_cache_files_directory = ptg_build_dir;
 
   if (!setup.navlog_path.empty()) {
     // MRPT names its log log_NNN.reactivenavlog inside a directory: write it in a private
@@ -151,7 +170,13 @@ Navigator::Navigator(RobotBase& base, const ObstacleSource& obstacles, const Nav
     nav.enableLogFile(true);
     impl_->log_open = true;
   }
-  nav.initialize();
+  try {
+    nav.initialize();
+  } catch (...) {
+    if (ptg_build_dir != setup.ptg_cache_dir) fs::remove_all(ptg_build_dir, ec);
+    throw;
+  }
+  publishPtgCache(ptg_build_dir, setup.ptg_cache_dir);
 }
 
 Navigator::~Navigator() {
