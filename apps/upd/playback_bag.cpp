@@ -84,32 +84,33 @@ std::optional<BagInput> convertBagInput(const std::string& path,
   std::filesystem::create_directories(out_dir);
   BagInput in;
   in.rawlog = (out_dir / "bag.rawlog").string();
-  const std::string tmp = in.rawlog + ".tmp";
   std::ostringstream tum;
   double last_pose_t = -1e300;
   ros1::BagReadStats stats;
-  {
-    mrpt::io::CFileGZOutputStream file(tmp);
-    auto archive = mrpt::serialization::archiveFrom(file);
-    stats = ros1::readBag(path, ros1::BagTopics{}, [&](const ros1::BagFrame& f) {
-      mrpt::obs::CObservation::Ptr obs = f.from_depth ? rangeScanOf(f) : pointCloudOf(f);
-      obs->timestamp = mrpt::Clock::fromDouble(f.stamp_s);
-      archive << *obs;
-      if (f.pose_world_base && f.stamp_s > last_pose_t) {
-        tum << tumLine(f.stamp_s, *f.pose_world_base);
-        last_pose_t = f.stamp_s;
+  io::writeFileAtomicallyVia(in.rawlog, [&](const std::string& tmp) {
+    {
+      mrpt::io::CFileGZOutputStream file(tmp);
+      auto archive = mrpt::serialization::archiveFrom(file);
+      stats = ros1::readBag(path, ros1::BagTopics{}, [&](const ros1::BagFrame& f) {
+        mrpt::obs::CObservation::Ptr obs = f.from_depth ? rangeScanOf(f) : pointCloudOf(f);
+        obs->timestamp = mrpt::Clock::fromDouble(f.stamp_s);
+        archive << *obs;
+        if (f.pose_world_base && f.stamp_s > last_pose_t) {
+          tum << tumLine(f.stamp_s, *f.pose_world_base);
+          last_pose_t = f.stamp_s;
+        }
+      });
+    }
+    if (stats.frames == 0) {
+      std::string why;
+      for (const auto& [reason, n] : stats.skipped) {
+        why += "; " + std::to_string(n) + " x " + reason;
       }
-    });
-  }
-  if (stats.frames == 0) {
-    std::filesystem::remove(tmp);
-    std::string why;
-    for (const auto& [reason, n] : stats.skipped) why += "; " + std::to_string(n) + " x " + reason;
-    throw std::runtime_error(path + ": no depth or PointCloud2 frame with a sensor transform (" +
-                             std::to_string(stats.messages) + " messages on the frame topics" +
-                             why + ")");
-  }
-  std::filesystem::rename(tmp, in.rawlog);
+      throw std::runtime_error(path + ": no depth or PointCloud2 frame with a sensor transform (" +
+                               std::to_string(stats.messages) + " messages on the frame topics" +
+                               why + ")");
+    }
+  });
   if (!tum.str().empty()) {
     in.poses = (out_dir / "bag_poses.tum").string();
     const std::string text = tum.str();

@@ -4,6 +4,7 @@
 #include "commands.h"
 #include "depth_input.h"
 
+#include "upd/io/atomic_file.h"
 #include "upd/mrpt_bridge/depth_files.h"
 #include "upd/mrpt_bridge/pose_source.h"
 #include "upd/sim/robot.h"
@@ -146,18 +147,16 @@ mrpt::obs::CObservation3DRangeScan::Ptr tumScan(const core::DepthImage& depth, c
   return obs;
 }
 
-// The folder as a rawlog (observations only), through a temporary file and a rename.
+// The folder as a rawlog (observations only), written atomically.
 void writeSequence(const std::vector<TumFrame>& frames, const TumOptions& o, const fs::path& rawlog) {
-  const fs::path tmp = rawlog.string() + ".tmp";
-  {
+  io::writeFileAtomicallyVia(rawlog.string(), [&](const std::string& tmp) {
     mrpt::io::CFileGZOutputStream out;
-    if (!out.open(tmp.string(), 1)) throw std::runtime_error("cannot write " + tmp.string());
+    if (!out.open(tmp, 1)) throw std::runtime_error("cannot write " + rawlog.string());
     auto arch = mrpt::serialization::archiveFrom(out);
     for (const TumFrame& f : frames) {
       arch << *tumScan(depthImageOf(f.png, o.calib, o.metres_per_unit), o, f.t_s);
     }
-  }
-  fs::rename(tmp, rawlog);
+  });
 }
 
 }  // namespace
@@ -171,13 +170,7 @@ int runTumPlayback(const std::vector<std::string>& argv) {
   const std::vector<TumFrame> frames = readDepthList(o.dir);
   fs::create_directories(o.out_dir);
   const fs::path rawlog = o.out_dir / "sequence.rawlog";
-  try {
-    writeSequence(frames, o, rawlog);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove(rawlog.string() + ".tmp", ec);
-    throw;
-  }
+  writeSequence(frames, o, rawlog);
   std::printf("%s: %zu depth images (fx %.1f, %g m per unit) -> %s\n", o.dir.c_str(),
               frames.size(), o.calib.K.fx, o.metres_per_unit, rawlog.c_str());
   std::vector<std::string> args{rawlog.string(), "--poses", o.poses};

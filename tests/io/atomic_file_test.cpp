@@ -69,6 +69,42 @@ TEST(AtomicFile, ThrowingWriterLeavesTargetIntactAndNoTemporary) {
   EXPECT_EQ(filesIn(dir.path()), 1u);
 }
 
+// Writers that open the file by name (MRPT's gzip streams, GDAL) get a temporary path with the
+// suffix they asked for; what they leave is renamed into place, a throw leaves nothing.
+TEST(AtomicFile, WriterByNameGetsATemporaryPathWithItsSuffix) {
+  TempDir dir;
+  const std::string f = dir.file("map.tif");
+  std::string seen;
+  upd::io::writeFileAtomicallyVia(
+      f,
+      [&](const std::string& tmp) {
+        seen = tmp;
+        std::ofstream(tmp) << "tiff";
+      },
+      ".tif");
+  EXPECT_NE(seen, f);
+  EXPECT_EQ(fs::path(seen).parent_path(), fs::path(f).parent_path());
+  EXPECT_EQ(fs::path(seen).extension(), ".tif");
+  EXPECT_EQ(readText(f), "tiff");
+  struct WriterFailure {};
+  EXPECT_THROW(upd::io::writeFileAtomicallyVia(f,
+                                               [](const std::string& tmp) {
+                                                 std::ofstream(tmp) << "half";
+                                                 throw WriterFailure{};
+                                               }),
+               WriterFailure);
+  EXPECT_EQ(readText(f), "tiff");
+  EXPECT_EQ(filesIn(dir.path()), 1u) << "a temporary file was left behind";
+  try {
+    upd::io::writeFileAtomicallyVia(dir.file("none.rawlog"), [](const std::string&) {});
+    FAIL() << "a writer that writes nothing must be an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("none.rawlog"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(upd::io::writeFileAtomicallyVia(dir.file("no/such/dir.bin"), [](const std::string&) {}),
+               std::runtime_error);
+}
+
 TEST(AtomicFile, StreamFailureIsAnErrorNamingTheFile) {
   // What a full disk looks like to the writer: the stream goes bad.
   TempDir dir;

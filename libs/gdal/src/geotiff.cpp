@@ -1,5 +1,6 @@
 #include "upd/gdal/geotiff.h"
 
+#include "upd/io/atomic_file.h"
 #include "upd/maps/fusion.h"
 
 #include <cpl_error.h>
@@ -13,7 +14,6 @@
 #include <memory>
 #include <mutex>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace upd::gdal {
 
@@ -188,18 +188,18 @@ void writeGeoTiff(const maps::TraversabilityGrid& grid, const std::string& path,
   if (options.epsg != 0) validateEpsg(options.epsg);  // fail before creating anything
   initGdal();
   const QuietErrors quiet;
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid()) + ".tif";
-  try {
-    writeDataset(grid, tmp, path, options);  // closed (flushed to disk) on return
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    if (ec) throw std::runtime_error("cannot write " + path + ": " + ec.message());
-  } catch (...) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    fs::remove(tmp + ".aux.xml", ec);
-    throw;
-  }
+  io::writeFileAtomicallyVia(
+      path,
+      [&](const std::string& tmp) {
+        try {
+          writeDataset(grid, tmp, path, options);  // closed (flushed to disk) on return
+        } catch (...) {
+          std::error_code ec;
+          fs::remove(tmp + ".aux.xml", ec);
+          throw;
+        }
+      },
+      ".tif");
 }
 
 namespace {

@@ -38,10 +38,7 @@ void removeQuietly(const fs::path& p) {
   fs::remove(p, ec);  // best effort: we are already reporting a more relevant error
 }
 
-}  // namespace
-
-void writeFileAtomically(const std::string& path,
-                         const std::function<void(std::ostream&)>& write) {
+void checkTarget(const std::string& path) {
   if (path.empty()) throw std::runtime_error("cannot write a file with an empty name");
   const fs::path target(path);
   const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
@@ -53,8 +50,24 @@ void writeFileAtomically(const std::string& path,
   if (fs::is_directory(target, ec)) {
     throw std::runtime_error("cannot write '" + path + "': it is a directory");
   }
+}
 
-  const fs::path tmp = temporaryPathFor(target);
+void renameIntoPlace(const fs::path& tmp, const std::string& path) {
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    removeQuietly(tmp);
+    throw std::runtime_error("cannot write '" + path + "': renaming the temporary file failed: " +
+                             ec.message());
+  }
+}
+
+}  // namespace
+
+void writeFileAtomically(const std::string& path,
+                         const std::function<void(std::ostream&)>& write) {
+  checkTarget(path);
+  const fs::path tmp = temporaryPathFor(fs::path(path));
   std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
   if (!out) {
     const int err = errno;
@@ -79,13 +92,25 @@ void writeFileAtomically(const std::string& path,
     removeQuietly(tmp);
     throw;
   }
+  renameIntoPlace(tmp, path);
+}
 
-  fs::rename(tmp, target, ec);
-  if (ec) {
+void writeFileAtomicallyVia(const std::string& path,
+                            const std::function<void(const std::string& tmp_path)>& write,
+                            const std::string& suffix) {
+  checkTarget(path);
+  fs::path tmp = temporaryPathFor(fs::path(path));
+  tmp += suffix;
+  try {
+    write(tmp.string());
+  } catch (...) {
     removeQuietly(tmp);
-    throw std::runtime_error("cannot write '" + path + "': renaming the temporary file failed: " +
-                             ec.message());
+    throw;
   }
+  if (!fs::exists(tmp)) {
+    throw std::runtime_error("cannot write '" + path + "': nothing was written");
+  }
+  renameIntoPlace(tmp, path);
 }
 
 }  // namespace upd::io

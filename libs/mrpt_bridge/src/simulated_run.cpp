@@ -24,7 +24,6 @@
 #include <iomanip>
 #include <random>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace upd::mrpt_bridge {
 
@@ -150,25 +149,6 @@ std::vector<RoutePose> sampleRoute(const std::vector<Eigen::Vector2d>& way,
   return route;
 }
 
-void writeAtomicallyWith(const std::string& path,
-                         const std::function<void(const std::string&)>& w) {
-  const fs::path target(path);
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir)) {
-    throw std::runtime_error("cannot write " + path + ": directory " + dir.string() +
-                             " does not exist");
-  }
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  try {
-    w(tmp);
-    fs::rename(tmp, target);
-  } catch (...) {
-    std::error_code ec;
-    fs::remove(tmp, ec);
-    throw;
-  }
-}
-
 std::string stemOf(const std::string& rawlog_path) {
   fs::path p(rawlog_path);
   return (p.parent_path() / p.stem()).string();
@@ -239,7 +219,7 @@ void writeRawlog(const std::vector<RoutePose>& route, const sim::WorldSpec& worl
   optical_in_sensor.linear() = sim::opticalInMount();
   std::mt19937 rng(static_cast<std::uint32_t>(p.seed));
   std::normal_distribution<double> gauss(0.0, 1.0);
-  writeAtomicallyWith(rawlog_path, [&](const std::string& tmp) {
+  io::writeFileAtomicallyVia(rawlog_path, [&](const std::string& tmp) {
     mrpt::io::CFileGZOutputStream out;
     if (!out.open(tmp, 1)) throw std::runtime_error("cannot write " + tmp);
     auto arch = mrpt::serialization::archiveFrom(out);

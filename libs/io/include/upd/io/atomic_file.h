@@ -20,4 +20,11 @@ namespace upd::io {
 /// stream fails (e.g. disk full) or when the rename fails.
 void writeFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// The same for writers that open a file by name themselves (MRPT's gzip streams, GDAL):
+/// write() gets the temporary file's path (ending in `suffix`, for writers that choose the
+/// format by extension), must have closed it when it returns, and is renamed over path.
+void writeFileAtomicallyVia(const std::string& path,
+                            const std::function<void(const std::string& tmp_path)>& write,
+                            const std::string& suffix = "");
+
 }  // namespace upd::io
