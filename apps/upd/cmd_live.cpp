@@ -72,12 +72,14 @@ const char* const kLiveUsage =
     "  --auto-mount       measure the mount from the floor in the first frames (robot on a\n"
     "                     level floor); no floor found: one line, exit status 1, no run\n\n"
     "exit status: 0 done; 1 error (a source that cannot be opened, ...); 2 usage error;\n"
-    "3 --navigate did not reach the goal; 4 the source stopped (the robot was stopped).\n";
+    "3 --navigate did not reach the goal; 4 the source stopped (the robot was stopped); 5 the\n"
+    "robot base stopped answering (an emergency stop was sent). --output is written in each.\n";
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr int kExitSourceStopped = 4;
+constexpr int kExitBaseFault = 5;
 
 /// What one run did, for the summary line and summary.json.
 struct LiveTally {
@@ -87,6 +89,7 @@ struct LiveTally {
   double score_ms = 0;  ///< summed over the frames
   std::map<std::string, std::size_t> skipped;  ///< observations that gave no cloud, by reason
   std::optional<SourceStall> stall;
+  std::optional<BaseFault> base_fault;
   std::size_t recorded = 0;
   nav::NavOutcome outcome;
 };
@@ -127,6 +130,13 @@ void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTa
   j["map_known_cells"] = stats.known;
   j["map_non_traversable_cells"] = stats.non_traversable;
   j["source_stopped"] = t.stall ? stallJson(*t.stall, o.stale_timeout_s) : nlohmann::json();
+  j["base_fault"] = nlohmann::json();
+  if (t.base_fault) {
+    j["base_fault"] = {{"reason", t.base_fault->reason},
+                       {"frames", t.base_fault->frames},
+                       {"robot_stopped", t.base_fault->robot_stopped},
+                       {"message", t.base_fault->line()}};
+  }
   if (o.record) j["recording"] = {{"path", *o.record}, {"observations", t.recorded}};
   if (o.goal) {
     j["goal_xy_m"] = {o.goal->x(), o.goal->y()};
@@ -156,6 +166,8 @@ struct LiveRun {
     if (o.goal) loop.navigateTo(*o.goal);
     t0 = last = last_report = now = Clock::now();  // the run starts after the set-up
   }
+  /// The base driven: the real one when there is one.
+  nav::RobotBase& driven() { return external ? *external : base; }
   double secondsSinceStart() const {
     return std::chrono::duration<double>(Clock::now() - t0).count();
   }
@@ -173,6 +185,7 @@ struct LiveRun {
   int frames = 0;
   double score_ms = 0;
   std::map<std::string, std::size_t> skipped;
+  std::optional<BaseFault> base_fault;  ///< set when the base stopped answering
 };
 
 // The base's pose at the frame (before it) and the observation, into the recording.
@@ -186,7 +199,8 @@ void recordFrame(LiveRun& run, const mrpt::obs::CObservation& obs, const nav::Ba
 }
 
 // Scores one observation into the map at the base's pose, advanced to the frame's arrival;
-// nullptr (counted) when the observation gives no cloud.
+// nullptr (counted) when the observation gives no cloud, or (run.base_fault set, the robot told
+// to stop) when the base does not answer.
 const nav::FrameEvidence* addFrame(LiveRun& run, mrpt::obs::CObservation& obs,
                                    nav::BaseState& s) {
   if (run.opt.mount || run.opt.auto_mount) remount(obs, run.config.camera);
@@ -194,8 +208,9 @@ const nav::FrameEvidence* addFrame(LiveRun& run, mrpt::obs::CObservation& obs,
   const double dt = std::chrono::duration<double>(run.now - run.last).count();
   run.last = run.now;
   if (dt > 0 && !run.external) run.base.advance(dt);
-  nav::RobotBase& driven = run.external ? *run.external : run.base;
-  if (!driven.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  nav::RobotBase& driven = run.driven();
+  run.base_fault = readBaseState(driven, static_cast<std::size_t>(run.frames), s);
+  if (run.base_fault) return nullptr;
   recordFrame(run, obs, s);
   mrpt_bridge::toCloud(obs, run.source_params, run.converted);
   if (!run.converted.ok()) {
@@ -251,7 +266,7 @@ std::string runFrames(LiveRun& run, LiveSource& source, LiveTally& t) {
   while (true) {
     if (run.opt.max_frames > 0 && run.frames >= run.opt.max_frames) return "frame limit";
     SourceStall stall;
-    switch (nextFreshFrame(source, watchdog, run.base, now_s, stopRequested, frame, stall)) {
+    switch (nextFreshFrame(source, watchdog, run.driven(), now_s, stopRequested, frame, stall)) {
       case NextFrame::End:
         return "end of the recording";
       case NextFrame::Interrupted:
@@ -266,6 +281,11 @@ std::string runFrames(LiveRun& run, LiveSource& source, LiveTally& t) {
     }
     nav::BaseState s;
     const nav::FrameEvidence* ev = addFrame(run, *frame.observation, s);
+    if (run.base_fault) {
+      std::fprintf(stderr, "upd live: %s\n", run.base_fault->line().c_str());
+      t.base_fault = run.base_fault;
+      return "base stopped answering";
+    }
     if (!ev) continue;
     if (const auto end = afterFrame(run, *ev, s)) return *end;
     reportProgress(run, *ev, s);
@@ -278,6 +298,7 @@ int finishLive(const LiveOptions& o, const LiveTally& t, const maps::Traversabil
   printSummary(t, stats);
   if (o.record) std::printf("  recorded %zu observations to %s\n", t.recorded, o.record->c_str());
   if (o.out) writeLiveOutputs(*o.out, o, t, grid, stats);
+  if (t.base_fault) return kExitBaseFault;
   if (t.stall) return kExitSourceStopped;
   if (o.goal) return t.outcome.target_reached ? 0 : 3;
   return 0;

@@ -319,6 +319,7 @@ struct Playback {
   std::string pose_source;  ///< where the robot poses came from
   std::optional<RawlogDamage> damage;  ///< set when the rawlog ended in damage (not --strict)
   int interrupted_by = 0;  ///< the signal that stopped the frame loop early, 0 if none
+  MemoryTrace memory_trace;  ///< resident memory every 1,000 frames processed
 
   explicit Playback(const RunConfig& config) : grid(config.grid), tree(config.octree) {}
 };
@@ -428,6 +429,7 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
     }
     if (annotated) annotated->write(entry, pose.pose_world_robot, res.scored);
     ++run.processed;
+    run.memory_trace.frameProcessed(run.processed, run.grid, run.tree);
     progress.update(run.read);
   }
   progress.finish();
@@ -523,6 +525,7 @@ int runPlayback(const std::vector<std::string>& argv) {
   writeMapFiles(run.grid, run.tree, run.trajectory, options.out_dir, options.epsg);
   json summary = summaryJson(options, config, run, truth, wall.elapsedMs() / 1000.0);
   memory["vm_hwm_with_exports_bytes"] = peakResidentBytes();
+  memory["trace"] = run.memory_trace.json();
   summary["memory"] = memory;
   io::writeJsonAtomically((options.out_dir / "summary.json").string(), summary);
   printSummary(options, summary, config.evaluation.tolerance_m);

@@ -59,4 +59,20 @@ NextFrame nextFreshFrame(LiveSource& source, SourceWatchdog& watchdog, nav::Robo
   return NextFrame::Interrupted;
 }
 
+std::string BaseFault::line() const {
+  return "the robot base stopped answering after " + std::to_string(frames) + " frames: " +
+         (reason.empty() ? std::string("it does not report its pose") : reason) + "; " +
+         (robot_stopped ? "emergency stop sent" : "the emergency stop FAILED too");
+}
+
+std::optional<BaseFault> readBaseState(nav::RobotBase& base, std::size_t frames,
+                                       nav::BaseState& state) {
+  if (base.readState(state)) return std::nullopt;
+  BaseFault fault;
+  fault.reason = base.lastError();
+  fault.frames = frames;
+  fault.robot_stopped = base.stop(true);
+  return fault;
+}
+
 }  // namespace upd::app

@@ -1,4 +1,4 @@
-// A source that stops: `upd live` must notice a device that delivers no frame, or delivers the
+// A source or a base that stops: `upd live` must notice a device that delivers no frame, or delivers the
 // same frame again and again (the same device stamp), and stop the robot.
 //
 // SourceWatchdog measures the time since the last NEW frame (a stamp it has not seen; a frame
@@ -6,6 +6,10 @@
 // nextFreshFrame() polls a LiveSource until a new frame comes, the recording ends or the
 // watchdog expires; on expiry it tells the base to stop (RobotBase::stop, emergency) and
 // returns Stalled with what happened, so that the caller logs one line and records it.
+//
+// readBaseState() reads the robot base once per frame; a base that stops answering (a call
+// returns false: RosRobotBase's odometry older than odom_timeout_s, a driver that times out) is
+// told to stop (emergency) and the run ends with BaseFault's line.
 #pragma once
 
 #include "live_source.h"
@@ -13,10 +17,12 @@
 #include <atomic>
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 
 namespace upd::nav {
 class RobotBase;
+struct BaseState;
 }
 
 namespace upd::app {
@@ -60,5 +66,19 @@ enum class NextFrame { Fresh, End, Stalled, Interrupted };
 NextFrame nextFreshFrame(LiveSource& source, SourceWatchdog& watchdog, nav::RobotBase& base,
                          const std::function<double()>& now_s, const std::function<bool()>& stop,
                          LiveFrame& frame, SourceStall& stall);
+
+/// A robot base that stopped answering.
+struct BaseFault {
+  std::string reason;        ///< RobotBase::lastError() ("" when the base gives none)
+  std::size_t frames = 0;    ///< frames processed before it
+  bool robot_stopped = false;  ///< the emergency stop sent after it was acknowledged
+  /// "the robot base stopped answering after 37 frames: odometry on /odom is stale (...);
+  /// emergency stop sent"
+  std::string line() const;
+};
+
+/// base.readState(state); when it fails, base.stop(true) and the fault (frames: processed so far).
+std::optional<BaseFault> readBaseState(nav::RobotBase& base, std::size_t frames,
+                                       nav::BaseState& state);
 
 }  // namespace upd::app

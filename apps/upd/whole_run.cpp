@@ -6,17 +6,35 @@
 
 namespace upd::app {
 
-std::size_t peakResidentBytes() {
+namespace {
+
+// A "Name:   N kB" line of /proc/self/status [bytes]; 0 when there is none.
+std::size_t statusBytes(const std::string& name) {
   std::ifstream status("/proc/self/status");
   std::string line;
   while (std::getline(status, line)) {
-    if (line.rfind("VmHWM:", 0) != 0) continue;
-    std::istringstream in(line.substr(6));
+    if (line.rfind(name, 0) != 0) continue;
+    std::istringstream in(line.substr(name.size()));
     std::size_t kib = 0;
     in >> kib;
     return kib * 1024;
   }
   return 0;
+}
+
+}  // namespace
+
+std::size_t peakResidentBytes() { return statusBytes("VmHWM:"); }
+
+std::size_t residentBytes() { return statusBytes("VmRSS:"); }
+
+void MemoryTrace::frameProcessed(std::size_t processed, const maps::TraversabilityGrid& grid,
+                                 const maps::TraversabilityOcTree& tree) {
+  if (every_ == 0 || processed % every_ != 0) return;
+  samples_.push_back({{"frames", processed},
+                      {"rss_bytes", residentBytes()},
+                      {"grid_bytes", grid.memoryBytes()},
+                      {"octree_bytes", tree.memoryUsage() + tree.keptTileBytes()}});
 }
 
 nlohmann::json runMemoryJson(const maps::TraversabilityGrid& grid,

@@ -15,6 +15,25 @@ namespace upd::app {
 /// The process's peak resident memory so far (VmHWM of /proc/self/status) [bytes]; 0 when the
 /// file cannot be read (not Linux).
 std::size_t peakResidentBytes();
+/// The process's resident memory now (VmRSS of /proc/self/status) [bytes]; 0 as above.
+std::size_t residentBytes();
+
+/// summary.json's "memory"."trace": every `every` frames processed, the resident memory and the
+/// maps' own bytes then, to show that a long run's memory stays flat once the map's working set
+/// (the grid's window, the octree's box, the tiles of the places seen) is reached.
+class MemoryTrace {
+ public:
+  explicit MemoryTrace(std::size_t every = 1000) : every_(every) {}
+  /// Records a sample when processed is a multiple of `every`.
+  void frameProcessed(std::size_t processed, const maps::TraversabilityGrid& grid,
+                      const maps::TraversabilityOcTree& tree);
+  /// [{"frames", "rss_bytes", "grid_bytes", "octree_bytes"}, ...]
+  const nlohmann::json& json() const { return samples_; }
+
+ private:
+  std::size_t every_;
+  nlohmann::json samples_ = nlohmann::json::array();
+};
 
 /// summary.json's "memory": the peak resident memory so far and the maps' own bytes (window or
 /// box, kept tiles, the stated bound per grid tile).

@@ -129,3 +129,76 @@ TEST(LiveWatchdog, FramesWithoutStampsAreAlwaysNew) {
   EXPECT_TRUE(w.expired(1.51));
   EXPECT_THROW(upd::app::SourceWatchdog(0.0, 0.0), std::invalid_argument);
 }
+
+namespace {
+
+// A base that answers `answers` readState calls, then stops answering (as RosRobotBase does
+// when its odometry is older than odom_timeout_s); its stop may fail too.
+class FakeBase : public upd::nav::RobotBase {
+ public:
+  FakeBase(int answers, std::string error, bool stop_works = true)
+      : answers_(answers), error_(std::move(error)), stop_works_(stop_works) {}
+  bool readState(upd::nav::BaseState& s) override {
+    if (reads_ >= answers_) return false;
+    s.pose_world_robot.x_m = ++reads_;
+    return true;
+  }
+  bool sendVelocity(const upd::nav::Twist2D&) override { return reads_ < answers_; }
+  bool stop(bool emergency) override {
+    ++stops;
+    emergency_stop = emergency;
+    return stop_works_;
+  }
+  double timeS() const override { return 0.0; }
+  std::string lastError() const override { return reads_ < answers_ ? "" : error_; }
+  int stops = 0;
+  bool emergency_stop = false;
+
+ private:
+  int answers_, reads_ = 0;
+  std::string error_;
+  bool stop_works_;
+};
+
+}  // namespace
+
+TEST(LiveBaseFault, ABaseThatStopsAnsweringIsToldToStopWithTheReasonInOneLine) {
+  FakeBase base(3, "odometry on /odom is stale (0.8 s old, limit 0.5 s)");
+  upd::nav::BaseState s;
+  for (std::size_t frame = 0; frame < 3; ++frame) {
+    EXPECT_FALSE(upd::app::readBaseState(base, frame, s).has_value());
+    EXPECT_EQ(s.pose_world_robot.x_m, frame + 1.0);
+  }
+  EXPECT_EQ(base.stops, 0);
+  const auto fault = upd::app::readBaseState(base, 3, s);
+  ASSERT_TRUE(fault.has_value());
+  EXPECT_EQ(base.stops, 1);
+  EXPECT_TRUE(base.emergency_stop);
+  EXPECT_TRUE(fault->robot_stopped);
+  EXPECT_EQ(fault->frames, 3u);
+  EXPECT_EQ(fault->line(),
+            "the robot base stopped answering after 3 frames: odometry on /odom is stale "
+            "(0.8 s old, limit 0.5 s); emergency stop sent");
+  EXPECT_EQ(fault->line().find('\n'), std::string::npos);
+}
+
+TEST(LiveBaseFault, ABaseWithoutAReasonOrAWorkingStopIsStillNamed) {
+  FakeBase base(0, "", /*stop_works=*/false);
+  upd::nav::BaseState s;
+  const auto fault = upd::app::readBaseState(base, 0, s);
+  ASSERT_TRUE(fault.has_value());
+  EXPECT_FALSE(fault->robot_stopped);
+  EXPECT_EQ(fault->line(), "the robot base stopped answering after 0 frames: it does not report "
+                           "its pose; the emergency stop FAILED too");
+}
+
+// The source watchdog stops the base the run drives, whichever it is.
+TEST(LiveBaseFault, AStalledSourceStopsTheBaseGiven) {
+  double clock_s = 0;
+  FakeSource source(2, FakeSource::After::Nothing, clock_s, 0.25);
+  FakeBase base(100, "");
+  const Pulled r = pull(source, clock_s, base, 1.0);
+  EXPECT_EQ(r.last, NextFrame::Stalled);
+  EXPECT_EQ(base.stops, 1);
+  EXPECT_TRUE(base.emergency_stop);
+}

@@ -113,6 +113,7 @@ class OwnedRosBase : public nav::RobotBase {
   bool sendVelocity(const nav::Twist2D& c) override { return base_.sendVelocity(c); }
   bool stop(bool e) override { return base_.stop(e); }
   double timeS() const override { return base_.timeS(); }
+  std::string lastError() const override { return base_.lastError(); }
   RosRobotBase& base() { return base_; }
 
  private:

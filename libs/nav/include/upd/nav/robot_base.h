@@ -12,6 +12,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 
 namespace upd::nav {
 
@@ -52,6 +53,8 @@ class RobotBase {
   /// Seconds on the clock the navigation runs on: simulated time for a simulator, a monotonic
   /// wall clock for a real robot. Only differences are used.
   virtual double timeS() const = 0;
+  /// Why the last call failed, for the one-line error a run ends with ("" when unknown).
+  virtual std::string lastError() const { return {}; }
 };
 
 /// Dynamics of the simulated base. Loaded from [SimulatedBaseParams].

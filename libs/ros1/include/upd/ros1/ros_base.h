@@ -60,7 +60,7 @@ class RosRobotBase : public nav::RobotBase {
   double timeS() const override;
 
   /// Why the last readState() failed ("" when it did not).
-  std::string lastError() const;
+  std::string lastError() const override;
   /// Whether any odometry arrived.
   bool hasOdometry() const;
 
