@@ -335,7 +335,7 @@ def evaluation_section(out, fig, status):
     missing = [p for p in pngs if (prefix + p) not in text]
     links = "".join("\n%s" % image(fig + "/evaluation", p, p[:-4]) for p in missing)
     # Demote the included headings below this section's.
-    text = re.sub(r"^(#+) ", lambda m: "#" + m.group(1) + " ", text, flags=re.M)
+    text = re.sub(r"^(#+) ", lambda m: "##" + m.group(1) + " ", text, flags=re.M)
     return (head + "From `upd evaluate --output %s/evaluation`, included as it wrote it:\n\n" % fig
             + text.strip() + "\n" + links + "\n")
 
