@@ -24,7 +24,7 @@ while [ $# -gt 0 ]; do
     --build) BUILD="$2"; shift 2 ;;
     --data) DATA="$2"; shift 2 ;;
     --quick) QUICK=1; shift ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "results.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -34,12 +34,13 @@ UPD="${UPD:-$BUILD/apps/upd/upd}"
 command -v python3 >/dev/null || { echo "results.sh: python3 is needed to format RESULTS.md" >&2; exit 1; }
 
 FIG_REL="figures/results"
-FIG="$OUT/$FIG_REL"
 WORK="$(mktemp -d "${TMPDIR:-/tmp}/upd-results.XXXXXX")"
 trap 'rm -rf "$WORK"' EXIT
-mkdir -p "$FIG" "$WORK/data"
-rm -f "$FIG"/*.png "$FIG"/*.jpg
-rm -rf "$FIG/evaluation"
+# Everything is made in a staging folder and moved into OUT at the end: a failed run leaves
+# OUT as it was.
+STAGE="$WORK/stage"
+FIG="$STAGE/$FIG_REL"
+mkdir -p "$FIG" "$WORK/data" "$OUT"
 CONFIG="$ROOT/config"
 
 if [ "$QUICK" = 1 ]; then
@@ -162,6 +163,11 @@ else
   say "no labelled evaluation: this build's upd has no 'evaluate' command"
 fi
 
-python3 "$ROOT/scripts/results_report.py" --work "$WORK" --figures "$FIG_REL" --out "$OUT" \
+python3 "$ROOT/scripts/results_report.py" --work "$WORK" --figures "$FIG_REL" --out "$STAGE" \
   --eval "$EVAL_STATUS" --quick "$QUICK" --data "$DATA"
-say "wrote $OUT/RESULTS.md and $(find "$FIG" -type f | wc -l) files in $FIG"
+COUNT="$(find "$FIG" -type f | wc -l)"
+rm -rf "${OUT:?}/$FIG_REL"
+mkdir -p "$(dirname "$OUT/$FIG_REL")"
+mv "$FIG" "$OUT/$FIG_REL"
+mv "$STAGE/RESULTS.md" "$OUT/RESULTS.md"
+say "wrote $OUT/RESULTS.md and $COUNT files in $OUT/$FIG_REL"
