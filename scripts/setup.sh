@@ -13,6 +13,7 @@ PACKAGES=(build-essential cmake pkg-config
           libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
           libegl1 libgl1-mesa-dri  # upd render: CFBORender through EGL, Mesa's software renderer
           octomap-tools cloudcompare gdal-bin mrpt-apps  # these four: tests open our files in them
+          python3  # scripts/results.sh formats docs/RESULTS.md; the layout and results tests
           ros-core libroscpp-dev librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
           libgeometry-msgs-dev libvisualization-msgs-dev libtf2-ros-dev libtf2-msgs-dev
           clang-14 libclang-rt-14-dev)  # libFuzzer and the sanitizers: scripts/fuzz.sh, sanitize.sh

@@ -35,6 +35,8 @@ const Command kCommands[] = {
      upd::app::kRenderUsage, upd::app::runRender},
     {"histogram", "plot the distribution of zeta at several d_m to a PNG",
      upd::app::kHistogramUsage, upd::app::runHistogram},
+    {"baseline", "score a cloud with the paper's roughness index, beside the UPD (Fig. 5)",
+     upd::app::kBaselineUsage, upd::app::runBaseline},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };

@@ -127,6 +127,24 @@ TEST(PlyIo, BinaryRoundTripWithoutColour) {
   EXPECT_EQ(back.height, 1u);
 }
 
+// The sensor origin orients the normals of vertical surfaces (towards the sensor): a PLY that
+// dropped it left a generated scene's wall with normals of both signs once read back.
+TEST(PlyIo, SensorOriginSurvivesTheRoundTrip) {
+  TempDir dir;
+  core::PointCloud c = randomCloud(50, false, 2);
+  c.sensor_origin = Eigen::Vector3f(1.5f, -0.25f, 1e-7f);
+  const std::string f = dir.file("origin.ply");
+  upd::io::writePly(f, c);
+  EXPECT_EQ(upd::io::readPly(f).sensor_origin, c.sensor_origin);
+  c.sensor_origin.setZero();  // the default: no header line
+  upd::io::writePly(f, c);
+  EXPECT_EQ(readBytes(f).find("sensor_origin"), std::string::npos);
+  EXPECT_EQ(upd::io::readPly(f).sensor_origin, Eigen::Vector3f::Zero());
+  writeBytes(f, "ply\nformat ascii 1.0\ncomment sensor_origin 1 x 2\nelement vertex 0\n"
+                "property float x\nproperty float y\nproperty float z\nend_header\n");
+  expectErrorContaining([&] { upd::io::readPly(f); }, {f, "sensor_origin", "'x'"});
+}
+
 TEST(PlyIo, BinaryRoundTripWithColourAndLabels) {
   TempDir dir;
   const core::PointCloud c = randomCloud(777, true, 2);

@@ -2,6 +2,8 @@
 // one routine writes every PLY the project produces, so their headers cannot drift apart.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -26,5 +28,10 @@ struct PlyColumn {
 /// skipped. comments go into the header, one `comment` line each (newlines become spaces).
 void writeBinaryPly(const std::string& path, std::size_t n, const std::vector<PlyColumn>& columns,
                     const std::vector<std::string>& comments, bool drop_non_finite_xyz);
+
+/// comments with `sensor_origin X Y Z` added when origin is not (0, 0, 0), the origin readPly
+/// restores: the "towards the sensor" orientation of vertical normals needs it.
+std::vector<std::string> withOriginComment(std::vector<std::string> comments,
+                                           const Eigen::Vector3f& origin);
 
 }  // namespace upd::io::detail

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdlib>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -48,6 +49,7 @@ struct PlyHeader {
   PlyFormat format = PlyFormat::Ascii;
   std::vector<PlyElement> elements;
   std::uint64_t lines = 0;  ///< header lines, so ascii data errors can give file line numbers
+  Eigen::Vector3f sensor_origin = Eigen::Vector3f::Zero();  ///< `comment sensor_origin X Y Z`
 };
 
 bool parseType(const std::string& s, PlyType& t) {
@@ -126,6 +128,15 @@ std::vector<std::string> splitWords(const std::string& line) {
   return words;
 }
 
+float parseOriginWord(const std::string& path, const std::string& where, const std::string& s) {
+  char* end = nullptr;
+  const float v = std::strtof(s.c_str(), &end);
+  if (s.empty() || *end != '\0' || !std::isfinite(v)) {
+    throw fileError(path, where + "bad sensor_origin coordinate '" + s + "'");
+  }
+  return v;
+}
+
 PlyHeader readHeader(const std::string& path, std::ifstream& in) {
   PlyHeader h;
   std::string line;
@@ -150,6 +161,10 @@ PlyHeader readHeader(const std::string& path, std::ifstream& in) {
     const std::vector<std::string> w = splitWords(line);
     if (w.empty()) continue;
     if (w[0] == "end_header") break;
+    if (w.size() == 5 && w[0] == "comment" && w[1] == "sensor_origin") {
+      for (int k = 0; k < 3; ++k) h.sensor_origin[k] = parseOriginWord(path, where, w[2 + k]);
+      continue;
+    }
     if (w[0] == "comment" || w[0] == "obj_info") continue;
     if (w[0] == "format") {
       if (w.size() != 3) throw fileError(path, where + "malformed format line");
@@ -469,6 +484,7 @@ core::PointCloud readPly(const std::string& path) {
   if (!lay.hasXyz()) throw fileError(path, "PLY vertex element has no x/y/z properties");
 
   core::PointCloud cloud;
+  cloud.sensor_origin = h.sensor_origin;
   if (h.format == PlyFormat::Ascii) {
     AsciiReader rd(path, in, h.lines);
     for (auto e = h.elements.begin(); e != vertex; ++e) {
@@ -575,7 +591,9 @@ void writePly(const std::string& path, const core::PointCloud& cloud, const std:
       cols.push_back(c);
     }
   }
-  detail::writeBinaryPly(path, n, cols, options.comments, options.drop_non_finite_xyz);
+  detail::writeBinaryPly(path, n, cols,
+                         detail::withOriginComment(options.comments, cloud.sensor_origin),
+                         options.drop_non_finite_xyz);
 }
 
 }  // namespace upd::io

@@ -2,9 +2,23 @@
 
 #include "ply_detail.h"
 
+#include <cstdio>
 #include <stdexcept>
 
 namespace upd::io {
+
+namespace detail {
+
+std::vector<std::string> withOriginComment(std::vector<std::string> comments,
+                                           const Eigen::Vector3f& origin) {
+  if (origin.isZero(0.f)) return comments;  // the default: nothing to record
+  char line[96];
+  std::snprintf(line, sizeof line, "sensor_origin %.9g %.9g %.9g", origin.x(), origin.y(), origin.z());
+  comments.emplace_back(line);
+  return comments;
+}
+
+}  // namespace detail
 
 namespace {
 
@@ -122,7 +136,9 @@ void writeScoredPly(const std::string& path, const ScoredPoints& p,
 
 void writeScoredPly(const std::string& path, const core::PipelineResult& result,
                     const ScoredPlyOptions& options) {
-  writeScoredPly(path, scoredPointsOf(result), options);
+  ScoredPlyOptions with_origin = options;
+  with_origin.comments = detail::withOriginComment(options.comments, result.cloud.sensor_origin);
+  writeScoredPly(path, scoredPointsOf(result), with_origin);
 }
 
 }  // namespace upd::io

@@ -95,6 +95,9 @@ ScoredCloud readScoredPly(std::istream& in, const PlyLayout& l, const std::strin
     c.cost.push_back(fieldAt(row, l, "scalar_cost"));
     const float lab = fieldAt(row, l, "scalar_label");
     c.label.push_back(lab <= 2.0f ? core::Label(std::uint8_t(lab)) : core::Label::Unknown);
+    if (l.props.count("red") && l.props.count("green") && l.props.count("blue"))
+      c.rgb.push_back({std::uint8_t(fieldAt(row, l, "red")), std::uint8_t(fieldAt(row, l, "green")),
+                       std::uint8_t(fieldAt(row, l, "blue"))});
   }
   return c;
 }
@@ -114,6 +117,7 @@ ScoredCloud scoreRawCloud(const std::string& path, const Eigen::Vector3f& up) {
     c.zeta.push_back(res.upd.zeta[i]);
     c.cost.push_back(res.classes.cost[i]);
     c.label.push_back(res.classes.label[i]);
+    if (res.cloud.hasColor()) c.rgb.push_back({res.cloud.r[i], res.cloud.g[i], res.cloud.b[i]});
   }
   return c;
 }
@@ -126,7 +130,8 @@ FigureColor parseFigureColor(const std::string& name) {
   if (name == "cost") return FigureColor::Cost;
   if (name == "slope") return FigureColor::Slope;
   if (name == "height") return FigureColor::Height;
-  throw std::invalid_argument("unknown colouring '" + name + "' (zeta, label, cost, slope, height)");
+  if (name == "rgb") return FigureColor::Rgb;
+  throw std::invalid_argument("unknown colouring '" + name + "' (zeta, label, cost, slope, height, rgb)");
 }
 
 ScoredCloud loadScoredCloud(const std::string& path, const Eigen::Vector3f& up) {

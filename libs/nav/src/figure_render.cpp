@@ -80,6 +80,9 @@ Rgb pointColor(const ScoredCloud& c, const Frame& f, std::size_t i, FigureColor 
       const float span = f.hi.z() - f.lo.z();
       return ramp(span > 0 ? (f.p[i].z() - f.lo.z()) / span : 0.0f);
     }
+    case FigureColor::Rgb:
+      if (c.rgb.size() != c.size()) return {150, 150, 150};
+      return {c.rgb[i][0], c.rgb[i][1], c.rgb[i][2]};
   }
   return {};
 }
@@ -157,8 +160,9 @@ void tick(mrpt::img::CImage& img, int x, int y, const std::string& text) {
 void drawBar(mrpt::img::CImage& img, const Frame& f, const RenderOptions& o) {
   const int x0 = o.width - kPanelWidth + 20, top = 60, bottom = o.height - 60, w = 26;
   img.selectTextFont("9x15");
-  const char* names[] = {"zeta (UPD)", "label", "cost", "slope [deg]", "height [m]"};
+  const char* names[] = {"zeta (UPD)", "label", "cost", "slope [deg]", "height [m]", "camera colour"};
   img.textOut(x0 - 6, top - 44, names[int(o.color)], mrpt::img::TColor(20, 20, 20));
+  if (o.color == FigureColor::Rgb) return;  // the picture is its own legend
   if (o.color == FigureColor::Label) {
     const char* labels[] = {"traversable", "non-trav.", "unknown"};
     for (int k = 0; k < 3; ++k) {

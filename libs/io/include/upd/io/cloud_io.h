@@ -46,7 +46,8 @@ core::PointCloud readPcd(const std::string& path);
 /// PLY `format ascii 1.0`, `binary_little_endian 1.0` or `binary_big_endian 1.0`. Reads the
 /// vertex element's x, y, z (any numeric type) and red, green, blue when present (uchar; other
 /// integer types are clamped to 0..255, float types are taken as 0..1); every other property
-/// and element (faces with list properties included) is skipped.
+/// and element (faces with list properties included) is skipped. A header line `comment
+/// sensor_origin X Y Z` (written by writePly and writeScoredPly) sets sensor_origin.
 core::PointCloud readPly(const std::string& path);
 
 /// XYZ text: one point per line, `x y z` or `x y z r g b` (r, g, b in 0..255), separated by
@@ -67,6 +68,7 @@ struct PlyWriteOptions {
 /// Writes a binary little-endian PLY with vertex properties `x y z`, then `label` (uchar, the
 /// Label values) when labels is given, then `red green blue` (uchar) when the cloud has
 /// colour. labels, when given, must hold one entry per point (else std::invalid_argument).
+/// A sensor_origin other than (0, 0, 0) is kept as the header line `comment sensor_origin X Y Z`.
 void writePly(const std::string& path, const core::PointCloud& cloud,
               const std::vector<core::Label>* labels = nullptr, const PlyWriteOptions& options = {});
 

@@ -10,6 +10,7 @@
 //   (30, 60, 220), through teal; invalid (NaN) zeta is grey.
 // - label: traversable green, non-traversable red, unknown grey.
 // - cost: 0 green, 0.5 yellow, 1 red.
+// - rgb: the cloud's own colour (red green blue of the PLY or PCD), grey when it has none.
 // - slope: angle between the normal and up, 0 to 45 degrees (and beyond), and height: the
 //   cloud's range along up; both on a blue - cyan - yellow - red ramp.
 #pragma once
@@ -18,6 +19,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -25,9 +27,10 @@
 
 namespace upd::nav {
 
-enum class FigureColor { Zeta, Label, Cost, Slope, Height };
+enum class FigureColor { Zeta, Label, Cost, Slope, Height, Rgb };
 
-/// "zeta", "label", "cost", "slope" or "height"; anything else throws std::invalid_argument.
+/// "zeta", "label", "cost", "slope", "height" or "rgb" (the camera's colour, grey where the
+/// cloud has none); anything else throws std::invalid_argument.
 FigureColor parseFigureColor(const std::string& name);
 
 /// A scored cloud as the figures need it: positions, unit normals, zeta, label and cost per
@@ -37,6 +40,7 @@ struct ScoredCloud {
   std::vector<Eigen::Vector3f> normals;
   std::vector<float> zeta, cost;
   std::vector<core::Label> label;
+  std::vector<std::array<std::uint8_t, 3>> rgb;  ///< the camera's colour; empty when none
   std::size_t size() const { return points.size(); }
 };
 
