@@ -35,6 +35,8 @@ const Command kCommands[] = {
      upd::app::kRenderUsage, upd::app::runRender},
     {"histogram", "plot the distribution of zeta at several d_m to a PNG",
      upd::app::kHistogramUsage, upd::app::runHistogram},
+    {"view", "3D window on a scored cloud, an .ot tree or a playback folder (keys recolour)",
+     upd::app::kViewUsage, upd::app::runView},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };
