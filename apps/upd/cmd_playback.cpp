@@ -513,12 +513,14 @@ int runPlayback(const std::vector<std::string>& argv) {
     per_run[k].poses_path = runs[k].poses_path;
     trackers.push_back(poseTracker(per_run[k], config));
   }
+  // The window first: without a display nothing is written.
+  auto view = options.view ? std::make_unique<PlaybackView>(options.rawlog) : nullptr;
   const Truth truth = loadTruth(options);
   fs::create_directories(options.out_dir);
   if (options.ply) fs::create_directories(options.out_dir / "frames");
 
   Playback run(config);
-  if (options.view) run.view = std::make_unique<PlaybackView>(options.rawlog);
+  run.view = std::move(view);
   {
     const StopOnSignal stop_on_signal;  // Ctrl-C ends the frame loop, the maps are written
     for (std::size_t k = 0; k < runs.size() && !run.damage && !stopRequested(); ++k) {
