@@ -17,7 +17,7 @@ const char* const kRenderUsage =
     "  Draws INPUT, a scored PLY (upd analyze --output) or a raw cloud (.pcd, .ply, .xyz,\n"
     "  scored here with the default parameters), as a PNG with a colour bar. INPUT may also be\n"
     "  a playback output folder (its map, the robot's path and the robot, and the last\n"
-    "  frames/NNNNNN.ply when present) or a map_traversability.ot tree. Runs headless\n"
+    "  frames/NNNNNN.ply when present) or an .ot tree (its voxels). Runs headless\n"
     "  (MRPT's off-screen renderer through EGL; no display needed). See docs/FIGURES.md.\n\n"
     "options:\n"
     "  --output FILE.png     the image (required)\n"
@@ -86,7 +86,7 @@ int runRender(const std::vector<std::string>& argv) {
                 output->c_str(), opt.width, opt.height);
     return 0;
   }
-  nav::renderMapFigure(in.map, style, in.cloud ? &*in.cloud : nullptr, opt, *output);
+  nav::renderMapFigure(in.map, firstMapStyle(in, style), in.cloud ? &*in.cloud : nullptr, opt, *output);
   std::printf("%s: map (%d x %d cells, %zu voxels, %zu path points%s) drawn by %s to %s (%dx%d)\n",
               input.c_str(), in.map.nx, in.map.ny, in.map.voxels.size(), in.map.path.size(),
               in.cloud ? (", " + baseName(in.cloud_file)).c_str() : "", color.c_str(), output->c_str(),

@@ -14,9 +14,10 @@ namespace upd::app {
 const char* const kViewUsage =
     "usage: upd view FILE|DIR [options]\n"
     "  Opens a 3D window on FILE, a scored PLY (upd analyze --output) or a raw cloud (.pcd,\n"
-    "  .ply, .xyz: scored here with the default parameters), a map_traversability.ot tree,\n"
-    "  or DIR, a playback output folder (its map, the robot's path and the robot, and the last\n"
-    "  frames/NNNNNN.ply when present). Needs a display (DISPLAY). See docs/VIEWER.md.\n\n"
+    "  .ply, .xyz: scored here with the default parameters), an .ot tree (map.ot or\n"
+    "  map_traversability.ot: its occupied voxels), or DIR, a playback output folder (its\n"
+    "  map, the robot's path and the robot, and the last frames/NNNNNN.ply when present).\n"
+    "  Needs a display (DISPLAY). See docs/VIEWER.md.\n\n"
     "keys in the window:\n"
     "  z l c s h (or 1-5)  colour by zeta, label, cost, slope, height\n"
     "  n normals on/off    m map: grid / octree / none    r reset the view\n"
@@ -55,6 +56,7 @@ int runView(const std::vector<std::string>& argv) {
 
   ViewInput in = readViewInput(input, opt.up);  // a bad file fails before a window opens
   if (in.is_map) opt.up = Eigen::Vector3f::UnitZ();
+  opt.map = firstMapStyle(in, opt.map);
   opt.title = "upd view " + input;
   nav::Viewer viewer(opt);
   viewer.setContent(in.cloud ? std::move(*in.cloud) : nav::ScoredCloud{}, std::move(in.map));

@@ -2,6 +2,7 @@
 // them are caught here and printed as one line, with a non-zero exit code.
 #include "cli.h"
 #include "commands.h"
+#include "upd/nav/viewer.h"
 
 #include <malloc.h>
 
@@ -72,12 +73,15 @@ int main(int argc, char** argv) {
       }
     }
     try {
-      return c.run(args);
+      const int code = c.run(args);
+      upd::nav::exitIfViewerShown(code);  // after a 3D window: no static destructors (viewer.h)
+      return code;
     } catch (const upd::app::UsageError& e) {
       std::cerr << "upd " << name << ": " << e.what() << " (see 'upd " << name << " --help')\n";
       return 2;
     } catch (const std::exception& e) {
       std::cerr << "upd " << name << ": error: " << e.what() << "\n";
+      upd::nav::exitIfViewerShown(1);
       return 1;
     }
   }

@@ -4,20 +4,21 @@
 #include "map_folder.h"
 
 #include "upd/io/cloud_io.h"
+#include "upd/maps/grid_export.h"
 #include "upd/maps/traversability_octree.h"
+
+#include <octomap/ColorOcTree.h>
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
 namespace upd::app {
 
 namespace fs = std::filesystem;
-
-bool isMapInput(const std::string& path) {
-  return fs::is_directory(path) || io::lowerExtension(path) == ".ot";
-}
 
 namespace {
 
@@ -44,6 +45,37 @@ ViewInput readFolder(const fs::path& dir) {
   return in;
 }
 
+// "ColorOcTree" or "TraversabilityOcTree" from the header's id line; "" when it has none.
+std::string octreeId(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int k = 0; k < 8 && std::getline(in, line); ++k) {
+    if (line.rfind("id ", 0) == 0) return line.substr(3);
+  }
+  return "";
+}
+
+// map.ot, the ColorOcTree every OctoMap tool reads: its colour is the traversability colour of
+// map.png (grey without evidence), so the label comes back from it; zeta and cost do not.
+void snapshotColourOctree(const std::string& path, nav::MapSnapshot& out, double p_nontrav_threshold = 0.65) {
+  std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(path));
+  auto* colour = dynamic_cast<octomap::ColorOcTree*>(tree.get());
+  if (colour == nullptr) throw std::runtime_error(path + ": cannot read it as an OctoMap ColorOcTree");
+  for (auto it = colour->begin_leafs(), end = colour->end_leafs(); it != end; ++it) {
+    if (!colour->isNodeOccupied(*it)) continue;
+    nav::MapVoxelView v;
+    v.centre = Eigen::Vector3f(float(it.getX()), float(it.getY()), float(it.getZ()));
+    v.size = float(it.getSize());
+    const octomap::ColorOcTreeNode::Color c = it->getColor();
+    if (c.r != maps::kUnknownColourRgb[0] || c.g != maps::kUnknownColourRgb[1] || c.b != maps::kUnknownColourRgb[2]) {
+      // Inverse of traversabilityColourRgb: red rises to 255 at p = 0.5, then green falls.
+      const double p = c.r < 255 ? c.r / 510.0 : 1.0 - c.g / 510.0;
+      v.label = p >= p_nontrav_threshold ? core::Label::NonTraversable : core::Label::Traversable;
+    }
+    out.voxels.push_back(v);
+  }
+}
+
 }  // namespace
 
 ViewInput readViewInput(const std::string& path, const Eigen::Vector3f& up) {
@@ -51,7 +83,8 @@ ViewInput readViewInput(const std::string& path, const Eigen::Vector3f& up) {
   ViewInput in;
   if (io::lowerExtension(path) == ".ot") {
     in.is_map = true;
-    nav::snapshotOctree(*maps::readTraversabilityOt(path), in.map);
+    if (octreeId(path) == "ColorOcTree") snapshotColourOctree(path, in.map);
+    else nav::snapshotOctree(*maps::readTraversabilityOt(path), in.map);
     if (in.map.voxels.empty()) throw std::runtime_error(path + ": the tree has no occupied voxel to draw");
     return in;
   }

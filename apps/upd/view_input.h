@@ -19,11 +19,14 @@ struct ViewInput {
   bool is_map = false;                   ///< a folder or a tree: drawn in the world frame, z up
 };
 
-/// True when path is a directory or an .ot file (drawn as a map).
-bool isMapInput(const std::string& path);
+/// The map style to draw first: the asked one, but a tree's voxels when there is no grid.
+inline nav::MapStyle firstMapStyle(const ViewInput& in, nav::MapStyle asked) {
+  return asked == nav::MapStyle::Grid && !in.map.hasGrid() ? nav::MapStyle::Octree : asked;
+}
 
 /// Reads path: a folder (map.tif, map_traversability.ot, map.3Dscene's path, the last
-/// frames/*.ply when present), a traversability tree (.ot), or a cloud (scored with up when
+/// frames/*.ply when present), a tree (.ot: map_traversability.ot, or map.ot, the ColorOcTree,
+/// whose colours give the labels only), or a cloud (scored with up when
 /// raw). Throws std::runtime_error with one line naming the file on bad input.
 ViewInput readViewInput(const std::string& path, const Eigen::Vector3f& up);
 

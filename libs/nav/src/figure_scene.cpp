@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_set>
 
 namespace upd::nav::detail {
 
@@ -121,10 +122,23 @@ mrpt::opengl::CSetOfLines::Ptr normalLines(const Frame& f) {
   auto lines = mrpt::opengl::CSetOfLines::Create();
   lines->setColor_u8(mrpt::img::TColor(30, 30, 30));
   lines->setLineWidth(1.5f);
-  const float len = 0.04f * (f.hi - f.lo).norm();
-  const std::size_t step = std::max<std::size_t>(1, f.p.size() / 1500);
-  for (std::size_t i = 0; i < f.p.size(); i += step) {
-    if (!f.n[i].allFinite()) continue;
+  Frame cloud_box;
+  for (const auto& p : f.p) cloud_box.extend(p);
+  const float len = 0.04f * (cloud_box.hi - cloud_box.lo).norm();
+  // One normal per cube of the segment's length (a dense scan near the sensor would bury its
+  // neighbourhood in segments), then every k-th of those for at most ~1500.
+  std::unordered_set<std::uint64_t> taken;
+  std::vector<std::size_t> picked;
+  for (std::size_t i = 0; i < f.p.size(); ++i) {
+    if (!f.n[i].allFinite() || !(len > 0)) continue;
+    const Eigen::Vector3f c = ((f.p[i] - cloud_box.lo) / len).array().floor();
+    const std::uint64_t key = (std::uint64_t(c.x()) * 73856093u) ^ (std::uint64_t(c.y()) * 19349663u) ^
+                              (std::uint64_t(c.z()) * 83492791u);
+    if (taken.insert(key).second) picked.push_back(i);
+  }
+  const std::size_t step = std::max<std::size_t>(1, picked.size() / 1500);
+  for (std::size_t k = 0; k < picked.size(); k += step) {
+    const std::size_t i = picked[k];
     const Eigen::Vector3f e = f.p[i] + len * f.n[i];
     lines->appendLine(f.p[i].x(), f.p[i].y(), f.p[i].z(), e.x(), e.y(), e.z());
   }

@@ -43,7 +43,8 @@ Frame upright(const ScoredCloud& c, const Eigen::Vector3f& up);
 /// The cloud's points coloured by mode (height over the frame's z range).
 mrpt::opengl::CPointCloudColoured::Ptr cloudPoints(const ScoredCloud& c, const Frame& f, FigureColor mode,
                                                    float point_size);
-/// Every k-th normal (at most ~1500) as a dark segment 4 % of the frame's diagonal long.
+/// Every k-th normal (at most ~1500) as a dark segment 4 % of the diagonal of the cloud's
+/// points f.p long (a map may make the frame's box larger).
 mrpt::opengl::CSetOfLines::Ptr normalLines(const Frame& f);
 
 /// The default view: the frame's centre from elevation_deg above, from the diagonal that sees

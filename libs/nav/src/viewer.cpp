@@ -14,9 +14,12 @@
 #include <opencv2/core.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <iostream>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -41,6 +44,8 @@ ScoredCloud scoredCloudOf(const core::ScoredFrame& frame) {
 }
 
 namespace {
+
+std::atomic<bool> g_viewer_shown{false};
 
 const char* const kColorNames[] = {"zeta", "label", "cost", "slope", "height"};
 const char* const kMapNames[] = {"grid", "octree", "none"};
@@ -99,10 +104,12 @@ void Viewer::Impl::drawTexts() {
   font.color = mrpt::img::TColorf(0.1f, 0.1f, 0.1f);
   font.vfont_scale = 11;
   win->addTextMessage(8, -16, o.title, 0, font);
-  const std::string status =
-      mrpt::format("colour: %s   map: %s   normals: %s   %zu points, %d x %d cells, %zu voxels",
-                   kColorNames[int(o.color)], kMapNames[int(o.map)], o.normals ? "on" : "off", cloud.size(),
-                   map.nx, map.ny, map.voxels.size());
+  std::string status = mrpt::format("colour: %s   normals: %s   %zu points", kColorNames[int(o.color)],
+                                    o.normals ? "on" : "off", cloud.size());
+  if (map.hasGrid() || !map.voxels.empty() || !map.path.empty()) {
+    status += mrpt::format("   map: %s (%d x %d cells, %zu voxels)   path: %zu poses", kMapNames[int(o.map)], map.nx,
+                           map.ny, map.voxels.size(), map.path.size());
+  }
   win->addTextMessage(8, -32, status, 1, font);
   const std::size_t lines = sizeof(kHelp) / sizeof(kHelp[0]);
   for (std::size_t k = 0; k < lines; ++k) {  // at the bottom left
@@ -131,6 +138,7 @@ Viewer::Viewer(const ViewerOptions& options) : impl_(std::make_unique<Impl>()) {
   }
   auto& d = *impl_;
   d.o = options;
+  g_viewer_shown = true;
   d.win = mrpt::gui::CDisplayWindow3D::Create(options.title, unsigned(options.width), unsigned(options.height));
   for (int k = 0; k < 100 && !d.win->isOpen(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   if (!d.win->isOpen()) throw std::runtime_error("cannot open the viewer's window on display " +
@@ -147,6 +155,14 @@ Viewer::Viewer(const ViewerOptions& options) : impl_(std::make_unique<Impl>()) {
 }
 
 Viewer::~Viewer() = default;
+
+void exitIfViewerShown(int code) {
+  if (!g_viewer_shown) return;
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+  std::_Exit(code);
+}
 
 MapStyle Viewer::mapStyle() const { return impl_->o.map; }
 
@@ -198,8 +214,8 @@ bool Viewer::processEvents() {
 void Viewer::saveScreenshot(const std::string& png) {
   auto& d = *impl_;
   if (!isOpen()) throw std::runtime_error(png + ": the window is closed");
-  // What the X server shows once two reads 300 ms apart agree (the window has drawn the
-  // current content), at most ~10 s.
+  // What the X server shows once two reads 300 ms apart agree and it is not black (the window
+  // has drawn the current content on its white background), at most ~10 s.
   mrpt::img::CImage last;
   bool have = false;
   for (int k = 0; k < 30; ++k) {

@@ -67,4 +67,10 @@ class Viewer {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Ends the process with code, without running static destructors, when a Viewer was opened
+/// (else returns): MRPT 2.5's wx thread goes on painting a closed CDisplayWindow3D while the
+/// libraries' static objects are destroyed, a crash at exit seen under Xvfb. Flushes stdout
+/// and stderr first. `upd` calls it when a command returns.
+void exitIfViewerShown(int code);
+
 }  // namespace upd::nav
