@@ -12,6 +12,7 @@ PACKAGES=(build-essential cmake pkg-config
           libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev zlib1g-dev
           libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
           libegl1 libgl1-mesa-dri  # upd render: CFBORender through EGL, Mesa's software renderer
+          libx11-dev xvfb  # upd view: screenshots read from the X server; its test's X server
           octomap-tools cloudcompare gdal-bin mrpt-apps  # these four: tests open our files in them
           python3  # scripts/results.sh formats docs/RESULTS.md; the layout and results tests
           ros-core libroscpp-dev librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev

@@ -13,6 +13,7 @@
 #include "playback_damage.h"
 #include "playback_merge.h"
 #include "playback_tum.h"
+#include "playback_view.h"
 #include "run_config.h"
 #include "whole_run.h"
 #include "stop_signal.h"
@@ -83,7 +84,9 @@ const char* const kPlaybackUsage =
     "                      points as a CObservationPointCloud (label UPD_NON_TRAVERSABLE)\n"
     "  --strict            a damaged rawlog is an error (exit 1, nothing written) instead of\n"
     "                      a partial run\n"
-    "  --quiet             no progress line\n\n"
+    "  --quiet             no progress line\n"
+    "  --view              show the frames and the map in a 3D window as they are played\n"
+    "                      (upd view's window and keys; needs a display); kept open at the end\n\n"
     "A damaged rawlog (cut off, or an object that does not deserialize) is played up to the\n"
     "damage: the maps of the observations before it are written, summary.json records the\n"
     "damage (object index, byte offset in the decompressed stream, reason) and one line on\n"
@@ -115,7 +118,7 @@ struct PlaybackOptions {
   std::optional<std::string> truth_path;
   int epsg = 0;  ///< CRS of map.tif (0: none)
   std::optional<sim::CameraMountParams> mount;  ///< --mount: replaces the recorded sensor pose
-  bool ply = false, output_rawlog = false, quiet = false, strict = false;
+  bool ply = false, output_rawlog = false, quiet = false, strict = false, view = false;
 
   /// Entry idx is inside --from/--to/--every.
   bool selected(long idx) const {
@@ -127,7 +130,7 @@ PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   const Args args(argv,
                   {"--config", "--output", "--from", "--to", "--every", "--poses", "--truth",
                    "--epsg", "--mount"},
-                  {"--ply", "--output-rawlog", "--quiet", "--strict"});
+                  {"--ply", "--output-rawlog", "--quiet", "--strict", "--view"});
   if (args.positionals().empty()) throw UsageError("expected at least one RAWLOG");
   if (!args.has("--config")) throw UsageError("--config FILE.ini is required");
   if (!args.has("--output")) throw UsageError("--output DIR is required");
@@ -154,6 +157,7 @@ PlaybackOptions parsePlaybackOptions(const std::vector<std::string>& argv) {
   o.output_rawlog = args.flag("--output-rawlog");
   o.quiet = args.flag("--quiet");
   o.strict = args.flag("--strict");
+  o.view = args.flag("--view");
   return o;
 }
 
@@ -320,6 +324,7 @@ struct Playback {
   std::optional<RawlogDamage> damage;  ///< set when the rawlog ended in damage (not --strict)
   int interrupted_by = 0;  ///< the signal that stopped the frame loop early, 0 if none
   MemoryTrace memory_trace;  ///< resident memory every 1,000 frames processed
+  std::unique_ptr<PlaybackView> view;  ///< --view
 
   explicit Playback(const RunConfig& config) : grid(config.grid), tree(config.octree) {}
 };
@@ -422,6 +427,7 @@ void playFrames(const PlaybackOptions& o, const RunConfig& config,
       continue;
     }
     fuseFrame(config, entry, res, frame_clock, run);
+    if (run.view) run.view->show(res.scored, run.grid, run.tree, run.trajectory);
     if (o.ply) {
       char name[32];
       std::snprintf(name, sizeof name, "%06ld.ply", idx);
@@ -509,11 +515,14 @@ int runPlayback(const std::vector<std::string>& argv) {
     per_run[k].poses_path = runs[k].poses_path;
     trackers.push_back(poseTracker(per_run[k], config));
   }
+  // The window first: without a display nothing is written.
+  auto view = options.view ? std::make_unique<PlaybackView>(options.rawlog) : nullptr;
   const Truth truth = loadTruth(options);
   fs::create_directories(options.out_dir);
   if (options.ply) fs::create_directories(options.out_dir / "frames");
 
   Playback run(config);
+  run.view = std::move(view);
   {
     const StopOnSignal stop_on_signal;  // Ctrl-C ends the frame loop, the maps are written
     for (std::size_t k = 0; k < runs.size() && !run.damage && !stopRequested(); ++k) {
@@ -529,6 +538,7 @@ int runPlayback(const std::vector<std::string>& argv) {
   summary["memory"] = memory;
   io::writeJsonAtomically((options.out_dir / "summary.json").string(), summary);
   printSummary(options, summary, config.evaluation.tolerance_m);
+  if (run.view) run.view->waitUntilClosed();
   if (run.damage) {
     std::fprintf(stderr, "%s\n", damageLine(*run.damage, options.out_dir.string()).c_str());
     return kExitPartial;

@@ -2,6 +2,7 @@
 // coloured by zeta, label, cost, slope or height, with a colour bar.
 #include "cli.h"
 #include "commands.h"
+#include "view_input.h"
 
 #include "upd/nav/figure.h"
 
@@ -14,7 +15,9 @@ namespace upd::app {
 const char* const kRenderUsage =
     "usage: upd render INPUT --output FILE.png [options]\n"
     "  Draws INPUT, a scored PLY (upd analyze --output) or a raw cloud (.pcd, .ply, .xyz,\n"
-    "  scored here with the default parameters), as a PNG with a colour bar. Runs headless\n"
+    "  scored here with the default parameters), as a PNG with a colour bar. INPUT may also be\n"
+    "  a playback output folder (its map, the robot's path and the robot, and the last\n"
+    "  frames/NNNNNN.ply when present) or an .ot tree (its voxels). Runs headless\n"
     "  (MRPT's off-screen renderer through EGL; no display needed). See docs/FIGURES.md.\n\n"
     "options:\n"
     "  --output FILE.png     the image (required)\n"
@@ -28,6 +31,8 @@ const char* const kRenderUsage =
     "  --look-at X,Y,Z       the point the camera looks at (default: the cloud's centre)\n"
     "  --up X,Y,Z            the cloud's up vector (default 0,0,1; 0,-1,0 for a level camera's\n"
     "                        optical frame): the view is drawn upright, a raw cloud scored with it\n"
+    "  --map grid|octree|none  a folder's map: the grid as a texture (default), the tree's\n"
+    "                        occupied voxels, or none (the path and the last frame only)\n"
     "  --size WxH            image size in pixels (default 1280x900)\n"
     "  --title TEXT          caption at the top left (default: INPUT and the colouring)\n";
 
@@ -48,7 +53,7 @@ std::pair<int, int> parseImageSize(const std::string& s) {
 }
 
 int runRender(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--output", "--color", "--view-from", "--look-at", "--up", "--size", "--title"},
+  const Args args(argv, {"--output", "--color", "--view-from", "--look-at", "--up", "--size", "--title", "--map"},
                   {"--normals"});
   if (args.positionals().size() != 1) throw UsageError("expected exactly one INPUT file");
   const std::string input = args.positionals()[0];
@@ -69,10 +74,24 @@ int runRender(const std::vector<std::string>& argv) {
   if (const auto size = args.str("--size")) std::tie(opt.width, opt.height) = parseImageSize(*size);
   opt.title = args.str("--title").value_or(baseName(input) + ": " + color);
 
-  const nav::ScoredCloud cloud = nav::loadScoredCloud(input, opt.up);
-  nav::renderFigure(cloud, opt, *output);
-  std::printf("%s: %zu points drawn by %s to %s (%dx%d)\n", input.c_str(), cloud.size(), color.c_str(),
-              output->c_str(), opt.width, opt.height);
+  nav::MapStyle style = nav::MapStyle::Grid;
+  try {
+    style = nav::parseMapStyle(args.str("--map").value_or("grid"));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--map: ") + e.what());
+  }
+  const ViewInput in = readViewInput(input, opt.up);
+  if (!in.is_map) {
+    nav::renderFigure(*in.cloud, opt, *output);
+    std::printf("%s: %zu points drawn by %s to %s (%dx%d)\n", input.c_str(), in.cloud->size(), color.c_str(),
+                output->c_str(), opt.width, opt.height);
+    return 0;
+  }
+  nav::renderMapFigure(in.map, firstMapStyle(in, style), in.cloud ? &*in.cloud : nullptr, opt, *output);
+  std::printf("%s: map (%d x %d cells, %zu voxels, %zu path points%s) drawn by %s to %s (%dx%d)\n",
+              input.c_str(), in.map.nx, in.map.ny, in.map.voxels.size(), in.map.path.size(),
+              in.cloud ? (", " + baseName(in.cloud_file)).c_str() : "", color.c_str(), output->c_str(),
+              opt.width, opt.height);
   return 0;
 }
 

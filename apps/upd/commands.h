@@ -28,6 +28,7 @@ int runRos(const std::vector<std::string>& args);
 int runRender(const std::vector<std::string>& args);
 int runHistogram(const std::vector<std::string>& args);
 int runBaseline(const std::vector<std::string>& args);
+int runView(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
 extern const char* const kSceneUsage;
@@ -42,6 +43,7 @@ extern const char* const kRosUsage;
 extern const char* const kRenderUsage;
 extern const char* const kHistogramUsage;
 extern const char* const kBaselineUsage;
+extern const char* const kViewUsage;
 
 /// The --size WxH option of `upd render` and `upd histogram`; throws UsageError naming it.
 std::pair<int, int> parseImageSize(const std::string& s);

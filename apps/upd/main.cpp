@@ -2,6 +2,7 @@
 // them are caught here and printed as one line, with a non-zero exit code.
 #include "cli.h"
 #include "commands.h"
+#include "upd/nav/viewer.h"
 
 #include <malloc.h>
 
@@ -37,6 +38,8 @@ const Command kCommands[] = {
      upd::app::kHistogramUsage, upd::app::runHistogram},
     {"baseline", "score a cloud with the paper's roughness index, beside the UPD (Fig. 5)",
      upd::app::kBaselineUsage, upd::app::runBaseline},
+    {"view", "3D window on a scored cloud, an .ot tree or a playback folder (keys recolour)",
+     upd::app::kViewUsage, upd::app::runView},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };
@@ -72,12 +75,15 @@ int main(int argc, char** argv) {
       }
     }
     try {
-      return c.run(args);
+      const int code = c.run(args);
+      upd::nav::exitIfViewerShown(code);  // after a 3D window: no static destructors (viewer.h)
+      return code;
     } catch (const upd::app::UsageError& e) {
       std::cerr << "upd " << name << ": " << e.what() << " (see 'upd " << name << " --help')\n";
       return 2;
     } catch (const std::exception& e) {
       std::cerr << "upd " << name << ": error: " << e.what() << "\n";
+      upd::nav::exitIfViewerShown(1);
       return 1;
     }
   }

@@ -2,6 +2,7 @@
 // wall) scored at d_m = 0.1 m, drawn headless and read back. The pictures are checked by their pixels: the
 // floor and wall in the zeta map's green, the corner's edge in its blue, the colour bar from
 // green (top, zeta = 1) to blue (bottom, zeta = sqrt(2)/2); bad input writes no file.
+#include "image_colours.h"
 #include "run_upd.h"
 #include "temp_dir.h"
 
@@ -20,42 +21,12 @@ using test::CmdResult;
 using test::runUpd;
 using test::TempDir;
 
-struct Counts {
-  std::size_t green = 0, blue = 0, cool = 0, red = 0, non_white = 0;
-};
-
-bool isGreen(const mrpt::img::TColor& c) { return c.G > c.R + 60 && c.G > c.B + 30; }
-bool isBlue(const mrpt::img::TColor& c) { return c.B > c.G + 60 && c.B > c.R + 100; }
-// The zeta map's lower half, teal (zeta ~ 0.85) to blue (sqrt(2)/2): a discontinuity.
-bool isTealOrBlue(const mrpt::img::TColor& c) { return c.B + 10 > c.G && c.B > c.R + 80; }
-bool isRed(const mrpt::img::TColor& c) { return c.R > c.G + 100 && c.R > c.B + 100; }
-
-mrpt::img::TColor pixel(const mrpt::img::CImage& img, int x, int y) {
-  const auto* p = img.ptr<std::uint8_t>(x, y);
-  if (img.getChannelsOrder() == "BGR") return {p[2], p[1], p[0]};
-  return {p[0], p[1], p[2]};
-}
-
-Counts countColours(const mrpt::img::CImage& img, int x_end) {
-  Counts n;
-  for (int y = 0; y < int(img.getHeight()); ++y) {
-    for (int x = 0; x < x_end; ++x) {
-      const auto c = pixel(img, x, y);
-      n.green += isGreen(c);
-      n.blue += isBlue(c);
-      n.cool += isTealOrBlue(c);
-      n.red += isRed(c);
-      n.non_white += c.R < 240 || c.G < 240 || c.B < 240;
-    }
-  }
-  return n;
-}
-
-mrpt::img::CImage loadPng(const std::string& path) {
-  mrpt::img::CImage img;
-  EXPECT_TRUE(img.loadFromFile(path)) << path;
-  return img;
-}
+using test::Counts;
+using test::countColours;
+using test::isBlue;
+using test::isGreen;
+using test::loadPng;
+using test::pixel;
 
 class RenderTest : public ::testing::Test {
  protected:
