@@ -70,13 +70,14 @@ Eigen::Vector3d xyYaw(const Pose2D& p) { return {p.x_m, p.y_m, p.yaw_rad}; }
 class ScenarioRun {
  public:
   ScenarioRun(const sim::WorldSpec& world, const NavConfig& config, core::ObstacleDetector detector,
-              const std::string& navlog_path)
+              const std::string& navlog_path, const NavigationLoop::PointLabeller& labeller)
       : world_(world),
         config_(config),
         base_(Pose2D{world.start_xy_yaw.x(), world.start_xy_yaw.y(), world.start_xy_yaw.z()},
               config.base),
         loop_(base_, config, detector, navlog_path),
         truth_(world.terrain, config.loop.truth_cell_m) {
+    if (labeller) loop_.setLabeller(labeller);
     if (config.loop.fence_world) {
       loop_.setFixedObstacles(rectangleFence(world.terrain.minXY(), world.terrain.maxXY(),
                                              config.obstacles.decimation_m));
@@ -153,11 +154,12 @@ void summarize(ScenarioRun& run, const sim::WorldSpec& world, const NavConfig& c
 
 ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
                            const NavConfig& config, core::ObstacleDetector detector,
-                           const std::string& navlog_path, const StepCallback& on_step) {
+                           const std::string& navlog_path, const StepCallback& on_step,
+                           const NavigationLoop::PointLabeller& labeller) {
   config.validate();
   const core::Stopwatch wall;
   SimulatedClock clock;
-  ScenarioRun run(world, config, detector, navlog_path);
+  ScenarioRun run(world, config, detector, navlog_path, labeller);
 
   ScenarioResult r;
   r.scenario = name;

@@ -11,6 +11,7 @@
 
 #include "upd/maps/traversability_grid.h"
 #include "upd/nav/nav_config.h"
+#include "upd/nav/navigation_loop.h"
 #include "upd/nav/navigator.h"
 #include "upd/nav/perception.h"
 #include "upd/nav/robot_base.h"
@@ -70,10 +71,12 @@ struct ScenarioResult {
 using StepCallback = std::function<void(const TrajectorySample&)>;
 
 /// Runs the loop on world (name is recorded). navlog_path: where the MRPT navlog goes (empty:
-/// none). Restores MRPT's clock to real time when it returns.
+/// none). labeller: when set, labels the frames instead of the detector
+/// (NavigationLoop::setLabeller). Restores MRPT's clock to real time when it returns.
 ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
                            const NavConfig& config, core::ObstacleDetector detector,
-                           const std::string& navlog_path = "", const StepCallback& on_step = {});
+                           const std::string& navlog_path = "", const StepCallback& on_step = {},
+                           const NavigationLoop::PointLabeller& labeller = {});
 
 /// summary.json's content: reached, end state, navigator error, simulated time, path length,
 /// minimum clearance, collisions, ...
