@@ -206,6 +206,7 @@ BenchRow runBenchWorld(const BenchWorld& world, const NavConfig& config, BenchPe
       p == BenchPerception::Truth ? truthLabeller(spec, c.loop.truth_cell_m)
                                   : NavigationLoop::PointLabeller{};
   ScenarioResult r = runScenario(spec, "bench", c, detector, "", {}, labeller);
+  r.perception = toString(p);
   row.outcome = outcomeOf(r);
   row.cause = categorize(r, spec, c, row.outcome);
   row.time_s = r.sim_time_s;

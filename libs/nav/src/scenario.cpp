@@ -202,7 +202,7 @@ ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
 nlohmann::json summaryJson(const ScenarioResult& r) {
   nlohmann::json j;
   j["scenario"] = r.scenario;
-  j["obstacles"] = toString(r.detector);
+  j["obstacles"] = r.perception.empty() ? std::string(toString(r.detector)) : r.perception;
   j["reached"] = r.reached;
   j["end"] = toString(r.end);
   j["navigator"] = {{"state", toString(r.navigator.state)},
@@ -344,7 +344,9 @@ void writeScenarioOutputs(const ScenarioResult& r, const sim::WorldSpec& world,
 
   const Eigen::Vector2d margin(0.5, 0.5);
   const TopView view(world.terrain.minXY() - margin, world.terrain.maxXY() + margin, 0.02);
-  const std::string title = r.scenario + " / " + toString(r.detector) + ": " + toString(r.end);
+  const std::string title = r.scenario + " / " +
+                            (r.perception.empty() ? std::string(toString(r.detector)) : r.perception) +
+                            ": " + toString(r.end);
   std::ostringstream stats;
   stats << std::fixed << std::setprecision(1) << r.sim_time_s << " s, " << r.path_length_m
         << " m driven, " << r.collision_steps << " collisions, min clearance "

@@ -47,6 +47,7 @@ const char* toString(RunEnd e);
 struct ScenarioResult {
   std::string scenario;
   core::ObstacleDetector detector = core::ObstacleDetector::Upd;
+  std::string perception;  ///< when not empty, named instead of the detector (e.g. "truth")
   Eigen::Vector2d goal_xy = Eigen::Vector2d::Zero();
   bool reached = false;  ///< the navigator reported the goal and the robot is within tolerance
   RunEnd end = RunEnd::TimeLimit;
