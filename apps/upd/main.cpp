@@ -24,6 +24,8 @@ const Command kCommands[] = {
      upd::app::kPlaybackUsage, upd::app::runPlayback},
     {"navigate", "drive a simulated robot to a goal on UPD traversability (closed loop)",
      upd::app::kNavigateUsage, upd::app::runNavigate},
+    {"bench-nav", "navigation benchmark: the closed loop on generated worlds, against the optimum",
+     upd::app::kBenchNavUsage, upd::app::runBenchNav},
     {"live", "UPD, map and navigation on a live OpenNI2 depth camera (or an .oni file)",
      upd::app::kLiveUsage, upd::app::runLive},
     {"map", "map folders: info, merge runs of one site, crop a region",

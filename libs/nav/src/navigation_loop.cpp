@@ -91,7 +91,11 @@ NavigationLoop::~NavigationLoop() = default;
 const FrameEvidence& NavigationLoop::addFrame(const core::PointCloud& cloud_world, double time_s,
                                               double ground_z_m) {
   // The cloud is already in the world frame: scored there, as the identity pose says.
-  scorer_.score(cloud_world, Eigen::Isometry3d::Identity(), last_frame_);
+  if (labeller_) {
+    labelFrame(cloud_world);
+  } else {
+    scorer_.score(cloud_world, Eigen::Isometry3d::Identity(), last_frame_);
+  }
   BaseState s;
   if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
   const auto view = maps::viewPoints(last_frame_.cloud_world, last_frame_.classes,
@@ -131,6 +135,32 @@ const FrameEvidence& NavigationLoop::addFrame(const core::PointCloud& cloud_worl
                          last_missing_ground_.end());
   obstacles_.setFrameObstacles(std::move(frame_obstacles));
   return last_frame_;
+}
+
+void NavigationLoop::labelFrame(const core::PointCloud& cloud_world) {
+  FrameEvidence& f = last_frame_;
+  f.cloud_world = cloud_world;
+  f.normals_world = {};
+  f.upd = {};
+  f.classes = {};
+  f.obstacles_world.clear();
+  f.timings = {};
+  f.classes.label.resize(cloud_world.size());
+  for (std::size_t i = 0; i < cloud_world.size(); ++i) {
+    const double x = cloud_world.x[i], y = cloud_world.y[i];
+    const core::Label l = std::isfinite(x) && std::isfinite(y) && std::isfinite(cloud_world.z[i])
+                              ? labeller_(x, y)
+                              : core::Label::Unknown;
+    f.classes.label[i] = l;
+    if (l == core::Label::NonTraversable) {
+      ++f.classes.non_traversable;
+      f.obstacles_world.emplace_back(x, y);
+    } else if (l == core::Label::Traversable) {
+      ++f.classes.traversable;
+    } else {
+      ++f.classes.unknown;
+    }
+  }
 }
 
 void NavigationLoop::setFixedObstacles(std::vector<Eigen::Vector2d> points_world) {

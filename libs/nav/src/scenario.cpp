@@ -70,13 +70,14 @@ Eigen::Vector3d xyYaw(const Pose2D& p) { return {p.x_m, p.y_m, p.yaw_rad}; }
 class ScenarioRun {
  public:
   ScenarioRun(const sim::WorldSpec& world, const NavConfig& config, core::ObstacleDetector detector,
-              const std::string& navlog_path)
+              const std::string& navlog_path, const NavigationLoop::PointLabeller& labeller)
       : world_(world),
         config_(config),
         base_(Pose2D{world.start_xy_yaw.x(), world.start_xy_yaw.y(), world.start_xy_yaw.z()},
               config.base),
         loop_(base_, config, detector, navlog_path),
         truth_(world.terrain, config.loop.truth_cell_m) {
+    if (labeller) loop_.setLabeller(labeller);
     if (config.loop.fence_world) {
       loop_.setFixedObstacles(rectangleFence(world.terrain.minXY(), world.terrain.maxXY(),
                                              config.obstacles.decimation_m));
@@ -153,11 +154,12 @@ void summarize(ScenarioRun& run, const sim::WorldSpec& world, const NavConfig& c
 
 ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
                            const NavConfig& config, core::ObstacleDetector detector,
-                           const std::string& navlog_path, const StepCallback& on_step) {
+                           const std::string& navlog_path, const StepCallback& on_step,
+                           const NavigationLoop::PointLabeller& labeller) {
   config.validate();
   const core::Stopwatch wall;
   SimulatedClock clock;
-  ScenarioRun run(world, config, detector, navlog_path);
+  ScenarioRun run(world, config, detector, navlog_path, labeller);
 
   ScenarioResult r;
   r.scenario = name;
@@ -200,7 +202,7 @@ ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
 nlohmann::json summaryJson(const ScenarioResult& r) {
   nlohmann::json j;
   j["scenario"] = r.scenario;
-  j["obstacles"] = toString(r.detector);
+  j["obstacles"] = r.perception.empty() ? std::string(toString(r.detector)) : r.perception;
   j["reached"] = r.reached;
   j["end"] = toString(r.end);
   j["navigator"] = {{"state", toString(r.navigator.state)},
@@ -342,7 +344,9 @@ void writeScenarioOutputs(const ScenarioResult& r, const sim::WorldSpec& world,
 
   const Eigen::Vector2d margin(0.5, 0.5);
   const TopView view(world.terrain.minXY() - margin, world.terrain.maxXY() + margin, 0.02);
-  const std::string title = r.scenario + " / " + toString(r.detector) + ": " + toString(r.end);
+  const std::string title = r.scenario + " / " +
+                            (r.perception.empty() ? std::string(toString(r.detector)) : r.perception) +
+                            ": " + toString(r.end);
   std::ostringstream stats;
   stats << std::fixed << std::setprecision(1) << r.sim_time_s << " s, " << r.path_length_m
         << " m driven, " << r.collision_steps << " collisions, min clearance "

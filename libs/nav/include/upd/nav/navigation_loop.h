@@ -30,6 +30,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,6 +53,10 @@ class NavigationLoop {
   /// ground), the level below which hidden ground counts as missing.
   const FrameEvidence& addFrame(const core::PointCloud& cloud_world, double time_s,
                                 double ground_z_m = 0.0);
+  /// Labels a frame's points by their world xy instead of the detector (the benchmark's oracle:
+  /// the ground truth's traversability seen through the same camera). Empty: the detector.
+  using PointLabeller = std::function<core::Label(double x_m, double y_m)>;
+  void setLabeller(PointLabeller labeller) { labeller_ = std::move(labeller); }
   /// Obstacles known a priori (world frame), e.g. rectangleFence() of the mission area.
   void setFixedObstacles(std::vector<Eigen::Vector2d> points_world);
 
@@ -84,6 +89,7 @@ class NavigationLoop {
   RobotBase& base_;
   NavConfig config_;
   core::FrameScorer scorer_;
+  PointLabeller labeller_;
   std::string navlog_path_;
   maps::TraversabilityGrid grid_;
   ObstacleSource obstacles_;
@@ -101,6 +107,7 @@ class NavigationLoop {
   double last_progress_s_ = 0.0;  ///< when the route last got shorter [s]
 
   void replan();
+  void labelFrame(const core::PointCloud& cloud_world);
 };
 
 }  // namespace upd::nav

@@ -11,6 +11,7 @@
 
 #include "upd/maps/traversability_grid.h"
 #include "upd/nav/nav_config.h"
+#include "upd/nav/navigation_loop.h"
 #include "upd/nav/navigator.h"
 #include "upd/nav/perception.h"
 #include "upd/nav/robot_base.h"
@@ -46,6 +47,7 @@ const char* toString(RunEnd e);
 struct ScenarioResult {
   std::string scenario;
   core::ObstacleDetector detector = core::ObstacleDetector::Upd;
+  std::string perception;  ///< when not empty, named instead of the detector (e.g. "truth")
   Eigen::Vector2d goal_xy = Eigen::Vector2d::Zero();
   bool reached = false;  ///< the navigator reported the goal and the robot is within tolerance
   RunEnd end = RunEnd::TimeLimit;
@@ -70,10 +72,12 @@ struct ScenarioResult {
 using StepCallback = std::function<void(const TrajectorySample&)>;
 
 /// Runs the loop on world (name is recorded). navlog_path: where the MRPT navlog goes (empty:
-/// none). Restores MRPT's clock to real time when it returns.
+/// none). labeller: when set, labels the frames instead of the detector
+/// (NavigationLoop::setLabeller). Restores MRPT's clock to real time when it returns.
 ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
                            const NavConfig& config, core::ObstacleDetector detector,
-                           const std::string& navlog_path = "", const StepCallback& on_step = {});
+                           const std::string& navlog_path = "", const StepCallback& on_step = {},
+                           const NavigationLoop::PointLabeller& labeller = {});
 
 /// summary.json's content: reached, end state, navigator error, simulated time, path length,
 /// minimum clearance, collisions, ...
