@@ -27,6 +27,8 @@ int runCalibrateMount(const std::vector<std::string>& args);
 int runRos(const std::vector<std::string>& args);
 int runRender(const std::vector<std::string>& args);
 int runHistogram(const std::vector<std::string>& args);
+int runEvaluate(const std::vector<std::string>& args);
+int runTrain(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
 extern const char* const kSceneUsage;
@@ -40,6 +42,11 @@ extern const char* const kCalibrateMountUsage;
 extern const char* const kRosUsage;
 extern const char* const kRenderUsage;
 extern const char* const kHistogramUsage;
+extern const char* const kEvaluateUsage;
+extern const char* const kTrainUsage;
+
+/// Makes `[ClassifyParams] classifier = FILE` loadable (libs/learn, when built).
+void registerClassifierLoader();
 
 /// The --size WxH option of `upd render` and `upd histogram`; throws UsageError naming it.
 std::pair<int, int> parseImageSize(const std::string& s);

@@ -35,6 +35,10 @@ const Command kCommands[] = {
      upd::app::kRenderUsage, upd::app::runRender},
     {"histogram", "plot the distribution of zeta at several d_m to a PNG",
      upd::app::kHistogramUsage, upd::app::runHistogram},
+    {"evaluate", "score the UPD, its baselines and the classifier against labelled clouds",
+     upd::app::kEvaluateUsage, upd::app::runEvaluate},
+    {"train", "train the learned traversability classifier on labelled clouds",
+     upd::app::kTrainUsage, upd::app::runTrain},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };
@@ -59,6 +63,7 @@ int main(int argc, char** argv) {
     printHelp(std::cout);
     return argc < 2 ? 2 : 0;
   }
+  upd::app::registerClassifierLoader();
   const std::string name = argv[1];
   const std::vector<std::string> args(argv + 2, argv + argc);
   for (const auto& c : kCommands) {

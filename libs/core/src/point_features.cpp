@@ -68,25 +68,38 @@ const RadiusScores& PointScores::at(double radius_m) const {
   throw std::invalid_argument("PointScores: no scores at d_m = " + std::to_string(radius_m));
 }
 
-void columnHeightStats(const PointCloud& cloud, const Eigen::Vector3f& up, double cell_m,
-                       std::vector<float>& range_m, std::vector<float>& spread_m) {
+std::vector<std::uint32_t> columnIndex(const PointCloud& cloud, const Eigen::Vector3f& up,
+                                       double cell_m, std::size_t& columns) {
   const Eigen::Vector3f e1 = up.unitOrthogonal(), e2 = up.cross(e1);
-  struct Column {
-    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    double sum = 0, sum_sq = 0;
-    std::size_t n = 0;
-  };
-  std::unordered_map<std::uint64_t, Column> columns;
-  std::vector<std::uint64_t> key(cloud.size(), 0);
+  std::unordered_map<std::uint64_t, std::uint32_t> dense;
+  std::vector<std::uint32_t> index(cloud.size(), kNoColumn);
   const auto cellOf = [&](float v) {
     return static_cast<std::uint32_t>(static_cast<std::int32_t>(std::floor(v / cell_m)));
   };
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (!cloud.isFinite(i)) continue;
     const Eigen::Vector3f p = cloud.point(i);
-    key[i] = (std::uint64_t(cellOf(p.dot(e1))) << 32) | cellOf(p.dot(e2));
-    Column& c = columns[key[i]];
-    const float h = p.dot(up);
+    const std::uint64_t key = (std::uint64_t(cellOf(p.dot(e1))) << 32) | cellOf(p.dot(e2));
+    index[i] = dense.emplace(key, static_cast<std::uint32_t>(dense.size())).first->second;
+  }
+  columns = dense.size();
+  return index;
+}
+
+void columnHeightStats(const PointCloud& cloud, const Eigen::Vector3f& up, double cell_m,
+                       std::vector<float>& range_m, std::vector<float>& spread_m) {
+  struct Column {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    double sum = 0, sum_sq = 0;
+    std::size_t n = 0;
+  };
+  std::size_t count = 0;
+  const std::vector<std::uint32_t> column = columnIndex(cloud, up, cell_m, count);
+  std::vector<Column> columns(count);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (column[i] == kNoColumn) continue;
+    Column& c = columns[column[i]];
+    const float h = cloud.point(i).dot(up);
     c.lo = std::min(c.lo, h);
     c.hi = std::max(c.hi, h);
     c.sum += h;
@@ -96,8 +109,8 @@ void columnHeightStats(const PointCloud& cloud, const Eigen::Vector3f& up, doubl
   range_m.assign(cloud.size(), kNaN);
   spread_m.assign(cloud.size(), kNaN);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (!cloud.isFinite(i)) continue;
-    const Column& c = columns[key[i]];
+    if (column[i] == kNoColumn) continue;
+    const Column& c = columns[column[i]];
     const double mean = c.sum / c.n;
     range_m[i] = c.hi - c.lo;
     spread_m[i] = static_cast<float>(std::sqrt(std::max(0.0, c.sum_sq / c.n - mean * mean)));

@@ -169,12 +169,6 @@ std::vector<float> PointClassifier::probabilityOfFeatures(const std::vector<floa
   return p;
 }
 
-std::vector<float> PointClassifier::probability(const core::PointCloud& cloud,
-                                                const core::Normals& normals,
-                                                const Eigen::Vector3f& up) const {
-  return probabilityOfFeatures(core::computeFeatures(cloud, normals, up, impl_->features));
-}
-
 const core::FeatureParams& PointClassifier::featureParams() const { return impl_->features; }
 ModelKind PointClassifier::kind() const { return impl_->kind; }
 

@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,13 @@ std::vector<float> featuresOf(const PointScores& scores, const FeatureParams& pa
 /// The same from scratch: the scores at FeatureParams' radii, then the features.
 std::vector<float> computeFeatures(const PointCloud& cloud, const Normals& normals,
                                    const Eigen::Vector3f& up, const FeatureParams& params);
+
+/// The cell_m x cell_m column (square cells in the plane normal to up) of every point, as
+/// dense indices 0 .. columns - 1 (columns receives the count); kNoColumn for a point with no
+/// finite position.
+constexpr std::uint32_t kNoColumn = 0xffffffffu;
+std::vector<std::uint32_t> columnIndex(const PointCloud& cloud, const Eigen::Vector3f& up,
+                                       double cell_m, std::size_t& columns);
 
 /// The height range and spread of each point's cell_m column (cells square in the plane
 /// normal to up; points with no finite position get NaN).

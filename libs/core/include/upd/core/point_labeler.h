@@ -14,6 +14,7 @@
 #include "upd/core/classify.h"
 #include "upd/core/normals.h"
 #include "upd/core/point_cloud.h"
+#include "upd/core/point_features.h"
 
 #include <Eigen/Core>
 
@@ -26,10 +27,17 @@ namespace upd::core {
 class PointLabeler {
  public:
   virtual ~PointLabeler() = default;
-  /// The probability of NonTraversable of every point of cloud (its normals unit or NaN, up
-  /// unit), in [0, 1].
-  virtual std::vector<float> probability(const PointCloud& cloud, const Normals& normals,
-                                         const Eigen::Vector3f& up) const = 0;
+  /// The features the model reads (point_features.h).
+  virtual const FeatureParams& featureParams() const = 0;
+  /// The probability of NonTraversable, in [0, 1], of each row of features (row-major,
+  /// kFeatureCount per point, as featuresOf gives them).
+  virtual std::vector<float> probabilityOfFeatures(const std::vector<float>& features) const = 0;
+  /// The same for every point of cloud (its normals unit or NaN, up unit): computeFeatures,
+  /// then probabilityOfFeatures.
+  std::vector<float> probability(const PointCloud& cloud, const Normals& normals,
+                                 const Eigen::Vector3f& up) const {
+    return probabilityOfFeatures(computeFeatures(cloud, normals, up, featureParams()));
+  }
   /// Points with probability >= this are NonTraversable.
   virtual float threshold() const { return 0.5f; }
 };

@@ -55,13 +55,9 @@ class PointClassifier : public core::PointLabeler {
   /// Writes it atomically; the extension picks the format (.yml, .yaml, .xml, .json).
   void save(const std::string& path) const;
 
-  /// Probability of non-traversable per row of features.
-  std::vector<float> probabilityOfFeatures(const std::vector<float>& features) const;
-  /// The features of the cloud, then their probabilities (core::PointLabeler).
-  std::vector<float> probability(const core::PointCloud& cloud, const core::Normals& normals,
-                                 const Eigen::Vector3f& up) const override;
-
-  const core::FeatureParams& featureParams() const;
+  /// Probability of non-traversable per row of features (core::PointLabeler).
+  std::vector<float> probabilityOfFeatures(const std::vector<float>& features) const override;
+  const core::FeatureParams& featureParams() const override;
   ModelKind kind() const;
   /// Random trees: the importance of each feature (kFeatureCount, summing to 1); else empty.
   std::vector<float> featureImportance() const;
