@@ -33,7 +33,7 @@ const char* const kEvaluateUsage =
     "  --config FILE.ini     score every cloud with this config (default: the shipped\n"
     "                        dune-kinect.ini for depth data, lidar.ini for LiDAR)\n"
     "  --classifier FILE     learned classifier (default: the shipped\n"
-    "                        models/traversability.yml when this upd has libs/learn)\n"
+    "                        models/traversability.yml.gz when this upd has libs/learn)\n"
     "  --no-classifier       score without it\n"
     "  --shared-data DIR     real frames from DIR (default: $UPD_SHARED_DATA_DIR,\n"
     "                        ../shared/data or /work/shared/data when present)\n"
@@ -69,7 +69,7 @@ std::string commandLine(const std::vector<std::string>& argv) {
 std::string classifierPath(const Args& args, std::vector<std::string>& notes) {
   if (args.flag("--no-classifier")) return "";
   if (const auto f = args.str("--classifier")) return *f;
-  const auto shipped = std::filesystem::path(nav::defaultDataDir()) / "models" / "traversability.yml";
+  const auto shipped = std::filesystem::path(nav::defaultDataDir()) / "models" / "traversability.yml.gz";
   if (!std::filesystem::exists(shipped)) {
     notes.push_back("no learned classifier: " + shipped.string() + " not found");
     return "";
@@ -123,7 +123,7 @@ int runEvaluate(const std::vector<std::string>& argv) {
   std::vector<std::vector<std::string>> names;
   std::size_t training_skipped = 0;
   forEachLabelledCloud(data, [&](LabelledCloud& c) {
-    if (!c.held_out && !all_scenes) {
+    if (c.trains_shipped_model && !all_scenes) {
       ++training_skipped;
       return;
     }
@@ -141,7 +141,7 @@ int runEvaluate(const std::vector<std::string>& argv) {
   }, rep.notes);
   if (training_skipped) {
     rep.notes.push_back(std::to_string(training_skipped) +
-                        " clouds of the training split not scored (--all-scenes scores them)");
+                        " generated clouds the shipped classifier was trained on not scored (--all-scenes scores them)");
   }
   if (pools.empty()) throw std::runtime_error("no labelled data to evaluate");
   for (std::size_t g = 0; g < pools.size(); ++g) {

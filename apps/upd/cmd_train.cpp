@@ -24,7 +24,7 @@ const char* const kTrainUsage =
     "  its precision, recall, F1 and AUC on the held-out split, and writes the model.\n"
     "  INPUT: SemanticKITTI or RELLIS-3D folders or .bin scans, with --class-map.\n\n"
     "options:\n"
-    "  --output FILE         the model: .yml, .yaml, .xml or .json (required)\n"
+    "  --output FILE         the model: .yml, .yaml, .xml or .json, + .gz (required)\n"
     "  --model KINDS         rtrees, boost and/or svm, comma-separated (default rtrees): each\n"
     "                        is trained and scored on the held-out split, and the one with\n"
     "                        the highest held-out F1 is written\n"

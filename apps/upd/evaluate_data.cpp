@@ -42,6 +42,7 @@ void visitScenes(const std::function<void(LabelledCloud&)>& visit) {
       c.group = noise > 0 ? "generated scenes, 5 mm noise" : "generated scenes";
       c.scene = name;
       c.held_out = kHeldOutScenes.count(name) > 0;
+      c.trains_shipped_model = !c.held_out;
       c.config = "dune-kinect.ini";
       c.cloud = std::move(s.cloud);
       c.truth = std::move(s.truth);
@@ -76,6 +77,7 @@ void visitWorldViews(const std::function<void(LabelledCloud&)>& visit) {
         c.group = noisy ? "simulated Kinect, noise" : "simulated Kinect, no noise";
         c.scene = std::string("world ") + name;
         c.held_out = kHeldOutScenes.count(c.scene) > 0;
+        c.trains_shipped_model = !c.held_out;
         c.config = "dune-kinect.ini";
         c.cloud = std::move(r.scene.cloud);
         c.truth = std::move(r.scene.truth);

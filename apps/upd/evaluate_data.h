@@ -25,7 +25,10 @@ struct LabelledCloud {
   std::string name;   ///< e.g. "scene ramp", "world mixed view 2", "pcl/office1.pcd"
   std::string group;  ///< the table it is scored in
   std::string scene;  ///< the unit of the train / test split
-  bool held_out = true;  ///< in the test split
+  bool held_out = true;  ///< in the test split of `upd train`
+  /// One of the scenes the shipped classifier was trained on: `upd evaluate` skips it unless
+  /// --all-scenes.
+  bool trains_shipped_model = false;
   std::string config;    ///< the shipped config it is scored with: "dune-kinect.ini", "lidar.ini"
   core::PointCloud cloud;
   std::vector<core::Label> truth;  ///< one per point

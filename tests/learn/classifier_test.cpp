@@ -73,6 +73,10 @@ TEST(PointClassifier, FileRoundTripsAndBadFilesFail) {
   EXPECT_EQ(back->probabilityOfFeatures(f), c->probabilityOfFeatures(f));
   EXPECT_EQ(c->featureImportance().size(), std::size_t(kFeatureCount));
 
+  const std::string gz = (tmp.path() / "m.yml.gz").string();  // compressed, as shipped
+  c->save(gz);
+  EXPECT_EQ(PointClassifier::load(gz)->probabilityOfFeatures(f), c->probabilityOfFeatures(f));
+
   registerLoader();
   EXPECT_NE(core::loadPointLabeler(path), nullptr);
   const std::string junk = (tmp.path() / "junk.yml").string();

@@ -8,21 +8,48 @@
 #include <ostream>
 #include <stdexcept>
 
+#include <unistd.h>
+
 namespace upd::learn {
 
 namespace {
 
 constexpr const char* kMetaNode = "upd_point_classifier";
 
-std::string formatOf(const std::string& path) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  if (ext == ".yml" || ext == ".yaml" || ext == ".xml" || ext == ".json") return ext;
-  throw std::invalid_argument("classifier file '" + path +
-                              "': the extension must be .yml, .yaml, .xml or .json");
-}
-
 std::runtime_error fileError(const std::string& path, const std::string& what) {
   return std::runtime_error("classifier '" + path + "': " + what);
+}
+
+// The format extension (".yml" ...) and whether the file is gzip-compressed (".yml.gz").
+std::string formatOf(const std::string& path, bool* gz = nullptr) {
+  std::filesystem::path p(path);
+  const bool compressed = p.extension() == ".gz";
+  if (compressed) p = p.stem();
+  if (gz) *gz = compressed;
+  const std::string ext = p.extension().string();
+  if (ext == ".yml" || ext == ".yaml" || ext == ".xml" || ext == ".json") return ext;
+  throw std::invalid_argument("classifier file '" + path +
+                              "': the extension must be .yml, .yaml, .xml or .json (+ .gz)");
+}
+
+void writeModel(cv::FileStorage& fs, const PointClassifier::Impl& m);
+
+// A compressed file: OpenCV writes it to a temporary path, renamed into place.
+void saveCompressed(const std::string& path, const PointClassifier::Impl& m) {
+  const std::filesystem::path target(path);
+  const std::filesystem::path tmp = target.parent_path() /
+      ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()) + target.stem().extension().string() + ".gz");
+  try {
+    cv::FileStorage fs(tmp.string(), cv::FileStorage::WRITE);
+    if (!fs.isOpened()) throw fileError(path, "cannot open for writing");
+    writeModel(fs, m);
+    fs.release();
+    std::filesystem::rename(tmp, target);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
 }
 
 cv::Ptr<cv::ml::StatModel> emptyModel(ModelKind kind) {
@@ -75,15 +102,21 @@ PointClassifier::Impl readMeta(const cv::FileNode& meta, const std::string& path
   return m;
 }
 
+void writeModel(cv::FileStorage& fs, const PointClassifier::Impl& m) {
+  writeMeta(fs, m);
+  fs << "model" << "{";
+  m.model->write(fs);
+  fs << "}";
+}
+
 }  // namespace
 
 void PointClassifier::save(const std::string& path) const {
-  const std::string format = formatOf(path);
+  bool gz = false;
+  const std::string format = formatOf(path, &gz);
+  if (gz) return saveCompressed(path, *impl_);
   cv::FileStorage fs(format, cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
-  writeMeta(fs, *impl_);
-  fs << "model" << "{";
-  impl_->model->write(fs);
-  fs << "}";
+  writeModel(fs, *impl_);
   const std::string text = fs.releaseAndGetString();
   io::writeFileAtomically(path, [&](std::ostream& out) { out << text; });
 }

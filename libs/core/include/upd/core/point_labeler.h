@@ -34,8 +34,8 @@ class PointLabeler {
   virtual std::vector<float> probabilityOfFeatures(const std::vector<float>& features) const = 0;
   /// The same for every point of cloud (its normals unit or NaN, up unit): computeFeatures,
   /// then probabilityOfFeatures.
-  std::vector<float> probability(const PointCloud& cloud, const Normals& normals,
-                                 const Eigen::Vector3f& up) const {
+  virtual std::vector<float> probability(const PointCloud& cloud, const Normals& normals,
+                                         const Eigen::Vector3f& up) const {
     return probabilityOfFeatures(computeFeatures(cloud, normals, up, featureParams()));
   }
   /// Points with probability >= this are NonTraversable.
