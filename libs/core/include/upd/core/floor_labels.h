@@ -21,7 +21,7 @@
 
 namespace upd::core {
 
-/// Loaded from [GeometricLabelParams].
+/// The rule of the header comment (`upd evaluate` uses the defaults).
 struct GeometricLabelParams {
   double off_floor_m = 0.05;  ///< farther from the floor plane: non-traversable [m]
   double border_m = 0.10;     ///< floor points this close to an off-floor point: non-traversable

@@ -29,7 +29,7 @@
 
 namespace upd::core {
 
-/// The features of the learned classifier. Loaded from [FeatureParams].
+/// The features of the learned classifier; a model file stores the ones it was trained with.
 struct FeatureParams {
   double radius_small_m = 0.3;  ///< the first d_m of the UPD and baselines [m]
   double radius_m = 0.5;        ///< the second [m]
