@@ -30,6 +30,8 @@ int runRender(const std::vector<std::string>& args);
 int runHistogram(const std::vector<std::string>& args);
 int runBaseline(const std::vector<std::string>& args);
 int runView(const std::vector<std::string>& args);
+int runEvaluate(const std::vector<std::string>& args);
+int runTrain(const std::vector<std::string>& args);
 
 extern const char* const kAnalyzeUsage;
 extern const char* const kSceneUsage;
@@ -46,6 +48,11 @@ extern const char* const kRenderUsage;
 extern const char* const kHistogramUsage;
 extern const char* const kBaselineUsage;
 extern const char* const kViewUsage;
+extern const char* const kEvaluateUsage;
+extern const char* const kTrainUsage;
+
+/// Makes `[ClassifyParams] classifier = FILE` loadable (libs/learn, when built).
+void registerClassifierLoader();
 
 /// The --size WxH option of `upd render` and `upd histogram`; throws UsageError naming it.
 std::pair<int, int> parseImageSize(const std::string& s);

@@ -42,6 +42,10 @@ const Command kCommands[] = {
      upd::app::kBaselineUsage, upd::app::runBaseline},
     {"view", "3D window on a scored cloud, an .ot tree or a playback folder (keys recolour)",
      upd::app::kViewUsage, upd::app::runView},
+    {"evaluate", "score the UPD, its baselines and the classifier against labelled clouds",
+     upd::app::kEvaluateUsage, upd::app::runEvaluate},
+    {"train", "train the learned traversability classifier on labelled clouds",
+     upd::app::kTrainUsage, upd::app::runTrain},
     {"params", "list every parameter with its ini section, default and unit",
      upd::app::kParamsUsage, upd::app::runParams},
 };
@@ -66,6 +70,7 @@ int main(int argc, char** argv) {
     printHelp(std::cout);
     return argc < 2 ? 2 : 0;
   }
+  upd::app::registerClassifierLoader();
   const std::string name = argv[1];
   const std::vector<std::string> args(argv + 2, argv + argc);
   for (const auto& c : kCommands) {

@@ -8,6 +8,7 @@ RunConfig loadRunConfig(const std::string& path) {
   RunConfig c;
   mrpt_bridge::IniReader ini(path);
   forEachSection(c, [&](const char* name, const char*, auto& params) { ini.read(name, params); });
+  mrpt_bridge::readClassifier(ini, c.observer.pipeline);
   ini.checkAllKeysKnown();
   try {
     c.observer.validate();

@@ -78,6 +78,7 @@ void runPipeline(const PointCloud& input, const PipelineParams& params, Pipeline
     res.timings.upd_ms = lapMs(lap);
   }
   classify(res.upd, up, params.classify, res.classes);
+  if (params.labeler) applyPointLabeler(*params.labeler, res.cloud, res.normals, up, res.classes);
   res.timings.classify_ms = lapMs(lap);
   res.timings.total_ms = total.elapsedMs();
 }

@@ -203,4 +203,20 @@ void loadPipelineParams(const std::string& ini_path, core::PipelineParams& param
   }
 }
 
+void readClassifier(IniReader& ini, core::PipelineParams& pipeline) {
+  const char* const section = "ClassifyParams";
+  const char* const key = "classifier";
+  ini.markKnown(section, key);
+  if (!ini.hasKey(section, key)) return;
+  std::filesystem::path file = trim(ini.rawValue(section, key));
+  if (file.empty()) return;
+  if (file.is_relative()) file = std::filesystem::path(ini.path()).parent_path() / file;
+  try {
+    pipeline.labeler = core::loadPointLabeler(file.lexically_normal().string());
+  } catch (const std::exception& e) {
+    throw std::runtime_error("config file " + ini.path() + ": [ClassifyParams] classifier: " +
+                             e.what());
+  }
+}
+
 }  // namespace upd::mrpt_bridge

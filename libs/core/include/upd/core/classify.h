@@ -6,6 +6,8 @@
 //  - NonTraversable (cost 1) when zeta < zeta_min or slope > max_slope;
 //  - Traversable otherwise, with cost = max(zeta term, slope term), where the zeta term rises
 //    linearly from 0 at zeta_caution to 1 at zeta_min and the slope term is (slope/max_slope)^2.
+// A learned classifier replaces this rule when a config sets `[ClassifyParams] classifier = FILE`
+// (point_labeler.h, docs/EVALUATION.md).
 // A point is "flagged" when its cost is > 0 because of zeta (zeta < zeta_caution): a gentle
 // concave border such as the foot of a 20 deg ramp is flagged but stays traversable.
 #pragma once

@@ -20,6 +20,7 @@
 
 #include "upd/core/classify.h"
 #include "upd/core/normals.h"
+#include "upd/core/point_labeler.h"
 #include "upd/core/preprocess.h"
 #include "upd/core/upd.h"
 
@@ -31,6 +32,9 @@ struct PipelineParams {
   NormalParams normals;
   UpdParams upd;
   ClassifyParams classify;
+  /// A learned classifier (`[ClassifyParams] classifier = FILE`, point_labeler.h): when set,
+  /// it labels the points instead of the threshold rule.
+  std::shared_ptr<const PointLabeler> labeler;
 
   /// Validates every part; throws std::invalid_argument naming the field and value.
   void validate() const;

@@ -125,6 +125,11 @@ void IniReader::read(const std::string& section, P& params) {
   }
 }
 
+/// `[ClassifyParams] classifier = FILE`, the learned classifier (upd/core/point_labeler.h; a
+/// relative FILE is relative to the ini file), loaded into pipeline.labeler when present.
+/// Marks the key known; throws naming the file and key when the model cannot be loaded.
+void readClassifier(IniReader& ini, core::PipelineParams& pipeline);
+
 /// Reads [PipelineParams] (key `up`), [PreprocessParams], [NormalParams], [UpdParams] and
 /// [ClassifyParams] into params, then checks that the file holds nothing else.
 void loadPipelineParams(const std::string& ini_path, core::PipelineParams& params);

@@ -91,6 +91,7 @@ void forEachRobotSection(const RobotConfigParts& c, F&& f) {
 inline void readRobotConfig(IniReader& ini, const RobotConfigParts& parts) {
   forEachRobotSection(parts,
                       [&](const char* name, const char*, auto& params) { ini.read(name, params); });
+  if (parts.pipeline != nullptr) readClassifier(ini, *parts.pipeline);
 }
 
 }  // namespace upd::mrpt_bridge
