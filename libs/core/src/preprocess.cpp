@@ -99,9 +99,11 @@ const std::vector<char>& outlierKeepMask(const PointCloud& in, int k, double std
   const double mu = s / n;
   const double sigma = std::sqrt(std::max(0.0, s2 / n - mu * mu));
   const double limit = mu + std_mul * sigma;
+  const double* m = mean_dist.data();  // (plain pointers: char stores alias the vectors)
+  char* k_out = keep.data();
   for (std::size_t i = 0; i < in.size(); ++i) {
     // A point alone has no neighbour distance: it is an outlier by definition.
-    keep[i] = !std::isnan(mean_dist[i]) && mean_dist[i] <= limit;
+    k_out[i] = !std::isnan(m[i]) && m[i] <= limit;
   }
   return keep;
 }
