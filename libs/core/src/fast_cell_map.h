@@ -130,6 +130,11 @@ class CellGrid {
   explicit CellGrid(std::size_t expected = 64) : map_(expected) {}
 
   std::size_t size() const { return map_.size(); }
+  /// Empties the grid for about `expected` cells, keeping its storage.
+  void clear(std::size_t expected) {
+    map_.clear(expected);
+    xyz_.clear();
+  }
   /// Cell coordinates, 3 per cell in id order.
   const std::vector<std::int32_t>& coords() const { return xyz_; }
   const std::int32_t* xyz(std::size_t c) const { return &xyz_[3 * c]; }

@@ -79,10 +79,13 @@ PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
 }
 
 namespace {
-// The outlier filter's verdict per point: its mean neighbour distance within mu + std_mul sigma.
-std::vector<char> outlierKeepMask(const PointCloud& in, int k, double std_mul) {
+// The outlier filter's verdict per point: its mean neighbour distance within mu + std_mul sigma
+// (the calling thread's buffer, valid until its next call).
+const std::vector<char>& outlierKeepMask(const PointCloud& in, int k, double std_mul) {
   requireParam(k >= 1, "PreprocessParams", "outlier_k", k, "must be >= 1");
-  const std::vector<double> mean_dist = meanNeighbourDistances(in, k);
+  thread_local std::vector<double> mean_dist;  // (kept from call to call, as keep)
+  thread_local std::vector<char> keep;
+  meanNeighbourDistances(in, k, mean_dist);
   double s = 0, s2 = 0;
   std::size_t n = 0;
   for (const double d : mean_dist) {
@@ -91,14 +94,16 @@ std::vector<char> outlierKeepMask(const PointCloud& in, int k, double std_mul) {
     s2 += d * d;
     ++n;
   }
-  std::vector<char> keep(in.size(), 0);
+  keep.assign(in.size(), 0);
   if (n == 0) return keep;
   const double mu = s / n;
   const double sigma = std::sqrt(std::max(0.0, s2 / n - mu * mu));
   const double limit = mu + std_mul * sigma;
+  const double* m = mean_dist.data();  // (plain pointers: char stores alias the vectors)
+  char* k_out = keep.data();
   for (std::size_t i = 0; i < in.size(); ++i) {
     // A point alone has no neighbour distance: it is an outlier by definition.
-    keep[i] = !std::isnan(mean_dist[i]) && mean_dist[i] <= limit;
+    k_out[i] = !std::isnan(m[i]) && m[i] <= limit;
   }
   return keep;
 }

@@ -36,6 +36,8 @@ struct PointGrid {
   std::vector<std::uint32_t> start;  // n_cells + 1
   std::vector<float> x, y, z;        // by cell
   std::vector<std::uint32_t> index;  // by cell: the cloud's index
+  std::vector<std::uint32_t> cell_of;  // (buildGrid's buffers)
+  detail::CellLists by_cell;
 
   // Squared distance from (qx, qy, qz) to the box of cell c (0 inside).
   float boxDistance2(std::uint32_t c, float qx, float qy, float qz) const {
@@ -61,17 +63,18 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   g.h = h, g.inv_h = 1.0 / h;
   const std::uint32_t f0 = finite.front();
   g.ox = in.x[f0], g.oy = in.y[f0], g.oz = in.z[f0];
-  g.cells = detail::CellGrid(finite.size() / 4 + 64);
-  std::vector<std::uint32_t> cell_of(finite.size());
+  g.cells.clear(finite.size() / 4 + 64);
+  std::vector<std::uint32_t>& cell_of = g.cell_of;
+  cell_of.resize(finite.size());
   const auto coords = [&](std::size_t f, std::int64_t(&c)[3]) {
     cellOf(in, finite[f], f0, g.inv_h, c);
     return true;
   };
   if (!detail::binCells(0, finite.size(), coords, g.cells, cell_of.data())) return false;
-  detail::CellLists by_cell;
+  detail::CellLists& by_cell = g.by_cell;
   detail::listByCell(
       finite.size(), g.cells.size(), [&](std::size_t f) { return cell_of[f]; }, by_cell);
-  g.start = std::move(by_cell.start);
+  g.start.assign(by_cell.start.begin(), by_cell.start.end());
   g.x.resize(finite.size()), g.y.resize(finite.size()), g.z.resize(finite.size());
   g.index.resize(finite.size());
   for (std::size_t j = 0; j < finite.size(); ++j) {
@@ -90,6 +93,25 @@ void distances2(const float* __restrict x, const float* __restrict y, const floa
     const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
     out[j] = dx * dx + dy * dy + dz * dz;
   }
+}
+
+// The same, counting those within t (into within_t) and within m2 (returned): counts that
+// vectorize with the distances.
+UPD_VECTOR_CLONES
+std::size_t distances2Within(const float* __restrict x, const float* __restrict y,
+                             const float* __restrict z, std::size_t n, float qx, float qy,
+                             float qz, float t, float m2, float* __restrict out,
+                             std::size_t& within_t) {
+  std::uint32_t in_t = 0, in_m2 = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
+    const float d2 = dx * dx + dy * dy + dz * dz;
+    out[j] = d2;
+    in_t += d2 <= t ? 1u : 0u;
+    in_m2 += d2 <= m2 ? 1u : 0u;
+  }
+  within_t = in_t;
+  return in_m2;
 }
 
 // Mean of the square roots of d2[1, n): the k nearest's mean distance, leaving out the first
@@ -127,6 +149,41 @@ class NearestK {
   std::size_t k_, n_ = 0;
   float d_[kMax];
 };
+
+// Chunks of the blocks' distances (BlockPoints pads to a multiple).
+constexpr std::size_t kChunk = 16;
+
+// The mean distance of a point to its k nearest others from the squared distances bd2[0, n) to
+// the points of its block (n a multiple of kChunk, padded with distances beyond t; the point
+// itself among them, at 0), when at least want of them lie within t
+// (the caller has counted them) and t is within the block's margin (squared), so that no point
+// outside the block is nearer than the want-th. The want smallest by a branch-free gathering of
+// the candidates within t (into cand, n floats) and a partial selection; the want-th (squared)
+// into kth.
+double settledMean(const float* bd2, std::size_t n, float t, std::size_t want, float* cand,
+                   float& kth) {
+  std::size_t c = 0;
+  for (std::size_t j0 = 0; j0 < n; j0 += kChunk) {
+    // (Most chunks of 16 hold no candidate: the block's cells come nearest first.)
+    std::uint32_t any = 0;
+    for (std::size_t j = j0; j < j0 + kChunk; ++j) any |= bd2[j] <= t ? 1u : 0u;
+    if (any == 0) continue;
+    for (std::size_t j = j0; j < j0 + kChunk; ++j) {
+      cand[c] = bd2[j];
+      c += bd2[j] <= t ? 1 : 0;
+    }
+  }
+  if (c > want) std::nth_element(cand, cand + (want - 1), cand + c);
+  // (The nearest, the point itself at 0, adds nothing to the sum.)
+  double s = 0;
+  float top = 0.f;
+  for (std::size_t j = 0; j < want; ++j) {
+    s += std::sqrt(static_cast<double>(cand[j]));
+    top = std::max(top, cand[j]);
+  }
+  kth = top;
+  return s / static_cast<double>(want - 1);
+}
 
 // The points of a block of cells as one structure of arrays, padded to a multiple of 16 with
 // far-away points (their distances are huge and never kept).
@@ -190,10 +247,11 @@ const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
   return table[static_cast<std::size_t>(ring)];
 }
 
-// The cell edge: about (k + 1) / 3 points per occupied cell. On a surface the k + 1 nearest of a
-// point then lie within about a cell's edge, mostly inside the 3 x 3 x 3 block around its cell,
-// which holds ~80 points (cells of k + 1 points made blocks of ~210, each compared with every
-// point of the cell: 1.4 times the instructions on a voxelized Kinect frame).
+// The cell edge: about (k + 1) / 2 points per occupied cell. On a surface the k + 1 nearest of a
+// point then lie within about 0.8 of a cell's edge, inside the 3 x 3 x 3 block around its cell
+// (~120 points on a voxelized Kinect frame) for all but a few per cent of the points, which look
+// at the 5 x 5 x 5 block. (With (k + 1) / 3 points more points need the wider block; with
+// k + 1 the blocks hold ~210 points: each 5-10 % more instructions on voxelized frames.)
 double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
@@ -216,82 +274,124 @@ double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& fini
     cells.findOrInsert(detail::packKey(c[0], c[1], c[2]), inserted);
   }
   const double per_cell = static_cast<double>(finite.size()) / static_cast<double>(cells.size());
-  const double target = static_cast<double>(k + 1) / 3.0;
+  const double target = static_cast<double>(k + 1) / 2.0;
   return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
 }
 
-// The k + 1 nearest of every point by the grid g, their mean distance into mean_dist: every
-// point of a cell is compared with the points of the 27 cells around (gathered once per cell);
-// the answer is exact where the (k + 1)-th distance is within the block's margin. Where it is
-// not (the edge of the data, a lone point), the block grows ring by ring up to kMaxRing (each
-// ring looked up once per cell); the points still unsettled go to rest (their grid positions).
+// The searches of one thread, cell by cell: the points of a cell share their blocks (the cells
+// within Chebyshev distance 1, and 2 when the first does not settle a point's k nearest),
+// gathered once per cell, nearest cells first.
+class CellSearch {
+ public:
+  // A search of grid g for the want nearest (the buffers kept from the last call).
+  void start(const PointGrid& g, std::size_t want) {
+    g_ = &g, want_ = want, best_ = NearestK(want);
+    kth_ = std::numeric_limits<float>::infinity();
+  }
+
+  void startCell(std::size_t c) {
+    cx_ = g_->cells.xyz(c)[0], cy_ = g_->cells.xyz(c)[1], cz_ = g_->cells.xyz(c)[2];
+    cells_.clear();
+    built_ = -1;
+    grow(1);
+  }
+
+  // The mean distance of grid point q (of the current cell) to its k nearest, or NaN when they
+  // lie beyond 3 rings (a lone point, a tiny cloud).
+  double meanOf(std::uint32_t q) {
+    const float qx = g_->x[q], qy = g_->y[q], qz = g_->z[q];
+    for (int ring = 1; ring <= 2; ++ring) {
+      if (built_ < ring) grow(ring);
+      const BlockPoints& b = block_[ring];
+      bd2_.resize(std::max(bd2_.size(), b.x.size())), cand_.resize(bd2_.size());
+      const double m = blockMargin(*g_, qx, qy, qz, cx_, cy_, cz_, ring);
+      const auto m2 = static_cast<float>(m * m * (1 - 1e-6));
+      // The previous point's k-th distance, a little widened, mostly bounds this one's: fewer
+      // candidates to select from.
+      const float t = std::min(m2, kth_ * kTighten);
+      std::size_t within_t = 0;
+      const std::size_t within_m2 = distances2Within(b.x.data(), b.y.data(), b.z.data(),
+                                                     b.x.size(), qx, qy, qz, t, m2, bd2_.data(),
+                                                     within_t);
+      if (within_m2 >= want_) {
+        return settledMean(bd2_.data(), b.x.size(), within_t >= want_ ? t : m2, want_, cand_.data(),
+                           kth_);
+      }
+    }
+    // The third ring, cell by cell: a cell whose box lies beyond the k-th distance so far holds
+    // none of the k (bd2_ holds the distances to the block of 2 rings).
+    best_.clear();
+    for (std::size_t j = 0; j < block_[2].n; ++j) best_.offer(bd2_[j]);
+    if (built_ < 3) shell(3, ring3_), built_ = 3;
+    for (const std::uint32_t b : ring3_) {
+      if (best_.full() && g_->boxDistance2(b, qx, qy, qz) > best_.worst()) continue;
+      const std::size_t n = g_->start[b + 1] - g_->start[b];
+      d2_.resize(std::max(d2_.size(), n));
+      distances2(&g_->x[g_->start[b]], &g_->y[g_->start[b]], &g_->z[g_->start[b]], n, qx, qy, qz,
+                 d2_.data());
+      for (std::size_t j = 0; j < n; ++j) best_.offer(d2_[j]);
+    }
+    const double m = blockMargin(*g_, qx, qy, qz, cx_, cy_, cz_, 3);
+    if (best_.full() && static_cast<double>(best_.worst()) <= m * m) {
+      return best_.meanWithoutFirst();
+    }
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+
+ private:
+  // The occupied cells at Chebyshev distance ring from the current cell, nearest first, into
+  // out.
+  void shell(int ring, std::vector<std::uint32_t>& out) const {
+    out.clear();
+    for (const auto& d : shellOffsets(ring)) {
+      const std::uint32_t c = g_->find(cx_ + d[0], cy_ + d[1], cz_ + d[2]);
+      if (c != detail::kNoIndex) out.push_back(c);
+    }
+  }
+  // The block of the cells within `ring` (1 or 2) of the current cell.
+  void grow(int ring) {
+    for (int r = built_ + 1; r <= ring; ++r) {
+      shell(r, around_);
+      cells_.insert(cells_.end(), around_.begin(), around_.end());
+    }
+    block_[ring].fill(*g_, cells_);
+    built_ = ring;
+  }
+
+  static constexpr float kTighten = 1.44f;  // (1.2 times the distance)
+  const PointGrid* g_ = nullptr;
+  std::size_t want_ = 1;
+  float kth_ = std::numeric_limits<float>::infinity();  // the previous point's, squared
+  NearestK best_{1};
+  std::int32_t cx_ = 0, cy_ = 0, cz_ = 0;
+  int built_ = -1;  // the rings gathered for the current cell
+  std::vector<std::uint32_t> cells_, around_, ring3_;
+  BlockPoints block_[3];
+  std::vector<float> bd2_, cand_, d2_;
+};
+
+// The k + 1 nearest of every point by the grid g, their mean distance into mean_dist (cells
+// in dynamic shares: their cost varies); the points not settled within 3 rings go to rest
+// (their grid positions).
 void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>& mean_dist,
                        std::vector<std::uint32_t>& rest) {
-  constexpr int kMaxRing = 3;
   const std::size_t n_cells = g.start.size() - 1;
 #pragma omp parallel
   {
-    NearestK best(want);
-    std::vector<float> d2;
-    std::vector<std::uint32_t> around, ring1;  // cells of a block, of the 3 x 3 x 3 block
-    BlockPoints block;                         // the points of ring1, nearest cells first
-    std::vector<float> bd2;
+    thread_local CellSearch search;  // (its blocks' buffers kept from call to call)
+    search.start(g, want);
     std::vector<std::uint32_t> my_rest;
-    std::vector<std::uint32_t> outer[kMaxRing + 1];  // the current cell's outer rings, as needed
-    // The cells at Chebyshev distance `ring` from (cx, cy, cz), nearest first: the nearer
-    // points come first, so that NearestK rejects most later ones with one comparison. Ring 0
-    // and 1 make a cell's block (copied once per cell); the outer rings are scanned only for
-    // the few points whose k-th distance the block's margin does not settle.
-    const auto shell = [&](std::int32_t cx, std::int32_t cy, std::int32_t cz, int ring) {
-      around.clear();
-      for (const auto& d : shellOffsets(ring)) {
-        const std::uint32_t c = g.find(cx + d[0], cy + d[1], cz + d[2]);
-        if (c != detail::kNoIndex) around.push_back(c);
-      }
-    };
 #pragma omp for schedule(dynamic, 16)
     for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
       const auto c = static_cast<std::size_t>(cc);
-      const std::int32_t cx = g.cells.xyz(c)[0], cy = g.cells.xyz(c)[1], cz = g.cells.xyz(c)[2];
-      shell(cx, cy, cz, 0);
-      ring1 = around;
-      shell(cx, cy, cz, 1);
-      ring1.insert(ring1.end(), around.begin(), around.end());
-      block.fill(g, ring1);
-      bd2.resize(block.x.size());
-      int outer_done = 1;  // outer[2 .. outer_done] hold this cell's rings
+      search.startCell(c);
       for (std::uint32_t q = g.start[c]; q < g.start[c + 1]; ++q) {
-        const float qx = g.x[q], qy = g.y[q], qz = g.z[q];
-        best.clear();
-        // The 3 x 3 x 3 block: its distances in one vector pass, then the nearest kept.
-        distances2(block.x.data(), block.y.data(), block.z.data(), block.x.size(), qx, qy, qz,
-                   bd2.data());
-        for (std::size_t j = 0; j < block.n; ++j) best.offer(bd2[j]);
-        int ring = 1;
-        while (true) {
-          const double margin = blockMargin(g, qx, qy, qz, cx, cy, cz, ring);
-          if (best.full() && static_cast<double>(best.worst()) <= margin * margin) break;
-          if (++ring > kMaxRing) break;
-          if (ring > outer_done) {  // (looked up once per cell, for its first point needing it)
-            shell(cx, cy, cz, ring);
-            outer[ring].swap(around);
-            outer_done = ring;
-          }
-          for (const std::uint32_t b : outer[ring]) {
-            // A cell whose box lies beyond the k-th distance so far holds none of the k.
-            if (best.full() && g.boxDistance2(b, qx, qy, qz) > best.worst()) continue;
-            const std::size_t n = g.start[b + 1] - g.start[b];
-            d2.resize(std::max(d2.size(), n));
-            distances2(&g.x[g.start[b]], &g.y[g.start[b]], &g.z[g.start[b]], n, qx, qy, qz,
-                       d2.data());
-            for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
-          }
-        }
-        if (ring > kMaxRing) {
+        const double mean = search.meanOf(q);
+        if (std::isnan(mean)) {
           my_rest.push_back(q);
-          continue;
+        } else {
+          mean_dist[g.index[q]] = mean;
         }
-        mean_dist[g.index[q]] = best.meanWithoutFirst();
       }
     }
 #pragma omp critical(upd_outlier_rest)
@@ -341,21 +441,29 @@ void kdTreeMeanDistances(const PointCloud& in, int k, const std::vector<std::uin
 }  // namespace
 
 std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
+  std::vector<double> mean_dist;
+  meanNeighbourDistances(in, k, mean_dist);
+  return mean_dist;
+}
+
+void meanNeighbourDistances(const PointCloud& in, int k, std::vector<double>& mean_dist) {
   requireParam(k >= 1, "PreprocessParams", "outlier_k", k, "must be >= 1");
-  std::vector<double> mean_dist(in.size(), std::numeric_limits<double>::quiet_NaN());
-  std::vector<std::uint32_t> finite;
+  // The calling thread's buffers, kept from call to call (no allocation in a warm frame loop).
+  thread_local std::vector<std::uint32_t> finite, rest;
+  thread_local PointGrid g;
+  mean_dist.assign(in.size(), std::numeric_limits<double>::quiet_NaN());
+  finite.clear();
   for (std::size_t i = 0; i < in.size(); ++i) {
     if (in.isFinite(i)) finite.push_back(static_cast<std::uint32_t>(i));
   }
-  if (finite.empty()) return mean_dist;
+  if (finite.empty()) return;
   const std::size_t want = static_cast<std::size_t>(k) + 1;  // the point itself comes first
-  PointGrid g;
   // (A k beyond NearestK's capacity, or a cloud beyond the keys' range: the k-d tree alone.)
   if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k), g)) {
     kdTreeMeanDistances(in, k, finite, mean_dist);
-    return mean_dist;
+    return;
   }
-  std::vector<std::uint32_t> rest;  // grid positions of the points the rings did not settle
+  rest.clear();  // grid positions of the points the rings did not settle
   gridMeanDistances(g, want, mean_dist, rest);
   // A few left (lone points, tiny clouds): compared with every point; many: the k-d tree.
   constexpr std::size_t kMaxAllPairs = 128;
@@ -365,7 +473,6 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
     for (std::uint32_t& q : rest) q = g.index[q];
     kdTreeMeanDistances(in, k, rest, mean_dist);
   }
-  return mean_dist;
 }
 
 }  // namespace upd::core

@@ -65,11 +65,15 @@ PointCloud removeStatisticalOutliers(const PointCloud& in, int k, double std_mul
 
 /// What the outlier filter thresholds: every finite point's mean distance to its k nearest
 /// other points (NaN for a point that is not finite or has no other point). The neighbours
-/// come from a grid of cells sized for about (k + 1) / 3 points each (the cells around a
-/// point's own, ring by ring until the k-th distance is certain); the few points whose
-/// neighbours lie beyond 3 rings are compared with every point (a k-d tree answers when there
-/// are many). The exact k nearest: the k-d tree's answer up to float rounding.
+/// come from a grid of cells sized for about (k + 1) / 2 points each (the block of cells around
+/// a point's own, then the wider block, then a third ring, until the k-th distance is certain);
+/// the few points whose neighbours lie beyond 3 rings are compared with every point (a k-d tree
+/// answers when there are many). The exact k nearest: the k-d tree's answer up to float
+/// rounding.
 std::vector<double> meanNeighbourDistances(const PointCloud& in, int k);
+/// The same into mean_dist (its buffer reused; the search's buffers are the calling thread's,
+/// kept from call to call).
+void meanNeighbourDistances(const PointCloud& in, int k, std::vector<double>& mean_dist);
 
 /// The whole chain. With every step disabled the input is returned unchanged (organized, NaNs
 /// kept), so invalid points are scored as NaN and counted instead of silently dropped.
