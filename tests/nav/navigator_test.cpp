@@ -160,7 +160,9 @@ TEST_F(NavNavigatorRun, PtgCacheAppearsWholeAndIsReused) {
   std::vector<std::string> files;
   for (const auto& e : fs::directory_iterator(cache)) files.push_back(e.path().filename());
   EXPECT_FALSE(files.empty());
-  if (fewest_seen != SIZE_MAX) EXPECT_EQ(fewest_seen, files.size());
+  if (fewest_seen != SIZE_MAX) {
+    EXPECT_EQ(fewest_seen, files.size());
+  }
   for (const auto& e : fs::directory_iterator(dir_)) {
     EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
   }
