@@ -329,6 +329,10 @@ def evaluation_section(out, fig, status):
         return head + "**Missing**: `upd evaluate` wrote no `evaluation.md`.\n"
     prefix = fig + "/evaluation/"
     text = open(md_path).read()
+    # Machine-specific paths (the staging folder, the build's classifier) as the repository's.
+    text = text.replace(os.path.abspath(folder), fig + "/evaluation")
+    text = re.sub(r"/\S*/share/upd-nav/models/", "share/models/", text)
+    text = re.sub(r"upd evaluate --output \S*/evaluation`", "upd evaluate --output %s/evaluation`" % fig, text)
     # Relative links of the included file point into its folder.
     text = re.sub(r"(\]\()(?![a-z]+:|/|#)", r"\1" + prefix, text)
     pngs = sorted(p for p in os.listdir(folder) if p.endswith(".png"))
