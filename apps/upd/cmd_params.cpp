@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <iostream>
 #include <sstream>
+#include <string>
 
 namespace upd::app {
 
@@ -67,6 +68,11 @@ void printSections(std::ostream& os, bool markdown, Sections&& for_each) {
     }
     Printer p{os, markdown};
     params.visit(p);
+    if (std::string(name) == "ClassifyParams") {  // read beside the struct: a file, not a number
+      p("classifier", std::string(),
+        "the learned classifier's model file (`upd train`; relative to the config file); when "
+        "set it labels the points instead of the thresholds above (empty: the thresholds)");
+    }
   });
 }
 
