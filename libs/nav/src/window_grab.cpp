@@ -7,6 +7,7 @@
 #include <X11/Xlib.h>
 #include <X11/Xutil.h>
 
+#include <algorithm>
 #include <memory>
 #endif
 
@@ -49,15 +50,33 @@ mrpt::img::CImage grabWindow(const std::string& title) {
   if (!XGetWindowAttributes(dpy.get(), w, &attr) || attr.width <= 0 || attr.height <= 0) {
     throw std::runtime_error("the window '" + title + "' has no size");
   }
-  XImage* xi = XGetImage(dpy.get(), w, 0, 0, unsigned(attr.width), unsigned(attr.height), AllPlanes, ZPixmap);
-  if (xi == nullptr) throw std::runtime_error("the X server gave no image of the window '" + title + "'");
+  // X gives the pixels of the part of a window that is on the screen only: a window larger than
+  // the screen (a small virtual display) is grabbed clipped to it.
+  int rx = 0, ry = 0;
+  Window child = 0;
+  XTranslateCoordinates(dpy.get(), w, attr.root, 0, 0, &rx, &ry, &child);
+  XWindowAttributes root_attr;
+  XGetWindowAttributes(dpy.get(), attr.root, &root_attr);
+  const int x0 = std::max(0, -rx), y0 = std::max(0, -ry);
+  const int width = std::min(attr.width, root_attr.width - rx) - x0;
+  const int height = std::min(attr.height, root_attr.height - ry) - y0;
+  if (width <= 0 || height <= 0) {
+    throw std::runtime_error("the window '" + title + "' is outside the screen");
+  }
+  XImage* xi = XGetImage(dpy.get(), w, x0, y0, unsigned(width), unsigned(height), AllPlanes,
+                         ZPixmap);
+  if (xi == nullptr) {
+    throw std::runtime_error("the X server gave no image of the window '" + title + "'");
+  }
   const int rs = shiftOf(xi->red_mask), gs = shiftOf(xi->green_mask), bs = shiftOf(xi->blue_mask);
-  mrpt::img::CImage img(attr.width, attr.height, mrpt::img::CH_RGB);
-  for (int y = 0; y < attr.height; ++y) {
-    for (int x = 0; x < attr.width; ++x) {
+  mrpt::img::CImage img(width, height, mrpt::img::CH_RGB);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
       const unsigned long p = XGetPixel(xi, x, y);
-      img.setPixel(x, y, mrpt::img::TColor(std::uint8_t((p & xi->red_mask) >> rs), std::uint8_t((p & xi->green_mask) >> gs),
-                                           std::uint8_t((p & xi->blue_mask) >> bs)));
+      img.setPixel(x, y,
+                   mrpt::img::TColor(std::uint8_t((p & xi->red_mask) >> rs),
+                                     std::uint8_t((p & xi->green_mask) >> gs),
+                                     std::uint8_t((p & xi->blue_mask) >> bs)));
     }
   }
   XDestroyImage(xi);
