@@ -140,9 +140,6 @@ else
     run analyze "$DATA/pcl-data/samp11-utm-ground.pcd" --no-preprocess --knn 16 \
       --output "$WORK/data/hillside-ground.ply"
   fi
-  if [ -f "$DATA/rtabmap/rgbd/rgb/17.jpg" ] && grep -q '^lab|' "$WORK/frames.txt"; then
-    install -m 644 "$DATA/rtabmap/rgbd/rgb/17.jpg" "$FIG/lab-rgb.jpg"
-  fi
 fi
 
 # The labelled evaluation, when this build has `upd evaluate`.

@@ -291,8 +291,8 @@ scored points. The paper's Fig. 6 shows indoor Kinect frames: RGB, normals and z
 {ground_truth_line(work)}"""]
     for name, file, up, cfg, d, what in frames:
         imgs = []
-        for suffix, alt in [("rgb.png", "camera colour"), ("rgb.jpg", "RGB image"),
-                            ("label.png", "label"), ("zeta.png", "zeta")]:
+        for suffix, alt in [("rgb.png", "camera colour"), ("label.png", "label"),
+                            ("zeta.png", "zeta")]:
             if os.path.exists(os.path.join(fig_abs(work), name + "-" + suffix)):
                 imgs.append(image(fig, name + "-" + suffix, name + ", " + alt))
         parts.append("### %s: %s (`%s`)\n\n%s\n" % (name, what, file, "\n".join(imgs)))
