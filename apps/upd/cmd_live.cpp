@@ -11,6 +11,7 @@
 #include "live_base.h"
 #include "live_options.h"
 #include "live_source.h"
+#include "live_view.h"
 #include "live_watchdog.h"
 #include "run_config.h"
 #include "stop_signal.h"
@@ -19,7 +20,6 @@
 #include "upd/maps/grid_export.h"
 #include "upd/mrpt_bridge/observation_cloud.h"
 #include "upd/mrpt_bridge/rawlog_writer.h"
-#include "upd/nav/live_view.h"
 #include "upd/nav/nav_config.h"
 #include "upd/nav/navigation_loop.h"
 #include "upd/sim/robot.h"
@@ -37,8 +37,9 @@
 namespace upd::app {
 
 const char* const kLiveUsage =
-    "usage: upd live [SOURCE] [--config FILE.ini] [--nav-config FILE.ini] [--view]\n"
-    "                [--navigate X,Y] [--frames N] [--output DIR] [--record RUN.rawlog]\n"
+    "usage: upd live [SOURCE] [--config FILE.ini] [--nav-config FILE.ini]\n"
+    "                [--view [--screenshot F.png]] [--navigate X,Y] [--frames N]\n"
+    "                [--output DIR] [--record RUN.rawlog]\n"
     "                [--stale-timeout S] [--mount FILE.ini | --auto-mount] [--base sim|ros]\n"
     "  Reads a live source, runs the UPD and the traversability map on every frame and, with\n"
     "  --navigate, drives the robot base to the goal with MRPT's reactive navigator. The shipped\n"
@@ -55,7 +56,9 @@ const char* const kLiveUsage =
     "  --config FILE      robot config (default config/dune-kinect.ini)\n"
     "  --nav-config FILE  navigation config: camera mount, obstacles, navigator\n"
     "                     (default config/dune-nav.ini)\n"
-    "  --view             3D view: cloud coloured by zeta, the map, the robot, the route\n"
+    "  --view             3D view: cloud coloured by zeta, the map, the robot, its path and\n"
+    "                     the route (the keys of upd view; docs/VIEWER.md)\n"
+    "  --screenshot FILE.png  with --view: save what the window shows at the end of the run\n"
     "  --base sim|ros     the base driven: simulated (default) or ROS 1 (/cmd_vel out, /odom\n"
     "                     in; docs/ROS.md)\n"
     "  --navigate X,Y     goal in the map frame (the robot starts at 0,0 facing +x) [m]\n"
@@ -161,7 +164,7 @@ struct LiveRun {
              o.out && o.goal
                  ? (std::filesystem::path(*o.out) / "navigation.reactivenavlog").string()
                  : "") {
-    if (o.view) view = std::make_unique<nav::LiveView>("upd live", c.body);
+    if (o.view) view = std::make_unique<LiveView>("upd live", c.body);
     if (o.record) recorder.emplace(*o.record);
     if (o.goal) loop.navigateTo(*o.goal);
     t0 = last = last_report = now = Clock::now();  // the run starts after the set-up
@@ -178,7 +181,7 @@ struct LiveRun {
   nav::SimulatedDiffDrive base;
   std::unique_ptr<nav::RobotBase> external;  ///< a real base (--base ros), else nullptr
   nav::NavigationLoop loop;
-  std::unique_ptr<nav::LiveView> view;
+  std::unique_ptr<LiveView> view;
   std::optional<mrpt_bridge::RawlogWriter> recorder;
   mrpt_bridge::ObservationCloud converted;  ///< reused frame to frame
   Clock::time_point t0, last, last_report, now;
@@ -240,7 +243,7 @@ std::optional<std::string> afterFrame(LiveRun& run, const nav::FrameEvidence& ev
   }
   if (run.view) {
     if (!run.view->isOpen()) return "window closed";
-    run.view->update(ev, run.loop.grid(), s.pose_world_robot,
+    run.view->show(ev, run.loop.grid(), s.pose_world_robot,
                      run.opt.goal ? &run.loop.route() : nullptr);
   }
   return std::nullopt;
@@ -342,6 +345,10 @@ int runSource(const LiveOptions& o, nav::NavConfig config, const RunConfig& run_
   if (run.recorder) {
     t.recorded = run.recorder->written();
     run.recorder->finish();
+  }
+  if (run.view && o.screenshot && run.view->isOpen()) {
+    run.view->saveScreenshot(*o.screenshot);
+    std::printf("  screenshot %s\n", o.screenshot->c_str());
   }
   t.seconds = run.secondsSinceStart();
   t.frames = run.frames;

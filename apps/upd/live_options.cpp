@@ -56,7 +56,7 @@ LiveOptions parseLiveOptions(const std::vector<std::string>& argv_in) {
   const Args args(argv,
                   {"--config", "--nav-config", "--oni", "--sensors", "--sensor-section",
                    "--navigate", "--frames", "--output", "--record", "--stale-timeout",
-                   "--mount", "--base"},
+                   "--mount", "--base", "--screenshot"},
                   {"--view", "--auto-mount"});
   if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
   o.config_path = args.str("--config").value_or(nav::defaultConfigDir() + "/dune-kinect.ini");
@@ -76,6 +76,8 @@ LiveOptions parseLiveOptions(const std::vector<std::string>& argv_in) {
                      ": must be > 0 [s]");
   }
   o.view = args.flag("--view");
+  o.screenshot = args.str("--screenshot");
+  if (o.screenshot && !o.view) throw UsageError("option --screenshot needs --view");
   o.mount = args.str("--mount");
   o.auto_mount = args.flag("--auto-mount");
   if (o.mount && o.auto_mount) throw UsageError("choose one of --mount and --auto-mount");

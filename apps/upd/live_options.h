@@ -24,6 +24,7 @@ struct LiveOptions {
   /// The source counts as stopped when no new frame (a new device stamp) came for this long [s].
   double stale_timeout_s = 1.0;
   bool view = false;
+  std::optional<std::string> screenshot;  ///< with view: the last view to this PNG
   std::optional<std::string> mount;  ///< --mount FILE.ini: [CameraMountParams] over the nav config's
   bool auto_mount = false;           ///< measure the mount from the floor in the first frames
   std::string base = "sim";  ///< the base driven: sim or ros (live_base.h)

@@ -6,7 +6,9 @@
 #include "upd/mrpt_bridge/rawlog_reader.h"
 #include "upd/sim/render.h"
 
+#include "apps/image_colours.h"
 #include "apps/run_upd.h"
+#include "apps/xvfb_server.h"
 #include "temp_dir.h"
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -180,4 +182,36 @@ TEST(Kinect, AutoMountMeasuresTheFloorAndMapsItTraversable) {
   const double known = j.at("map_known_cells").get<double>();
   EXPECT_GT(known, 100) << j.dump();
   EXPECT_LE(j.at("map_non_traversable_cells").get<double>(), 0.02 * known) << j.dump();
+}
+
+// `upd live --view` on the Kinect route in a virtual X server: the window of `upd view` follows
+// the robot over the floor it maps (green: planes), the robot's box is drawn (orange), the
+// screenshot of the last view is written, and the run ends with status 0 (no crash when the
+// window's thread meets the process's exit).
+TEST(Kinect, LiveViewShowsTheMappedFloorAndTheRobot) {
+  if (!fs::exists(kFakenect)) GTEST_SKIP() << kFakenect << " not installed (libfreenect-bin)";
+  const upd::test::XvfbServer x;
+  if (!x.available()) GTEST_SKIP() << "Xvfb is not installed: the live view is not tested";
+  const upd::test::TempDir dir;
+  const fs::path rec = dir.path() / "rec";
+  fs::create_directories(rec);
+  for (int i = 0; i < 6; ++i) fn::writeFakenectDepth(rec.string(), floorFrame(i), 0.01 * i, 1000 + 33 * i);
+  const std::string png = dir.file("live.png");
+  const auto r = upd::test::runCommand("DISPLAY=" + x.display() + " FAKENECT_PATH=" + rec.string() +
+                                       " LD_PRELOAD=" + kFakenect + " " + UPD_BINARY +
+                                       " live --kinect --nav-config " + navConfig(dir) +
+                                       " --view --screenshot " + png);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const mrpt::img::CImage img = upd::test::loadPng(png);
+  ASSERT_EQ(img.getWidth(), 1280u);
+  const upd::test::Counts c = upd::test::countColours(img, 1280 - 170, 40);
+  EXPECT_GT(c.green, 20000u) << "the floor: planes (zeta 1) and traversable cells";
+  EXPECT_GT(c.orange, 100u) << "the robot";
+  EXPECT_LT(c.red, c.green / 20) << "a flat floor holds no obstacle";
+}
+
+TEST(Kinect, LiveScreenshotNeedsTheView) {
+  const auto r = upd::test::runUpd("live --kinect --screenshot x.png");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--screenshot needs --view"), std::string::npos) << r.output;
 }

@@ -161,20 +161,28 @@ mrpt::opengl::CRenderizable::Ptr octreeVoxels(const MapSnapshot& m, FigureColor 
   return vox;
 }
 
+// A polyline through points, lifted by dz [m] above them.
+mrpt::opengl::CSetOfLines::Ptr polyline(const std::vector<Eigen::Vector3f>& points, mrpt::img::TColor colour,
+                                        float width, float dz) {
+  auto lines = mrpt::opengl::CSetOfLines::Create();
+  lines->setColor_u8(colour);
+  lines->setLineWidth(width);
+  for (std::size_t k = 1; k < points.size(); ++k) {
+    const auto& a = points[k - 1];
+    const auto& b = points[k];
+    lines->appendLine(a.x(), a.y(), a.z() + dz, b.x(), b.y(), b.z() + dz);
+  }
+  return lines;
+}
+
 void addPathAndRobot(const MapSnapshot& m, mrpt::opengl::CSetOfObjects& set) {
   if (m.path.empty()) return;
-  auto lines = mrpt::opengl::CSetOfLines::Create();
-  lines->setColor_u8(mrpt::img::TColor(20, 20, 20));
-  lines->setLineWidth(3.0f);
-  for (std::size_t k = 1; k < m.path.size(); ++k) {
-    const auto& a = m.path[k - 1];
-    const auto& b = m.path[k];
-    lines->appendLine(a.x(), a.y(), a.z() + 0.08, b.x(), b.y(), b.z() + 0.08);
-  }
-  set.insert(lines);
+  set.insert(polyline(m.path, mrpt::img::TColor(20, 20, 20), 3.0f, 0.08f));
+  if (m.route.size() > 1) set.insert(polyline(m.route, mrpt::img::TColor(40, 90, 230), 2.0f, 0.06f));
   const Eigen::Vector3f end = m.path.back();
-  float yaw = 0;
-  for (std::size_t k = m.path.size(); k-- > 1;) {  // heading of the last segment of some length
+  float yaw = std::isfinite(m.robot_yaw_rad) ? m.robot_yaw_rad : 0.f;
+  // Without a heading: that of the last segment of some length.
+  for (std::size_t k = m.path.size(); !std::isfinite(m.robot_yaw_rad) && k-- > 1;) {
     const Eigen::Vector3f d = end - m.path[k - 1];
     if (d.head<2>().norm() > 0.05f) {
       yaw = std::atan2(d.y(), d.x());

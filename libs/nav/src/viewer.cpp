@@ -5,7 +5,6 @@
 #include "figure_scene.h"
 #include "map_scene.h"
 #include "window_grab.h"
-#include "upd/nav/live_view.h"
 
 #include <mrpt/core/format.h>
 #include <mrpt/gui/CDisplayWindow3D.h>
@@ -25,6 +24,14 @@
 #include <vector>
 
 namespace upd::nav {
+
+bool displayAvailable() {
+  for (const char* var : {"DISPLAY", "WAYLAND_DISPLAY"}) {
+    const char* v = std::getenv(var);
+    if (v != nullptr && *v != '\0') return true;
+  }
+  return false;
+}
 
 ScoredCloud scoredCloudOf(const core::ScoredFrame& frame) {
   ScoredCloud c;

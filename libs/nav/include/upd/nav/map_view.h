@@ -46,7 +46,10 @@ struct MapSnapshot {
   std::vector<MapCellView> cells;             ///< nx * ny, index cy * nx + cx, cy from y min
   std::vector<MapVoxelView> voxels;
   std::vector<Eigen::Vector3f> path;          ///< the robot's positions [m, world]
+  std::vector<Eigen::Vector3f> route;         ///< the planned route ahead, when any [m, world]
   float robot_length_m = 0.7f, robot_width_m = 0.45f;
+  /// The robot's heading [rad]; NaN: that of the path's last segment.
+  float robot_yaw_rad = std::numeric_limits<float>::quiet_NaN();
 
   bool hasGrid() const { return nx > 0 && ny > 0; }
   /// The extent of the known cells, voxels and path; false when there is none.

@@ -21,6 +21,9 @@
 
 namespace upd::nav {
 
+/// True when a window can be opened ($DISPLAY or $WAYLAND_DISPLAY is set).
+bool displayAvailable();
+
 /// The valid points of a scored frame (world frame) as the viewer and the figures draw them.
 ScoredCloud scoredCloudOf(const core::ScoredFrame& frame);
 
