@@ -314,6 +314,12 @@ def fig_abs(_work):
 
 # ---------------------------------------------------------------------------- evaluation
 
+def repository_paths(text, folder, fig):
+    text = text.replace(os.path.abspath(folder), fig + "/evaluation")
+    text = re.sub(r"/\S*/share/upd-nav/models/", "share/models/", text)
+    return re.sub(r"upd evaluate --output \S*/evaluation([`\"])", r"upd evaluate --output %s/evaluation\1" % fig, text)
+
+
 def evaluation_section(out, fig, status):
     head = "## Labelled evaluation\n\n"
     if status == "absent":
@@ -328,11 +334,15 @@ def evaluation_section(out, fig, status):
     if not os.path.exists(md_path):
         return head + "**Missing**: `upd evaluate` wrote no `evaluation.md`.\n"
     prefix = fig + "/evaluation/"
+    # Machine-specific paths (the staging folder, the build's classifier) as the repository's,
+    # in the files kept beside the report as in the text included in it.
+    for name in ("evaluation.md", "evaluation.json"):
+        path = os.path.join(folder, name)
+        if os.path.exists(path):
+            kept = repository_paths(open(path).read(), folder, fig)
+            with open(path, "w") as f:
+                f.write(kept)
     text = open(md_path).read()
-    # Machine-specific paths (the staging folder, the build's classifier) as the repository's.
-    text = text.replace(os.path.abspath(folder), fig + "/evaluation")
-    text = re.sub(r"/\S*/share/upd-nav/models/", "share/models/", text)
-    text = re.sub(r"upd evaluate --output \S*/evaluation`", "upd evaluate --output %s/evaluation`" % fig, text)
     # Relative links of the included file point into its folder.
     text = re.sub(r"(\]\()(?![a-z]+:|/|#)", r"\1" + prefix, text)
     pngs = sorted(p for p in os.listdir(folder) if p.endswith(".png"))
