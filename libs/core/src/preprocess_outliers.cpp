@@ -311,7 +311,7 @@ class CellSearch {
     built_ = ring;
   }
 
-  static constexpr float kTighten = 1.44f;  // (1.2 times the distance)
+  static constexpr float kTighten = 1.3f;  // (1.14 times the distance)
   const PointGrid* g_ = nullptr;
   std::size_t want_ = 1;
   float kth_ = std::numeric_limits<float>::infinity();  // the previous point's, squared
@@ -324,10 +324,10 @@ class CellSearch {
 };
 
 // The cells [c0, c1) of grid g by search: each point's mean distance into mean_dist, the
-// points not settled within 3 rings to rest. (A function of its own: the caller's search is a
-// thread_local, whose address GCC computes again, by a call into the dynamic linker, at each
-// use in the function that names it.)
-__attribute__((noinline)) void searchCells(CellSearch& search, const PointGrid& g,
+// points not settled within 3 rings to rest. (A function of its own, kept from inlining and
+// from specializing on its argument: the caller's search is a thread_local, whose address GCC
+// computes again, by a call into the dynamic linker, at each use in a function that names it.)
+__attribute__((noipa)) void searchCells(CellSearch& search, const PointGrid& g,
                                            std::size_t c0, std::size_t c1,
                                            std::vector<double>& mean_dist,
                                            std::vector<std::uint32_t>& rest) {
@@ -417,7 +417,7 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
 namespace {
 // meanNeighbourDistances with the calling thread's buffers (a function of its own: see
 // searchCells).
-__attribute__((noinline)) void meanNeighbourDistances(const PointCloud& in, int k,
+__attribute__((noipa)) void meanNeighbourDistances(const PointCloud& in, int k,
                                                       std::vector<double>& mean_dist,
                                                       std::vector<std::uint32_t>& finite,
                                                       std::vector<std::uint32_t>& rest,
