@@ -44,12 +44,11 @@ std::size_t voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* t
                      PointCloud& out);
 
 /// The outlier filter's candidates: the squared distances from (qx, qy, qz) to the n points
-/// (x, y, z)[j] (n a multiple of 8) that lie within t, in point order, into cand (room for n);
-/// the number of the points within m2 into within_m2. Returns the number within t. On AVX2 a
-/// vector of distances at a time, its lanes within t packed to the front (no branch per point).
+/// (x, y, z)[j] (n a multiple of 8) that lie within t, in point order, into cand (room for n).
+/// Returns their number. On AVX2 a vector of distances at a time, its lanes within t packed to
+/// the front (no branch per point).
 std::size_t gatherWithin(const float* x, const float* y, const float* z, std::size_t n, float qx,
-                         float qy, float qz, float t, float m2, float* cand,
-                         std::size_t& within_m2);
+                         float qy, float qz, float t, float* cand);
 
 /// The mean distance of a point to its k = want - 1 nearest others from the c >= want squared
 /// distances cand[0, c) to the points within a bound (the point itself among them, at 0; the
@@ -60,8 +59,7 @@ double selectMean(float* cand, std::size_t c, std::size_t want, float& kth);
 
 /// The plain versions of the two, whatever the CPU (the tests compare them).
 std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, std::size_t n,
-                              float qx, float qy, float qz, float t, float m2, float* cand,
-                              std::size_t& within_m2);
+                              float qx, float qy, float qz, float t, float* cand);
 double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth);
 
 /// Keeps the points of c where keep[i], in order, in place (an unorganized cloud).

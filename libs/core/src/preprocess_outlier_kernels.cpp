@@ -18,22 +18,18 @@ namespace upd::core::detail {
 namespace {
 
 using GatherWithinFn = std::size_t (*)(const float*, const float*, const float*, std::size_t,
-                                       float, float, float, float, float, float*, std::size_t&);
+                                       float, float, float, float, float*);
 
 std::size_t gatherWithinScalar(const float* __restrict x, const float* __restrict y,
                                const float* __restrict z, std::size_t n, float qx, float qy,
-                               float qz, float t, float m2, float* __restrict cand,
-                               std::size_t& within_m2) {
+                               float qz, float t, float* __restrict cand) {
   std::size_t c = 0;
-  std::uint32_t in_m2 = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
     const float d2 = dx * dx + dy * dy + dz * dz;
     cand[c] = d2;
     c += d2 <= t ? 1 : 0;
-    in_m2 += d2 <= m2 ? 1u : 0u;
   }
-  within_m2 = in_m2;
   return c;
 }
 
@@ -55,25 +51,21 @@ constexpr std::array<std::uint64_t, 256> kCompressIndex = [] {
 
 __attribute__((target("avx2,fma,popcnt"))) std::size_t gatherWithinAvx2(
     const float* __restrict x, const float* __restrict y, const float* __restrict z,
-    std::size_t n, float qx, float qy, float qz, float t, float m2, float* __restrict cand,
-    std::size_t& within_m2) {
+    std::size_t n, float qx, float qy, float qz, float t, float* __restrict cand) {
   const __m256 vx = _mm256_set1_ps(qx), vy = _mm256_set1_ps(qy), vz = _mm256_set1_ps(qz);
-  const __m256 vt = _mm256_set1_ps(t), vm2 = _mm256_set1_ps(m2);
-  std::size_t c = 0, in_m2 = 0;
+  const __m256 vt = _mm256_set1_ps(t);
+  std::size_t c = 0;
   for (std::size_t j = 0; j < n; j += 8) {
     const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(x + j), vx);
     const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(y + j), vy);
     const __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(z + j), vz);
     const __m256 d2 = _mm256_fmadd_ps(dz, dz, _mm256_fmadd_ps(dy, dy, _mm256_mul_ps(dx, dx)));
     const auto mt = static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(d2, vt, _CMP_LE_OQ)));
-    const auto mm = static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(d2, vm2, _CMP_LE_OQ)));
     const __m256i idx = _mm256_cvtepu8_epi32(
         _mm_cvtsi64_si128(static_cast<long long>(kCompressIndex[mt])));
     _mm256_storeu_ps(cand + c, _mm256_permutevar8x32_ps(d2, idx));
     c += static_cast<std::size_t>(__builtin_popcount(mt));
-    in_m2 += static_cast<std::size_t>(__builtin_popcount(mm));
   }
-  within_m2 = in_m2;
   return c;
 }
 
@@ -169,9 +161,8 @@ const SelectMeanFn pickedSelectMean = pickSelectMean();
 }  // namespace
 
 std::size_t gatherWithin(const float* x, const float* y, const float* z, std::size_t n, float qx,
-                         float qy, float qz, float t, float m2, float* cand,
-                         std::size_t& within_m2) {
-  return pickedGatherWithin(x, y, z, n, qx, qy, qz, t, m2, cand, within_m2);
+                         float qy, float qz, float t, float* cand) {
+  return pickedGatherWithin(x, y, z, n, qx, qy, qz, t, cand);
 }
 
 double selectMean(float* cand, std::size_t c, std::size_t want, float& kth) {
@@ -179,9 +170,8 @@ double selectMean(float* cand, std::size_t c, std::size_t want, float& kth) {
 }
 
 std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, std::size_t n,
-                              float qx, float qy, float qz, float t, float m2, float* cand,
-                              std::size_t& within_m2) {
-  return gatherWithinScalar(x, y, z, n, qx, qy, qz, t, m2, cand, within_m2);
+                              float qx, float qy, float qz, float t, float* cand) {
+  return gatherWithinScalar(x, y, z, n, qx, qy, qz, t, cand);
 }
 
 double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth) {

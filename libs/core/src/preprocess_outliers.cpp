@@ -254,18 +254,15 @@ class CellSearch {
       const double m = blockMargin(*g_, qx, qy, qz, cx_, cy_, cz_, ring);
       const auto m2 = static_cast<float>(m * m * (1 - 1e-6));
       // The previous point's k-th distance, a little widened, mostly bounds this one's: fewer
-      // candidates to select from.
+      // candidates to select from. Where it does not, the block's margin.
       const float t = std::min(m2, kth_ * kTighten);
-      std::size_t within_m2 = 0;
-      const std::size_t within_t = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.x.size(),
-                                                qx, qy, qz, t, m2, cand_.data(), within_m2);
-      if (within_t >= want_) return detail::selectMean(cand_.data(), within_t, want_, kth_);
-      if (within_m2 >= want_) {
-        std::size_t again = 0;
-        const std::size_t c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.x.size(), qx,
-                                           qy, qz, m2, m2, cand_.data(), again);
-        return detail::selectMean(cand_.data(), c, want_, kth_);
+      std::size_t c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.x.size(), qx, qy,
+                                           qz, t, cand_.data());
+      if (c < want_ && t < m2) {
+        c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.x.size(), qx, qy, qz, m2,
+                                 cand_.data());
       }
+      if (c >= want_) return detail::selectMean(cand_.data(), c, want_, kth_);
     }
     // The third ring, cell by cell: a cell whose box lies beyond the k-th distance so far holds
     // none of the k.
