@@ -158,24 +158,41 @@ class VoxelPass {
     if (!keys) keys = s_.keys.data();
     if (!voxelKeys(&in_.x[b], &in_.y[b], &in_.z[b], n, k_, keys)) throwSpan(voxel_m_);
     const bool colour = in_.hasColor();
-    for (std::size_t col = 0; col < n; ++col) {
+    const float *x = &in_.x[b], *y = &in_.y[b], *z = &in_.z[b];
+    const std::uint8_t* rgb[3] = {colour ? &in_.r[b] : nullptr, colour ? &in_.g[b] : nullptr,
+                                  colour ? &in_.b[b] : nullptr};
+    std::size_t col = 0;
+    while (col < n) {
       const std::uint64_t key = keys[col];
-      if (key == kNoKey) continue;
-      const std::size_t i = b + col;
-      ++passed_;
-      const double dx = static_cast<double>(in_.x[i]) - ref_.x(),
-                   dy = static_cast<double>(in_.y[i]) - ref_.y(),
-                   dz = static_cast<double>(in_.z[i]) - ref_.z();
+      if (key == kNoKey) {
+        ++col;
+        continue;
+      }
       if (key != last_key_) {
         // The pixel on the left (last_key_) or above mostly shares the voxel: no lookup.
         last_id_ = above_keys && above_keys[col] == key ? above_ids[col] : lookUp(key);
         last_key_ = key;
       }
-      if (ids) ids[col] = last_id_;
+      // A run of points in this voxel, its sums in registers from the voxel's and back: the
+      // same additions in the same order as into the voxel point by point. (The colours are
+      // integers, their sums exact in any order.)
       VoxelSums& a = s_.voxels[last_id_];
-      a.sx += dx, a.sy += dy, a.sz += dz;
-      ++a.n;
-      if (colour) a.r += in_.r[i], a.g += in_.g[i], a.b += in_.b[i];
+      double sx = a.sx, sy = a.sy, sz = a.sz;
+      std::uint32_t sr = 0, sg = 0, sb = 0;
+      std::size_t j = col;
+      for (; j < n && keys[j] == key; ++j) {
+        sx += static_cast<double>(x[j]) - ref_.x();
+        sy += static_cast<double>(y[j]) - ref_.y();
+        sz += static_cast<double>(z[j]) - ref_.z();
+        if (ids) ids[j] = last_id_;
+        if (colour) sr += rgb[0][j], sg += rgb[1][j], sb += rgb[2][j];
+      }
+      const auto run = static_cast<std::uint32_t>(j - col);
+      a.sx = sx, a.sy = sy, a.sz = sz;
+      a.n += run;
+      if (colour) a.r += sr, a.g += sg, a.b += sb;
+      passed_ += run;
+      col = j;
     }
   }
   std::size_t passed() const { return passed_; }
