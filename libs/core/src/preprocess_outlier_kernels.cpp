@@ -71,7 +71,10 @@ __attribute__((target("avx2,fma,popcnt"))) std::size_t gatherWithinAvx2(
 
 GatherWithinFn pickGatherWithin() {
   __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return gatherWithinAvx2;
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+      __builtin_cpu_supports("popcnt")) {
+    return gatherWithinAvx2;
+  }
   return gatherWithinScalar;
 }
 #else
@@ -150,7 +153,11 @@ __attribute__((target("avx2,popcnt,bmi"))) double selectMeanAvx2(float* cand, st
 
 SelectMeanFn pickSelectMean() {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? selectMeanAvx2 : selectMeanScalar;
+  // (The instructions its target names: AVX2, POPCNT and BMI's TZCNT.)
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt") &&
+                 __builtin_cpu_supports("bmi")
+             ? selectMeanAvx2
+             : selectMeanScalar;
 }
 #else
 SelectMeanFn pickSelectMean() { return selectMeanScalar; }

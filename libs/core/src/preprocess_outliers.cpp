@@ -142,7 +142,7 @@ struct BlockPoints {
     n = 0;
     for (const std::uint32_t c : cells) n += g.start[c + 1] - g.start[c];
     const std::size_t cap = (n + 15) / 16 * 16;
-    x.assign(cap, 1e18f), y.assign(cap, 1e18f), z.assign(cap, 1e18f);
+    x.resize(cap), y.resize(cap), z.resize(cap);
     std::size_t j = 0;
     for (const std::uint32_t c : cells) {
       const std::uint32_t b = g.start[c], e = g.start[c + 1];
@@ -151,6 +151,7 @@ struct BlockPoints {
       std::copy(&g.z[b], &g.z[b] + (e - b), &z[j]);
       j += e - b;
     }
+    for (; j < cap; ++j) x[j] = y[j] = z[j] = 1e18f;  // (the padding: every point written once)
   }
 };
 
