@@ -7,7 +7,8 @@
 # threads spin a while before they sleep), as `upd` runs on a robot's computer. The frame
 # timings are then run again with OMP_WAIT_POLICY=passive (threads sleep at once: the setting
 # for a machine shared with other jobs) into out/bench-passive.json, since the second core's
-# gain depends on it.
+# gain depends on it. Last, `upd playback` of the demo run with the paper's config against the
+# realtime one (scripts/bench-playback.sh, out/bench-playback.json).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 mkdir -p "$UPD_ROOT/out"
@@ -17,3 +18,6 @@ echo
 echo "The frame pipeline again with OMP_WAIT_POLICY=passive:"
 OMP_WAIT_POLICY=passive "$UPD_BUILD/bench/upd_bench" --data "$UPD_ROOT/../shared/data" \
   --frames-only --json "$UPD_ROOT/out/bench-passive.json"
+echo
+echo "upd playback of the demo run, config/dune-kinect.ini against config/dune-kinect-realtime.ini:"
+"$UPD_ROOT/scripts/bench-playback.sh"

@@ -137,11 +137,12 @@ using detail::kScanLanes;
 using detail::Moments;
 
 // The finite points binned into cells of edge radius_m (the neighbours of a point lie in the 27
-// cells around its own), grouped by cell and kept relative to the first finite point.
+// cells around its own), grouped by cell and kept relative to the first finite point, as
+// coordinate arrays.
 struct RadiusGrid {
   detail::CellGrid grid;
-  detail::CellLists points;            // cloud indices by cell
-  std::vector<Eigen::Vector3f> local;  // by cell: relative to the first finite point
+  detail::CellLists points;   // cloud indices by cell
+  std::vector<float> x, y, z;  // by cell: relative to the first finite point
 };
 
 void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, RadiusGrid& g) {
@@ -163,34 +164,43 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   }
   detail::listByCell(
       N, g.grid.size(), [&](std::size_t i) { return cell_of[i]; }, g.points);
-  g.local.resize(g.points.order.size());
-  for (std::size_t s = 0; s < g.local.size(); ++s) {
-    g.local[s] = (cloud.point(g.points.order[s]).cast<double>() - ref).cast<float>();
+  const std::size_t n = g.points.order.size();
+  g.x.resize(n), g.y.resize(n), g.z.resize(n);
+  for (std::size_t s = 0; s < n; ++s) {
+    const Eigen::Vector3f q =
+        (cloud.point(g.points.order[s]).cast<double>() - ref).cast<float>();
+    g.x[s] = q.x(), g.y[s] = q.y(), g.z[s] = q.z();
   }
 }
 
 // The candidates of the points of cell c (the points of the 27 cells around it), as coordinate
-// rows for gatedMoments, padded with kFar; returns their number.
+// rows for gatedMoments, padded with kFar; returns their number. The rows are resized, never
+// shrunk (no allocation once they have the room).
 std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<float>& cx,
                             std::vector<float>& cy, std::vector<float>& cz) {
   std::array<std::uint32_t, 27> around{};
   int n_around = 0;
+  std::size_t total = 0;
   const std::int32_t* xyz = g.grid.xyz(c);
+  const std::vector<std::uint32_t>& start = g.points.start;
   for (int d = 0; d < 27; ++d) {
     const std::uint32_t id =
         g.grid.find(xyz[0] + d % 3 - 1, xyz[1] + (d / 3) % 3 - 1, xyz[2] + d / 9 - 1);
-    if (id != kNoIndex) around[n_around++] = id;
+    if (id == kNoIndex) continue;
+    around[n_around++] = id;
+    total += start[id + 1] - start[id];
   }
-  cx.clear(), cy.clear(), cz.clear();
-  const std::vector<std::uint32_t>& start = g.points.start;
+  if (cx.size() < total + kScanLanes) {
+    cx.resize(total + kScanLanes), cy.resize(total + kScanLanes), cz.resize(total + kScanLanes);
+  }
+  float *ox = cx.data(), *oy = cy.data(), *oz = cz.data();
+  std::size_t m = 0;
   for (int a = 0; a < n_around; ++a) {
-    for (std::uint32_t t = start[around[a]]; t < start[around[a] + 1]; ++t) {
-      cx.push_back(g.local[t].x()), cy.push_back(g.local[t].y()), cz.push_back(g.local[t].z());
-    }
+    const std::uint32_t b = start[around[a]], e = start[around[a] + 1];
+    for (std::uint32_t t = b; t < e; ++t, ++m) ox[m] = g.x[t], oy[m] = g.y[t], oz[m] = g.z[t];
   }
-  const auto n_candidates = static_cast<std::ptrdiff_t>(cx.size());
-  cx.resize(cx.size() + kScanLanes, kFar), cy.resize(cx.size(), kFar), cz.resize(cx.size(), kFar);
-  return n_candidates;
+  for (int l = 0; l < kScanLanes; ++l) ox[m + l] = oy[m + l] = oz[m + l] = kFar;
+  return static_cast<std::ptrdiff_t>(total);
 }
 
 // Moments relative to p of the candidates [0, n) within sqrt(radius2), weighted by a Gaussian
@@ -234,7 +244,7 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
   const bool gaussian = params.weighting == NormalWeighting::Gaussian;
   const float sigma = 0.5f * static_cast<float>(params.radius_m);
   const float inv_2s2 = 1.f / (2.f * sigma * sigma);
-  std::size_t invalid = N - g.local.size();
+  std::size_t invalid = N - g.x.size();
   const NormalOrienter orient(cloud.sensor_origin, up, params.vertical_band_rad);
   const auto n_cells = static_cast<std::ptrdiff_t>(g.grid.size());
 #pragma omp parallel reduction(+ : invalid)
@@ -244,13 +254,15 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
     for (std::ptrdiff_t cc = 0; cc < n_cells; ++cc) {
       const auto c = static_cast<std::size_t>(cc);
       const std::ptrdiff_t n_candidates = gatherAround(g, c, cx, cy, cz);
+      // (The rows' length for gatedMoments: the candidates and one vector of padding.)
+      const auto n_rows = static_cast<std::size_t>(n_candidates) + kScanLanes;
       for (std::uint32_t s = g.points.start[c]; s < g.points.start[c + 1]; ++s) {
-        const Eigen::Vector3f p = g.local[s];
+        const Eigen::Vector3f p(g.x[s], g.y[s], g.z[s]);
         // Moments of the neighbours relative to p (eq. 4), weighted when Gaussian.
         std::size_t count = 0;
         const Moments m =
             gaussian ? gaussianMoments(cx, cy, cz, n_candidates, p, radius2, inv_2s2, count)
-                     : detail::gatedMoments(cx.data(), cy.data(), cz.data(), cx.size(), 0, 0, 0,
+                     : detail::gatedMoments(cx.data(), cy.data(), cz.data(), n_rows, 0, 0, 0,
                                             n_candidates - 1, 1, p.x(), p.y(), p.z(), radius2);
         if (!gaussian) count = static_cast<std::size_t>(m.n);
         Eigen::Vector3f n;

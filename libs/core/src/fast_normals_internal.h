@@ -43,6 +43,9 @@ bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature);
 // clones: the dispatcher GCC emits for a target_clones function must live beside its clones.
 typedef float LaneF __attribute__((vector_size(kScanLanes * sizeof(float))));
 
+typedef float LaneQ __attribute__((vector_size(4 * sizeof(float))));
+typedef std::int32_t LaneQi __attribute__((vector_size(4 * sizeof(std::int32_t))));
+
 inline void loadLanes(LaneF& v, const float* p) { std::memcpy(&v, p, sizeof v); }
 
 // Moments, relative to p, of the points within sqrt(radius2) of p among rows [v0, v1] (every
@@ -73,10 +76,16 @@ static Moments gatedMoments(const float* X, const float* Y, const float* Z, std:
           szz += cz * qz;
     }
   }
+  // The sum of the lanes, (v0 + v4 + v1 + v5) + (v2 + v6 + v3 + v7) in that grouping, by vector
+  // adds and one shuffle (a loop over the lanes compiled to a scalar add per lane).
   const auto total = [](const LaneF& v) {
-    float s[4] = {0, 0, 0, 0};
-    for (int l = 0; l < kScanLanes; ++l) s[l % 4] += v[l];
-    return static_cast<double>((s[0] + s[1]) + (s[2] + s[3]));
+    static_assert(kScanLanes == 8, "the reduction adds two halves of 4 lanes");
+    LaneQ lo, hi;
+    std::memcpy(&lo, &v, sizeof lo);
+    std::memcpy(&hi, reinterpret_cast<const char*>(&v) + sizeof lo, sizeof hi);
+    const LaneQ s = lo + hi;  // s_l = v_l + v_(l+4)
+    const LaneQ p = s + __builtin_shuffle(s, LaneQi{1, 0, 3, 2});  // s0 + s1, ., s2 + s3, .
+    return static_cast<double>(p[0] + p[2]);
   };
   Moments m;
   m.n = total(n), m.x = total(sx), m.y = total(sy), m.z = total(sz);

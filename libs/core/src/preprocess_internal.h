@@ -21,6 +21,7 @@ class RangeBoxTest {
         rmin2_(p.range_min_m * p.range_min_m),
         rmax2_(p.range_max_m * p.range_max_m) {}
   bool enabled() const { return p_.range_enabled || p_.box_enabled; }
+  const PreprocessParams& params() const { return p_; }
   bool keeps(const Eigen::Vector3f& q) const {
     if (p_.range_enabled) {
       const double d2 = (q - origin_).cast<double>().squaredNorm();
@@ -41,6 +42,25 @@ class RangeBoxTest {
 /// appearance, colour averaged. Returns the number of points that passed.
 std::size_t voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* test,
                      PointCloud& out);
+
+/// The outlier filter's candidates: the squared distances from (qx, qy, qz) to the n points
+/// (x, y, z)[j] (n a multiple of 8) that lie within t, in point order, into cand (room for n).
+/// Returns their number. On AVX2 a vector of distances at a time, its lanes within t packed to
+/// the front (no branch per point).
+std::size_t gatherWithin(const float* x, const float* y, const float* z, std::size_t n, float qx,
+                         float qy, float qz, float t, float* cand);
+
+/// The mean distance of a point to its k = want - 1 nearest others from the c >= want squared
+/// distances cand[0, c) to the points within a bound (the point itself among them, at 0; the
+/// caller knows that no other point is nearer than the want-th); the want-th (squared) into kth.
+/// cand has room for c rounded up to a multiple of 8 and is reordered. On AVX2, where c - want
+/// is small, the c - want largest are dropped one at a time; otherwise a partial selection.
+double selectMean(float* cand, std::size_t c, std::size_t want, float& kth);
+
+/// The plain versions of the two, whatever the CPU (the tests compare them).
+std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, std::size_t n,
+                              float qx, float qy, float qz, float t, float* cand);
+double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth);
 
 /// Keeps the points of c where keep[i], in order, in place (an unorganized cloud).
 void compactInPlace(PointCloud& c, const std::vector<char>& keep);

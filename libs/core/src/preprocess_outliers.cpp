@@ -13,6 +13,8 @@
 #include "upd/core/kdtree.h"
 #include "upd/core/preprocess.h"
 
+#include "preprocess_internal.h"
+
 namespace upd::core {
 
 namespace {
@@ -95,25 +97,6 @@ void distances2(const float* __restrict x, const float* __restrict y, const floa
   }
 }
 
-// The same, counting those within t (into within_t) and within m2 (returned): counts that
-// vectorize with the distances.
-UPD_VECTOR_CLONES
-std::size_t distances2Within(const float* __restrict x, const float* __restrict y,
-                             const float* __restrict z, std::size_t n, float qx, float qy,
-                             float qz, float t, float m2, float* __restrict out,
-                             std::size_t& within_t) {
-  std::uint32_t in_t = 0, in_m2 = 0;
-  for (std::size_t j = 0; j < n; ++j) {
-    const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
-    const float d2 = dx * dx + dy * dy + dz * dz;
-    out[j] = d2;
-    in_t += d2 <= t ? 1u : 0u;
-    in_m2 += d2 <= m2 ? 1u : 0u;
-  }
-  within_t = in_t;
-  return in_m2;
-}
-
 // Mean of the square roots of d2[1, n): the k nearest's mean distance, leaving out the first
 // (the query point itself, or a duplicate of it at the same distance 0: the k-d tree's answer,
 // whichever of the two it lists first).
@@ -150,41 +133,6 @@ class NearestK {
   float d_[kMax];
 };
 
-// Chunks of the blocks' distances (BlockPoints pads to a multiple).
-constexpr std::size_t kChunk = 16;
-
-// The mean distance of a point to its k nearest others from the squared distances bd2[0, n) to
-// the points of its block (n a multiple of kChunk, padded with distances beyond t; the point
-// itself among them, at 0), when at least want of them lie within t
-// (the caller has counted them) and t is within the block's margin (squared), so that no point
-// outside the block is nearer than the want-th. The want smallest by a branch-free gathering of
-// the candidates within t (into cand, n floats) and a partial selection; the want-th (squared)
-// into kth.
-double settledMean(const float* bd2, std::size_t n, float t, std::size_t want, float* cand,
-                   float& kth) {
-  std::size_t c = 0;
-  for (std::size_t j0 = 0; j0 < n; j0 += kChunk) {
-    // (Most chunks of 16 hold no candidate: the block's cells come nearest first.)
-    std::uint32_t any = 0;
-    for (std::size_t j = j0; j < j0 + kChunk; ++j) any |= bd2[j] <= t ? 1u : 0u;
-    if (any == 0) continue;
-    for (std::size_t j = j0; j < j0 + kChunk; ++j) {
-      cand[c] = bd2[j];
-      c += bd2[j] <= t ? 1 : 0;
-    }
-  }
-  if (c > want) std::nth_element(cand, cand + (want - 1), cand + c);
-  // (The nearest, the point itself at 0, adds nothing to the sum.)
-  double s = 0;
-  float top = 0.f;
-  for (std::size_t j = 0; j < want; ++j) {
-    s += std::sqrt(static_cast<double>(cand[j]));
-    top = std::max(top, cand[j]);
-  }
-  kth = top;
-  return s / static_cast<double>(want - 1);
-}
-
 // The points of a block of cells as one structure of arrays, padded to a multiple of 16 with
 // far-away points (their distances are huge and never kept).
 struct BlockPoints {
@@ -194,7 +142,7 @@ struct BlockPoints {
     n = 0;
     for (const std::uint32_t c : cells) n += g.start[c + 1] - g.start[c];
     const std::size_t cap = (n + 15) / 16 * 16;
-    x.assign(cap, 1e18f), y.assign(cap, 1e18f), z.assign(cap, 1e18f);
+    x.resize(cap), y.resize(cap), z.resize(cap);
     std::size_t j = 0;
     for (const std::uint32_t c : cells) {
       const std::uint32_t b = g.start[c], e = g.start[c + 1];
@@ -203,6 +151,7 @@ struct BlockPoints {
       std::copy(&g.z[b], &g.z[b] + (e - b), &z[j]);
       j += e - b;
     }
+    for (; j < cap; ++j) x[j] = y[j] = z[j] = 1e18f;  // (the padding: every point written once)
   }
 };
 
@@ -303,24 +252,25 @@ class CellSearch {
     for (int ring = 1; ring <= 2; ++ring) {
       if (built_ < ring) grow(ring);
       const BlockPoints& b = block_[ring];
-      bd2_.resize(std::max(bd2_.size(), b.x.size())), cand_.resize(bd2_.size());
       const double m = blockMargin(*g_, qx, qy, qz, cx_, cy_, cz_, ring);
       const auto m2 = static_cast<float>(m * m * (1 - 1e-6));
       // The previous point's k-th distance, a little widened, mostly bounds this one's: fewer
-      // candidates to select from.
+      // candidates to select from. Where it does not, the block's margin.
       const float t = std::min(m2, kth_ * kTighten);
-      std::size_t within_t = 0;
-      const std::size_t within_m2 = distances2Within(b.x.data(), b.y.data(), b.z.data(),
-                                                     b.x.size(), qx, qy, qz, t, m2, bd2_.data(),
-                                                     within_t);
-      if (within_m2 >= want_) {
-        return settledMean(bd2_.data(), b.x.size(), within_t >= want_ ? t : m2, want_, cand_.data(),
-                           kth_);
+      std::size_t c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.x.size(), qx, qy,
+                                           qz, t, cand_.data());
+      if (c < want_ && t < m2) {
+        c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.x.size(), qx, qy, qz, m2,
+                                 cand_.data());
       }
+      if (c >= want_) return detail::selectMean(cand_.data(), c, want_, kth_);
     }
     // The third ring, cell by cell: a cell whose box lies beyond the k-th distance so far holds
-    // none of the k (bd2_ holds the distances to the block of 2 rings).
+    // none of the k.
     best_.clear();
+    bd2_.resize(std::max(bd2_.size(), block_[2].n));
+    distances2(block_[2].x.data(), block_[2].y.data(), block_[2].z.data(), block_[2].n, qx, qy,
+               qz, bd2_.data());
     for (std::size_t j = 0; j < block_[2].n; ++j) best_.offer(bd2_[j]);
     if (built_ < 3) shell(3, ring3_), built_ = 3;
     for (const std::uint32_t b : ring3_) {
@@ -355,10 +305,11 @@ class CellSearch {
       cells_.insert(cells_.end(), around_.begin(), around_.end());
     }
     block_[ring].fill(*g_, cells_);
+    cand_.resize(std::max(cand_.size(), block_[ring].x.size()));
     built_ = ring;
   }
 
-  static constexpr float kTighten = 1.44f;  // (1.2 times the distance)
+  static constexpr float kTighten = 1.3f;  // (1.14 times the distance)
   const PointGrid* g_ = nullptr;
   std::size_t want_ = 1;
   float kth_ = std::numeric_limits<float>::infinity();  // the previous point's, squared
@@ -370,29 +321,44 @@ class CellSearch {
   std::vector<float> bd2_, cand_, d2_;
 };
 
+// The cells [c0, c1) of grid g by search: each point's mean distance into mean_dist, the
+// points not settled within 3 rings to rest. (A function of its own, kept from inlining and
+// from specializing on its argument: the caller's search is a thread_local, whose address GCC
+// computes again, by a call into the dynamic linker, at each use in a function that names it.)
+__attribute__((noipa)) void searchCells(CellSearch& search, const PointGrid& g,
+                                           std::size_t c0, std::size_t c1,
+                                           std::vector<double>& mean_dist,
+                                           std::vector<std::uint32_t>& rest) {
+  for (std::size_t c = c0; c < c1; ++c) {
+    search.startCell(c);
+    for (std::uint32_t q = g.start[c]; q < g.start[c + 1]; ++q) {
+      const double mean = search.meanOf(q);
+      if (std::isnan(mean)) {
+        rest.push_back(q);
+      } else {
+        mean_dist[g.index[q]] = mean;
+      }
+    }
+  }
+}
+
 // The k + 1 nearest of every point by the grid g, their mean distance into mean_dist (cells
 // in dynamic shares: their cost varies); the points not settled within 3 rings go to rest
 // (their grid positions).
 void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>& mean_dist,
                        std::vector<std::uint32_t>& rest) {
   const std::size_t n_cells = g.start.size() - 1;
+  constexpr std::size_t kCellsPerShare = 16;
+  const std::size_t n_shares = (n_cells + kCellsPerShare - 1) / kCellsPerShare;
 #pragma omp parallel
   {
     thread_local CellSearch search;  // (its blocks' buffers kept from call to call)
     search.start(g, want);
     std::vector<std::uint32_t> my_rest;
-#pragma omp for schedule(dynamic, 16)
-    for (std::ptrdiff_t cc = 0; cc < static_cast<std::ptrdiff_t>(n_cells); ++cc) {
-      const auto c = static_cast<std::size_t>(cc);
-      search.startCell(c);
-      for (std::uint32_t q = g.start[c]; q < g.start[c + 1]; ++q) {
-        const double mean = search.meanOf(q);
-        if (std::isnan(mean)) {
-          my_rest.push_back(q);
-        } else {
-          mean_dist[g.index[q]] = mean;
-        }
-      }
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t sh = 0; sh < static_cast<std::ptrdiff_t>(n_shares); ++sh) {
+      const std::size_t c0 = static_cast<std::size_t>(sh) * kCellsPerShare;
+      searchCells(search, g, c0, std::min(n_cells, c0 + kCellsPerShare), mean_dist, my_rest);
     }
 #pragma omp critical(upd_outlier_rest)
     rest.insert(rest.end(), my_rest.begin(), my_rest.end());
@@ -446,11 +412,14 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
   return mean_dist;
 }
 
-void meanNeighbourDistances(const PointCloud& in, int k, std::vector<double>& mean_dist) {
-  requireParam(k >= 1, "PreprocessParams", "outlier_k", k, "must be >= 1");
-  // The calling thread's buffers, kept from call to call (no allocation in a warm frame loop).
-  thread_local std::vector<std::uint32_t> finite, rest;
-  thread_local PointGrid g;
+namespace {
+// meanNeighbourDistances with the calling thread's buffers (a function of its own: see
+// searchCells).
+__attribute__((noipa)) void meanNeighbourDistances(const PointCloud& in, int k,
+                                                      std::vector<double>& mean_dist,
+                                                      std::vector<std::uint32_t>& finite,
+                                                      std::vector<std::uint32_t>& rest,
+                                                      PointGrid& g) {
   mean_dist.assign(in.size(), std::numeric_limits<double>::quiet_NaN());
   finite.clear();
   for (std::size_t i = 0; i < in.size(); ++i) {
@@ -473,6 +442,15 @@ void meanNeighbourDistances(const PointCloud& in, int k, std::vector<double>& me
     for (std::uint32_t& q : rest) q = g.index[q];
     kdTreeMeanDistances(in, k, rest, mean_dist);
   }
+}
+}  // namespace
+
+void meanNeighbourDistances(const PointCloud& in, int k, std::vector<double>& mean_dist) {
+  requireParam(k >= 1, "PreprocessParams", "outlier_k", k, "must be >= 1");
+  // The calling thread's buffers, kept from call to call (no allocation in a warm frame loop).
+  thread_local std::vector<std::uint32_t> finite, rest;
+  thread_local PointGrid g;
+  meanNeighbourDistances(in, k, mean_dist, finite, rest, g);
 }
 
 }  // namespace upd::core

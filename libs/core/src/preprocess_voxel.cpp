@@ -1,7 +1,9 @@
-// The voxel grid in one pass over the input: the cut-off tested per point on the way, each
-// point's voxel found from its left or upper neighbour's (organized frames: a voxel spans
-// several pixels in a row and several rows) before the hash map is asked, the sums per voxel
-// in point order. Its output is voxelDownsample's after cropRange, bit for bit.
+// The voxel grid in one pass over the input, a row at a time: first the cut-off and the voxel
+// key of every point of the row in a vector loop, then the sums, each point's voxel found from
+// its left or upper neighbour's (organized frames: a voxel spans several pixels in a row and
+// several rows) before the hash map is asked, the sums per voxel in point order. Its output is
+// voxelDownsample's after cropRange, bit for bit (this file is built without contracting a
+// multiply and an add into one rounding, so that the vector loop's range test is cropRange's).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -16,6 +18,63 @@ namespace upd::core::detail {
 
 namespace {
 
+// No packed key has its top bit: the key of a point that does not pass.
+constexpr std::uint64_t kNoKey = ~std::uint64_t(0);
+
+// What the key pass needs: the anchor, the voxel's inverse edge and RangeBoxTest's bounds (a
+// test that is off has infinite bounds, which every finite point passes).
+struct KeyPassParams {
+  double ref_x, ref_y, ref_z, inv;
+  float ox, oy, oz;  // sensor origin
+  double rmin2, rmax2;
+  float bx0, by0, bz0, bx1, by1, bz1;  // box
+};
+
+// floor(v) as a 32-bit integer for |v| < 2^30, v clamped to +-2^30 first (keyFits then
+// refuses it): floorToInt's value wherever a key fits.
+inline std::int32_t floorClamped(double v) {
+  constexpr double kLimit = 1073741824.0;  // 2^30
+  v = v > -kLimit ? v : -kLimit;
+  v = v < kLimit ? v : kLimit;
+  const auto t = static_cast<std::int32_t>(v);
+  return t - (v < static_cast<double>(t) ? 1 : 0);
+}
+
+// The voxel key of each of the n points (x, y, z) that passes (finite, kept by the range and box
+// tests, each in RangeBoxTest's arithmetic) into keys, kNoKey for the others. Returns false when
+// a passing point's voxel lies beyond the keys' range. Branch-free, so that it vectorizes.
+UPD_VECTOR_CLONES
+bool voxelKeys(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+               std::size_t n, const KeyPassParams& k, std::uint64_t* __restrict keys) {
+  constexpr float kMaxF = std::numeric_limits<float>::max();
+  constexpr std::int32_t kBias = static_cast<std::int32_t>(kKeyBias);
+  std::uint32_t bad = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const float fx = x[j], fy = y[j], fz = z[j];
+    const bool finite =
+        (std::abs(fx) <= kMaxF) & (std::abs(fy) <= kMaxF) & (std::abs(fz) <= kMaxF);
+    const auto sx = static_cast<double>(fx - k.ox), sy = static_cast<double>(fy - k.oy),
+               sz = static_cast<double>(fz - k.oz);
+    const double d2 = (sx * sx + sy * sy) + sz * sz;  // (Eigen's squaredNorm of 3: the same)
+    const bool in_range = (d2 >= k.rmin2) & (d2 <= k.rmax2);
+    const bool in_box = (fx >= k.bx0) & (fy >= k.by0) & (fz >= k.bz0) & (fx <= k.bx1) &
+                        (fy <= k.by1) & (fz <= k.bz1);
+    // (& instead of &&: no branch, so that the loop vectorizes.)
+    const bool pass = finite & in_range & in_box;
+    const std::int32_t cx = floorClamped((static_cast<double>(fx) - k.ref_x) * k.inv);
+    const std::int32_t cy = floorClamped((static_cast<double>(fy) - k.ref_y) * k.inv);
+    const std::int32_t cz = floorClamped((static_cast<double>(fz) - k.ref_z) * k.inv);
+    const bool fits = (cx >= -kBias) & (cx < kBias) & (cy >= -kBias) & (cy < kBias) &
+                      (cz >= -kBias) & (cz < kBias);
+    bad |= (pass & !fits) ? 1u : 0u;
+    const std::uint64_t key = static_cast<std::uint64_t>(static_cast<std::uint32_t>(cx + kBias)) |
+                              (static_cast<std::uint64_t>(static_cast<std::uint32_t>(cy + kBias)) << 21) |
+                              (static_cast<std::uint64_t>(static_cast<std::uint32_t>(cz + kBias)) << 42);
+    keys[j] = pass ? key : kNoKey;
+  }
+  return bad == 0;
+}
+
 // Per voxel: the sums of the points relative to the anchor, of the colours, and the count.
 struct VoxelSums {
   double sx = 0, sy = 0, sz = 0;
@@ -29,6 +88,7 @@ struct VoxelScratch {
   std::vector<VoxelSums> voxels;
   std::vector<std::uint64_t> row_key[2];  // the voxel key and id of each column, last two rows
   std::vector<std::uint32_t> row_id[2];
+  std::vector<std::uint64_t> keys;  // the keys of the points of one row (unorganized: a chunk)
 };
 
 [[noreturn]] void throwSpan(double voxel_m) {
@@ -73,47 +133,72 @@ namespace {
 class VoxelPass {
  public:
   VoxelPass(VoxelScratch& s, const PointCloud& in, const Eigen::Vector3d& ref, double voxel_m,
-            const RangeBoxTest* test)
-      : s_(s), in_(in), ref_(ref), voxel_m_(voxel_m), inv_(1.0 / voxel_m), test_(test) {}
+            const PreprocessParams* p)
+      : s_(s), in_(in), ref_(ref), voxel_m_(voxel_m) {
+    k_.ref_x = ref.x(), k_.ref_y = ref.y(), k_.ref_z = ref.z();
+    k_.inv = 1.0 / voxel_m;
+    k_.ox = in.sensor_origin.x(), k_.oy = in.sensor_origin.y(), k_.oz = in.sensor_origin.z();
+    const bool range = p && p->range_enabled, box = p && p->box_enabled;
+    const double inf = std::numeric_limits<double>::infinity();
+    const float inf_f = std::numeric_limits<float>::infinity();
+    k_.rmin2 = range ? p->range_min_m * p->range_min_m : -inf;
+    k_.rmax2 = range ? p->range_max_m * p->range_max_m : inf;
+    const Eigen::Vector3f lo = box ? p->box_min_m : Eigen::Vector3f::Constant(-inf_f);
+    const Eigen::Vector3f hi = box ? p->box_max_m : Eigen::Vector3f::Constant(inf_f);
+    k_.bx0 = lo.x(), k_.by0 = lo.y(), k_.bz0 = lo.z();
+    k_.bx1 = hi.x(), k_.by1 = hi.y(), k_.bz1 = hi.z();
+  }
 
   // Points [b, e) of one row (of an organized cloud: keys holds the row's voxel keys and ids
   // for the next row, above the previous row's; else both null).
   void row(std::size_t b, std::size_t e, std::uint64_t* keys, std::uint32_t* ids,
            const std::uint64_t* above_keys, const std::uint32_t* above_ids) {
+    const std::size_t n = e - b;
+    if (s_.keys.size() < n) s_.keys.resize(n);
+    if (!keys) keys = s_.keys.data();
+    if (!voxelKeys(&in_.x[b], &in_.y[b], &in_.z[b], n, k_, keys)) throwSpan(voxel_m_);
     const bool colour = in_.hasColor();
-    for (std::size_t i = b; i < e; ++i) {
-      const std::size_t col = i - b;
-      if (keys) keys[col] = kNone;
-      if (!in_.isFinite(i) || (test_ && !test_->keeps(in_.point(i)))) continue;
-      ++passed_;
-      const double dx = static_cast<double>(in_.x[i]) - ref_.x(),
-                   dy = static_cast<double>(in_.y[i]) - ref_.y(),
-                   dz = static_cast<double>(in_.z[i]) - ref_.z();
-      // Checked before the conversion to integers, which is undefined beyond 2^63 (1e30 m).
-      if (!(std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) * inv_ < 1e15)) {
-        throwSpan(voxel_m_);
+    const float *x = &in_.x[b], *y = &in_.y[b], *z = &in_.z[b];
+    const std::uint8_t* rgb[3] = {colour ? &in_.r[b] : nullptr, colour ? &in_.g[b] : nullptr,
+                                  colour ? &in_.b[b] : nullptr};
+    std::size_t col = 0;
+    while (col < n) {
+      const std::uint64_t key = keys[col];
+      if (key == kNoKey) {
+        ++col;
+        continue;
       }
-      const std::int64_t cx = floorToInt(dx * inv_), cy = floorToInt(dy * inv_),
-                         cz = floorToInt(dz * inv_);
-      if (!keyFits(cx, cy, cz)) throwSpan(voxel_m_);
-      const std::uint64_t key = packKey(cx, cy, cz);
       if (key != last_key_) {
         // The pixel on the left (last_key_) or above mostly shares the voxel: no lookup.
         last_id_ = above_keys && above_keys[col] == key ? above_ids[col] : lookUp(key);
         last_key_ = key;
       }
-      if (keys) keys[col] = key, ids[col] = last_id_;
+      // A run of points in this voxel, its sums in registers from the voxel's and back: the
+      // same additions in the same order as into the voxel point by point. (The colours are
+      // integers, their sums exact in any order.)
       VoxelSums& a = s_.voxels[last_id_];
-      a.sx += dx, a.sy += dy, a.sz += dz;
-      ++a.n;
-      if (colour) a.r += in_.r[i], a.g += in_.g[i], a.b += in_.b[i];
+      double sx = a.sx, sy = a.sy, sz = a.sz;
+      std::uint32_t sr = 0, sg = 0, sb = 0;
+      std::size_t j = col;
+      for (; j < n && keys[j] == key; ++j) {
+        sx += static_cast<double>(x[j]) - ref_.x();
+        sy += static_cast<double>(y[j]) - ref_.y();
+        sz += static_cast<double>(z[j]) - ref_.z();
+        if (ids) ids[j] = last_id_;
+        if (colour) sr += rgb[0][j], sg += rgb[1][j], sb += rgb[2][j];
+      }
+      const auto run = static_cast<std::uint32_t>(j - col);
+      a.sx = sx, a.sy = sy, a.sz = sz;
+      a.n += run;
+      if (colour) a.r += sr, a.g += sg, a.b += sb;
+      passed_ += run;
+      col = j;
     }
   }
   std::size_t passed() const { return passed_; }
   std::size_t voxels() const { return n_voxels_; }
 
  private:
-  static constexpr std::uint64_t kNone = ~std::uint64_t(0);  // no packed key has its top bit
   std::uint32_t lookUp(std::uint64_t key) {
     bool inserted = false;
     const std::uint32_t id = s_.map.findOrInsert(key, inserted);
@@ -127,9 +212,9 @@ class VoxelPass {
   VoxelScratch& s_;
   const PointCloud& in_;
   Eigen::Vector3d ref_;
-  double voxel_m_, inv_;
-  const RangeBoxTest* test_;
-  std::uint64_t last_key_ = kNone;
+  double voxel_m_;
+  KeyPassParams k_;
+  std::uint64_t last_key_ = kNoKey;
   std::uint32_t last_id_ = 0;
   std::size_t passed_ = 0, n_voxels_ = 0;
 };
@@ -148,9 +233,12 @@ std::size_t voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* t
   // Keys and centroids relative to the first point: exact far from the origin.
   const Eigen::Vector3d ref = in.point(first).cast<double>();
   s.map.clear(in.size() / 4 + 16);
-  VoxelPass pass(s, in, ref, voxel_m, test);
+  VoxelPass pass(s, in, ref, voxel_m, test ? &test->params() : nullptr);
   if (!in.isOrganized()) {
-    pass.row(first, in.size(), nullptr, nullptr, nullptr, nullptr);
+    constexpr std::size_t kChunk = 4096;  // (the keys of a chunk stay in the cache)
+    for (std::size_t b = first; b < in.size(); b += kChunk) {
+      pass.row(b, std::min(in.size(), b + kChunk), nullptr, nullptr, nullptr, nullptr);
+    }
   } else {
     const std::size_t w = in.width;
     for (int r = 0; r < 2; ++r) {

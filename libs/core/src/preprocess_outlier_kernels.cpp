@@ -1,0 +1,188 @@
+// The outlier filter's two inner steps, gatherWithin and selectMean (preprocess_internal.h), in
+// a version for AVX2 by intrinsics and a plain one, the one for the running CPU chosen once when
+// the library loads.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "preprocess_internal.h"
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
+namespace upd::core::detail {
+
+namespace {
+
+using GatherWithinFn = std::size_t (*)(const float*, const float*, const float*, std::size_t,
+                                       float, float, float, float, float*);
+
+std::size_t gatherWithinScalar(const float* __restrict x, const float* __restrict y,
+                               const float* __restrict z, std::size_t n, float qx, float qy,
+                               float qz, float t, float* __restrict cand) {
+  std::size_t c = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const float dx = x[j] - qx, dy = y[j] - qy, dz = z[j] - qz;
+    const float d2 = dx * dx + dy * dy + dz * dz;
+    cand[c] = d2;
+    c += d2 <= t ? 1 : 0;
+  }
+  return c;
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+// For each 8-bit mask, the lanes whose bit is set, in order, one byte each (AVX2 has no
+// compress: a permutation by these indices packs the lanes).
+constexpr std::array<std::uint64_t, 256> kCompressIndex = [] {
+  std::array<std::uint64_t, 256> t{};
+  for (std::uint32_t m = 0; m < 256; ++m) {
+    std::uint64_t v = 0;
+    int k = 0;
+    for (std::uint32_t lane = 0; lane < 8; ++lane) {
+      if (m & (1u << lane)) v |= static_cast<std::uint64_t>(lane) << (8 * k++);
+    }
+    t[m] = v;
+  }
+  return t;
+}();
+
+__attribute__((target("avx2,fma,popcnt"))) std::size_t gatherWithinAvx2(
+    const float* __restrict x, const float* __restrict y, const float* __restrict z,
+    std::size_t n, float qx, float qy, float qz, float t, float* __restrict cand) {
+  const __m256 vx = _mm256_set1_ps(qx), vy = _mm256_set1_ps(qy), vz = _mm256_set1_ps(qz);
+  const __m256 vt = _mm256_set1_ps(t);
+  std::size_t c = 0;
+  for (std::size_t j = 0; j < n; j += 8) {
+    const __m256 dx = _mm256_sub_ps(_mm256_loadu_ps(x + j), vx);
+    const __m256 dy = _mm256_sub_ps(_mm256_loadu_ps(y + j), vy);
+    const __m256 dz = _mm256_sub_ps(_mm256_loadu_ps(z + j), vz);
+    const __m256 d2 = _mm256_fmadd_ps(dz, dz, _mm256_fmadd_ps(dy, dy, _mm256_mul_ps(dx, dx)));
+    const auto mt = static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(d2, vt, _CMP_LE_OQ)));
+    const __m256i idx = _mm256_cvtepu8_epi32(
+        _mm_cvtsi64_si128(static_cast<long long>(kCompressIndex[mt])));
+    _mm256_storeu_ps(cand + c, _mm256_permutevar8x32_ps(d2, idx));
+    c += static_cast<std::size_t>(__builtin_popcount(mt));
+  }
+  return c;
+}
+
+GatherWithinFn pickGatherWithin() {
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+      __builtin_cpu_supports("popcnt")) {
+    return gatherWithinAvx2;
+  }
+  return gatherWithinScalar;
+}
+#else
+GatherWithinFn pickGatherWithin() { return gatherWithinScalar; }
+#endif
+
+const GatherWithinFn pickedGatherWithin = pickGatherWithin();
+
+using SelectMeanFn = double (*)(float*, std::size_t, std::size_t, float&);
+
+// By a partial selection of the want smallest.
+double selectMeanScalar(float* cand, std::size_t c, std::size_t want, float& kth) {
+  if (c > want) std::nth_element(cand, cand + (want - 1), cand + c);
+  // (The nearest, the point itself at 0, adds nothing to the sum.)
+  double s = 0;
+  float top = 0.f;
+  for (std::size_t j = 0; j < want; ++j) {
+    s += std::sqrt(static_cast<double>(cand[j]));
+    top = std::max(top, cand[j]);
+  }
+  kth = top;
+  return s / static_cast<double>(want - 1);
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+// The horizontal maximum of v in every lane.
+__attribute__((target("avx2"))) inline __m256 maxAllLanes(__m256 v) {
+  v = _mm256_max_ps(v, _mm256_permute2f128_ps(v, v, 1));
+  v = _mm256_max_ps(v, _mm256_shuffle_ps(v, v, 0x4e));
+  return _mm256_max_ps(v, _mm256_shuffle_ps(v, v, 0xb1));
+}
+
+// By dropping the c - want largest one at a time (the candidates within the previous point's
+// bound exceed want by a few): each drop a maximum over a few vectors, no branch per candidate;
+// then the square roots of the rest summed a vector at a time. Many candidates (the first
+// point of a thread, a point settled by its block's margin): the partial selection.
+__attribute__((target("avx2,popcnt,bmi"))) double selectMeanAvx2(float* cand, std::size_t c,
+                                                                 std::size_t want, float& kth) {
+  constexpr std::size_t kMaxVectors = 8;
+  const std::size_t nv = (c + 7) / 8;
+  if (nv > kMaxVectors || c - want > 16) return selectMeanScalar(cand, c, want, kth);
+  const float lowest = -std::numeric_limits<float>::infinity();
+  for (std::size_t j = c; j < nv * 8; ++j) cand[j] = lowest;
+  __m256 v[kMaxVectors];
+  for (std::size_t i = 0; i < nv; ++i) v[i] = _mm256_loadu_ps(cand + 8 * i);
+  const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256 lowest_v = _mm256_set1_ps(lowest);
+  __m256 top = lowest_v;
+  for (std::size_t drop = 0; drop <= c - want; ++drop) {
+    __m256 m = v[0];
+    for (std::size_t i = 1; i < nv; ++i) m = _mm256_max_ps(m, v[i]);
+    top = maxAllLanes(m);
+    if (drop == c - want) break;  // (top: the want-th, the largest left)
+    // One instance of the largest goes (ties: the others stay, as in a selection).
+    for (std::size_t i = 0; i < nv; ++i) {
+      const auto eq = static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(v[i], top, _CMP_EQ_OQ)));
+      if (eq == 0) continue;
+      const __m256i lane = _mm256_set1_epi32(static_cast<int>(__builtin_ctz(eq)));
+      v[i] = _mm256_blendv_ps(v[i], lowest_v, _mm256_castsi256_ps(_mm256_cmpeq_epi32(lane_index, lane)));
+      break;
+    }
+  }
+  // The dropped and the padding are -inf: 0 after the max with 0, adding nothing.
+  const __m256 zero = _mm256_setzero_ps();
+  __m256d sum = _mm256_setzero_pd();
+  for (std::size_t i = 0; i < nv; ++i) {
+    const __m256 d = _mm256_max_ps(v[i], zero);
+    sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(d))));
+    sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(d, 1))));
+  }
+  alignas(32) double lanes[4];
+  _mm256_store_pd(lanes, sum);
+  kth = _mm_cvtss_f32(_mm256_castps256_ps128(top));
+  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) / static_cast<double>(want - 1);
+}
+
+SelectMeanFn pickSelectMean() {
+  __builtin_cpu_init();
+  // (The instructions its target names: AVX2, POPCNT and BMI's TZCNT.)
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt") &&
+                 __builtin_cpu_supports("bmi")
+             ? selectMeanAvx2
+             : selectMeanScalar;
+}
+#else
+SelectMeanFn pickSelectMean() { return selectMeanScalar; }
+#endif
+
+const SelectMeanFn pickedSelectMean = pickSelectMean();
+
+}  // namespace
+
+std::size_t gatherWithin(const float* x, const float* y, const float* z, std::size_t n, float qx,
+                         float qy, float qz, float t, float* cand) {
+  return pickedGatherWithin(x, y, z, n, qx, qy, qz, t, cand);
+}
+
+double selectMean(float* cand, std::size_t c, std::size_t want, float& kth) {
+  return pickedSelectMean(cand, c, want, kth);
+}
+
+std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, std::size_t n,
+                              float qx, float qy, float qz, float t, float* cand) {
+  return gatherWithinScalar(x, y, z, n, qx, qy, qz, t, cand);
+}
+
+double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth) {
+  return selectMeanScalar(cand, c, want, kth);
+}
+
+}  // namespace upd::core::detail

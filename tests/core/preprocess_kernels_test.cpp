@@ -1,0 +1,109 @@
+// The outlier filter's two inner steps, in the version the running CPU gets (AVX2 where it has
+// it), against their plain versions and a reference in double: gatherWithin keeps exactly the
+// points within the bound, in point order; selectMean gives
+// the mean of the square roots of the want smallest and the want-th, with ties, few candidates
+// and many. Fixed seeds.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "../../libs/core/src/preprocess_internal.h"
+
+namespace upd::core {
+namespace {
+
+// The squared distance in double (the kernels compute it in float, with or without a fused
+// multiply-add: within a few float roundings of this).
+double exactD2(float x, float y, float z, float qx, float qy, float qz) {
+  const double dx = static_cast<double>(x) - qx, dy = static_cast<double>(y) - qy,
+               dz = static_cast<double>(z) - qz;
+  return dx * dx + dy * dy + dz * dz;
+}
+
+TEST(PreprocessKernels, GatherWithinKeepsThePointsWithinTheBoundInOrder) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-0.1f, 0.1f);
+  int checked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const std::size_t n = 8 * (1 + static_cast<std::size_t>(trial % 50));
+    std::vector<float> x(n), y(n), z(n);
+    for (std::size_t j = 0; j < n; ++j) x[j] = u(rng), y[j] = u(rng), z[j] = 1.f + u(rng);
+    if (trial % 3 == 0) x[n - 1] = y[n - 1] = z[n - 1] = 1e18f;  // padding, as a block has
+    const float qx = u(rng), qy = u(rng), qz = 1.f + u(rng);
+    std::vector<double> d2(n);
+    for (std::size_t j = 0; j < n; ++j) d2[j] = exactD2(x[j], y[j], z[j], qx, qy, qz);
+    std::vector<double> sorted = d2;
+    std::sort(sorted.begin(), sorted.end());
+    // Bounds halfway between two distances, clear of the kernels' rounding.
+    const std::size_t kt = static_cast<std::size_t>(trial) % n;
+    const double t = kt + 1 < n ? 0.5 * (sorted[kt] + sorted[kt + 1]) : 2 * sorted[kt];
+    const auto clear = [&](double b) {
+      for (const double d : d2) {
+        if (std::abs(d - b) <= 1e-5 * b) return false;
+      }
+      return true;
+    };
+    if (!clear(t)) continue;
+    ++checked;
+    std::vector<double> want;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (d2[j] <= t) want.push_back(d2[j]);
+    }
+    for (const bool plain : {false, true}) {
+      std::vector<float> cand(n, -1.f);
+      const auto tf = static_cast<float>(t);
+      const std::size_t c =
+          plain ? detail::gatherWithinPlain(x.data(), y.data(), z.data(), n, qx, qy, qz, tf,
+                                            cand.data())
+                : detail::gatherWithin(x.data(), y.data(), z.data(), n, qx, qy, qz, tf,
+                                       cand.data());
+      ASSERT_EQ(c, want.size()) << "trial " << trial << (plain ? " plain" : "");
+      for (std::size_t j = 0; j < c; ++j) {
+        EXPECT_NEAR(cand[j], want[j], 1e-6 * want[j] + 1e-12) << "trial " << trial << ", " << j;
+      }
+    }
+  }
+  EXPECT_GT(checked, 300);
+}
+
+TEST(PreprocessKernels, SelectMeanIsTheMeanOfTheNearestWithTies) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.f, 0.01f);
+  for (int trial = 0; trial < 600; ++trial) {
+    const std::size_t want = 2 + static_cast<std::size_t>(trial % 30);
+    // Mostly a few more candidates than wanted (the drop path), sometimes many (the selection).
+    const std::size_t extra = trial % 7 == 0 ? 40 + static_cast<std::size_t>(trial % 50)
+                                             : static_cast<std::size_t>(trial % 19);
+    const std::size_t c = want + extra;
+    std::vector<float> cand(c);
+    for (float& d : cand) d = u(rng);
+    cand[static_cast<std::size_t>(trial) % c] = 0.f;  // the point itself
+    if (trial % 4 == 1) {  // ties, at the want-th among them
+      std::vector<float> s = cand;
+      std::sort(s.begin(), s.end());
+      for (float& d : cand) {
+        if (d >= s[want - 2] && d <= s[std::min(c - 1, want + 1)]) d = s[want - 1];
+      }
+    }
+    std::vector<double> sorted(cand.begin(), cand.end());
+    std::sort(sorted.begin(), sorted.end());
+    double sum = 0;
+    for (std::size_t j = 0; j < want; ++j) sum += std::sqrt(sorted[j]);
+    const double mean = sum / static_cast<double>(want - 1);
+    for (const bool plain : {false, true}) {
+      std::vector<float> buf(c + 8);
+      std::copy(cand.begin(), cand.end(), buf.begin());
+      float kth = -1.f;
+      const double got = plain ? detail::selectMeanPlain(buf.data(), c, want, kth)
+                               : detail::selectMean(buf.data(), c, want, kth);
+      EXPECT_NEAR(got, mean, 1e-12 * mean) << "trial " << trial << (plain ? " plain" : "");
+      EXPECT_EQ(kth, static_cast<float>(sorted[want - 1])) << "trial " << trial;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace upd::core
