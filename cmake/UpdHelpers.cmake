@@ -7,9 +7,10 @@ function(upd_set_warnings target)
                                            -Wno-deprecated-copy)
 endfunction()
 
-# upd_add_test(NAME name SOURCES a.cpp b.cpp LIBS lib1 lib2)
+# upd_add_test(NAME name SOURCES a.cpp b.cpp LIBS lib1 lib2 [LABEL label]): LABEL is the ctest
+# label of its test cases, the library it tests (`ctest -L '^maps$'`; scripts/sanitize.sh's scopes).
 function(upd_add_test)
-  cmake_parse_arguments(T "" "NAME" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(T "" "NAME;LABEL" "SOURCES;LIBS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
   target_link_libraries(${T_NAME} PRIVATE ${T_LIBS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${T_NAME} PRIVATE
@@ -17,7 +18,8 @@ function(upd_add_test)
   upd_set_warnings(${T_NAME})
   include(GoogleTest)
   gtest_discover_tests(${T_NAME} DISCOVERY_TIMEOUT 60
-                       PROPERTIES ENVIRONMENT "UPD_SHARED_DATA_DIR=${UPD_SHARED_DATA_DIR}")
+                       PROPERTIES ENVIRONMENT "UPD_SHARED_DATA_DIR=${UPD_SHARED_DATA_DIR}"
+                                  LABELS "${T_LABEL}")
 endfunction()
 
 # upd_install_library(upd_<name> [PACKAGES spec...] [STATIC_PACKAGES spec...]): the library is

@@ -4,8 +4,8 @@
 # In CI (CI=true), or with UPD_RELIABILITY=1, bounded reliability steps follow
 # (docs/RELIABILITY.md): the fuzzers of the cloud readers, the robot config and the core
 # pipeline for at most UPD_FUZZ_SECONDS each (default 90; a fixed seed and 2,000 inputs, so a
-# run is repeatable), the rawlog fuzzer on its seeds and regressions, and the Eigen-only
-# libraries' tests under ASan + UBSan.
+# run is repeatable), the rawlog fuzzer on its seeds and regressions, and the tests of the
+# libraries up to the MRPT bridge (core, sim, io, maps, mrpt_bridge) under ASan + UBSan.
 # Longer and wider: scripts/fuzz.sh SECONDS [TARGET...] and scripts/sanitize.sh (every test).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
@@ -19,5 +19,7 @@ if [ "${CI:-}" = true ] || [ "${UPD_RELIABILITY:-0}" = 1 ]; then
   # object stream finds MRPT's own traps, docs/RELIABILITY.md; by hand: scripts/fuzz.sh 600 rawlog).
   UPD_FUZZ_SEED="${UPD_FUZZ_SEED:-1}" UPD_FUZZ_RUNS=0 \
     "$UPD_ROOT/scripts/fuzz.sh" "${UPD_FUZZ_SECONDS:-90}" rawlog
-  UPD_SANITIZE_SCOPE=core "$UPD_ROOT/scripts/sanitize.sh"
+  # The libraries up to the MRPT bridge and their tests under ASan + UBSan + LeakSanitizer
+  # (nav and the apps: by hand, scripts/sanitize.sh; docs/RELIABILITY.md, "In CI").
+  UPD_SANITIZE_SCOPE="core sim io maps mrpt_bridge" "$UPD_ROOT/scripts/sanitize.sh"
 fi

@@ -274,5 +274,49 @@ TEST(PlaybackDamage, AnObjectClaimingAnImpossibleSizeIsDamageNotACrash) {
   EXPECT_NE(r.output.find("std::bad_alloc"), std::string::npos) << r.output;
 }
 
+// A fuzzed copy of a 2D-laser rawlog whose odometry action at object #15 says "motion model
+// -256, 1007614517 particles" (found by fuzz_rawlog): MRPT would draw 10^9 particles while
+// reading it (minutes). The reader checks those fields first: damage, as for a cut file; the
+// maps are those of the file cut before that object (8 planar scans: none processed).
+TEST(PlaybackDamage, OdometryActionWithAnImpossibleParticleCountIsDamage) {
+  const fs::path rawlog = fs::path(UPD_SOURCE_DIR) /
+                          "tests/fuzz/regressions/rawlog/odometry_action_particle_count_of_1e9.rawlog";
+  const test::TempDir tmp("particles");
+  const fs::path out = tmp.path() / "out", ref = tmp.path() / "ref";
+  const CmdResult r = SimulatedRun::playback(rawlog, out);
+  ASSERT_EQ(r.exit_code, 3) << r.output;
+  const std::string reason =
+      "corrupt CActionRobotMovement2D (action 1 of 1 in a CActionCollection): unknown motion "
+      "model -256 (0 Gaussian, 1 Thrun; MRPT would draw its 1007614517 particles)";
+  EXPECT_NE(r.output.find("rawlog " + rawlog.string() + " is damaged at object #15 (byte 17575 of "
+                          "the decompressed stream): " + reason),
+            std::string::npos)
+      << r.output;
+  const json s = readJson(out / "summary.json");
+  EXPECT_EQ(s["end"], "damaged");
+  EXPECT_EQ(s["damage"]["object_index"], 15);
+  EXPECT_EQ(s["damage"]["byte_offset"], 17575);
+  EXPECT_EQ(s["damage"]["reason"], reason);
+  EXPECT_EQ(s["damage"]["observations_before"], 8);
+  EXPECT_EQ(s["frames_read"], 8);
+  EXPECT_EQ(s["frames_skipped"]["CObservation2DRangeScan has no 3D points (a planar laser scan)"], 8);
+  // The same file cut right before the damaged object (a valid, shorter rawlog).
+  const fs::path cut = tmp.path() / "cut.rawlog";
+  {
+    mrpt::io::CFileGZInputStream in(rawlog.string());
+    std::string bytes(17575, '\0');
+    ASSERT_EQ(in.Read(bytes.data(), bytes.size()), bytes.size());
+    writeBytes(cut, bytes);
+  }
+  const CmdResult clean = SimulatedRun::playback(cut, ref);
+  ASSERT_EQ(clean.exit_code, 0) << clean.output;
+  expectMapsEqual(out, ref);
+
+  const fs::path strict = tmp.path() / "strict";
+  const CmdResult st = SimulatedRun::playback(rawlog, strict, "--strict");
+  expectNothingWritten(st, strict, rawlog);
+  EXPECT_NE(st.output.find("object #15"), std::string::npos) << st.output;
+}
+
 }  // namespace
 }  // namespace upd

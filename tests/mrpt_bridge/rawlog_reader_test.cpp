@@ -5,6 +5,7 @@
 #include "test_data.h"
 
 #include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservationComment.h>
@@ -276,6 +277,114 @@ TEST(RawlogReader, WrittenLayoutsAndSkipReasons) {
   EXPECT_EQ(s.skipped.at("odometry at the end of the file with no observation after it"), 1u);
   EXPECT_EQ(reader.layout(), RawlogLayout::Mixed);
   EXPECT_NE(s.summary().find("5 observations"), std::string::npos) << s.summary();
+}
+
+// An odometry action whose motion model MRPT rebuilds while reading it: the Thrun model draws
+// nParticlesCount particles, any value but 0 (Gaussian) selects it. Nothing is drawn here: the
+// fields are set and written as they are.
+mrpt::obs::CActionCollection odometryWithModel(int model, std::uint32_t particles) {
+  using mrpt::obs::CActionRobotMovement2D;
+  CActionRobotMovement2D act;
+  act.estimationMethod = CActionRobotMovement2D::emOdometry;
+  act.rawOdometryIncrementReading = mrpt::poses::CPose2D(0.5, 0, 0);
+  act.motionModelConfiguration.modelSelection =
+      static_cast<CActionRobotMovement2D::TDrawSampleMotionModel>(model);
+  act.motionModelConfiguration.thrunModel.nParticlesCount = particles;
+  mrpt::obs::CActionCollection acts;
+  acts.insert(act);
+  return acts;
+}
+
+// A plain rawlog: an observation, the given actions, an observation.
+void writeAroundActions(const fs::path& file, const mrpt::obs::CActionCollection& acts) {
+  mrpt::io::CFileOutputStream out(file.string());
+  auto ar = mrpt::serialization::archiveFrom(out);
+  mrpt::obs::CObservationComment first, last;
+  first.text = "before";
+  last.text = "after";
+  ar << first << acts << last;
+}
+
+// A corrupt particle count would make MRPT draw 10^9 particles inside its deserialization
+// (minutes, gigabytes): the reader reads the fields first and names the object as damage; the
+// observation before it is delivered. A sane Thrun model is read as usual.
+TEST(RawlogReader, ImpossibleOdometryMotionModelIsDamageBeforeMrptDrawsIt) {
+  TempDir tmp;
+  struct Case {
+    int model;
+    std::uint32_t particles;
+    const char* reason;  ///< "" when the file reads to its end
+  } cases[] = {
+      {1, 2000000000u,
+       "corrupt CActionRobotMovement2D (action 1 of 1 in a CActionCollection): a motion model of "
+       "2000000000 particles (more than 100000; MRPT draws every one while reading the object)"},
+      {-256, 1007614517u,
+       "corrupt CActionRobotMovement2D (action 1 of 1 in a CActionCollection): unknown motion "
+       "model -256 (0 Gaussian, 1 Thrun; MRPT would draw its 1007614517 particles)"},
+      {7, 300u, "unknown motion model 7"},
+      {1, 300u, ""},
+      {0, 4000000000u, ""},  // the Gaussian model draws nothing: the count is not used
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::to_string(c.model) + " / " + std::to_string(c.particles));
+    const fs::path file = tmp.path() / "odometry.rawlog";
+    writeAroundActions(file, odometryWithModel(c.model, c.particles));
+    RawlogReader reader(file.string());
+    RawlogEntry e;
+    ASSERT_TRUE(reader.next(e));
+    EXPECT_EQ(e.className(), "CObservationComment");
+    if (*c.reason == '\0') {
+      ASSERT_TRUE(reader.next(e));
+      EXPECT_TRUE(e.odometry_increment);
+      EXPECT_FALSE(reader.next(e));
+      continue;
+    }
+    try {
+      reader.next(e);
+      ADD_FAILURE() << "the action was read";
+    } catch (const RawlogError& err) {
+      EXPECT_EQ(err.objectIndex(), 1u);
+      EXPECT_GT(err.byteOffset(), 0u);
+      EXPECT_NE(err.reason().find(c.reason), std::string::npos) << err.reason();
+      EXPECT_NE(std::string(err.what()).find("cannot read object #1 (at byte " +
+                                             std::to_string(err.byteOffset())),
+                std::string::npos)
+          << err.what();
+    }
+  }
+}
+
+// CActionCollection resizes its list of actions to the count it reads: an impossible count is
+// damage before MRPT allocates it.
+TEST(RawlogReader, ImpossibleActionCountIsDamage) {
+  TempDir tmp;
+  const fs::path file = tmp.path() / "actions.rawlog";
+  writeAroundActions(file, odometryWithModel(0, 300));
+  std::string bytes;
+  {
+    std::ifstream in(file, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  // The object header: the name's length with the high bit set, the name, the version 0.
+  const std::string name = "mrpt::obs::CActionCollection";
+  const std::string header = std::string(1, static_cast<char>(0x80 | name.size())) + name + '\0';
+  const auto at = bytes.find(header);
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t count_at = at + header.size();
+  ASSERT_EQ(bytes[count_at], 1);
+  bytes.replace(count_at, 4, std::string("\xF0\xFF\xFF\xFF", 4));  // 4294967280 actions
+  std::ofstream(file, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  RawlogReader reader(file.string());
+  RawlogEntry e;
+  ASSERT_TRUE(reader.next(e));
+  try {
+    reader.next(e);
+    ADD_FAILURE() << "the collection was read";
+  } catch (const RawlogError& err) {
+    EXPECT_EQ(err.objectIndex(), 1u);
+    EXPECT_EQ(err.byteOffset(), at);
+    EXPECT_EQ(err.reason(), "corrupt CActionCollection: 4294967280 actions (more than 4096)");
+  }
 }
 
 }  // namespace

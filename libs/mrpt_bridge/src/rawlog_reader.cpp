@@ -4,6 +4,7 @@
 #include <mrpt/obs/registerAllClasses.h>
 
 #include "mrpt_util.h"
+#include "rawlog_precheck.h"
 #include "upd/mrpt_bridge/pose_source.h"
 
 #include <mrpt/img/CImage.h>
@@ -125,6 +126,8 @@ struct RawlogReader::Impl {
   std::string path;
   std::string images_dir;
   mrpt::io::CFileGZInputStream in;
+  // MRPT reads through it; the pre-check looks at the next object's bytes before MRPT does.
+  std::unique_ptr<detail::LookaheadStream> lookahead;
   mrpt::serialization::CArchive::UniquePtr archive;
   RawlogStats stats;
   bool seen_frames = false, seen_bare_observations = false;
@@ -255,7 +258,8 @@ RawlogReader::RawlogReader(const std::string& path) : impl_(std::make_unique<Imp
   }
   if (!std::ifstream(path).good()) throw std::runtime_error("rawlog " + path + ": unreadable");
   if (!impl_->in.open(path)) throw std::runtime_error("rawlog " + path + ": cannot be opened");
-  impl_->archive = mrpt::serialization::archiveUniquePtrFrom(impl_->in);
+  impl_->lookahead = std::make_unique<detail::LookaheadStream>(impl_->in);
+  impl_->archive = mrpt::serialization::archiveUniquePtrFrom(*impl_->lookahead);
   impl_->images_dir = detectImagesDirectory(path);
   mrpt::img::CImage::setImagesPathBase(impl_->images_dir);
 }
@@ -283,12 +287,14 @@ bool RawlogReader::next(RawlogEntry& entry) {
     if (d.finished) return false;
 
     const std::size_t object_index = d.stats.objects;
-    const uint64_t position = d.in.getPosition();
+    const uint64_t position = d.lookahead->getPosition();
     mrpt::serialization::CSerializable::Ptr object;
+    std::string impossible;
     try {
-      *d.archive >> object;
+      impossible = detail::precheckNextObject(*d.lookahead);
+      if (impossible.empty()) *d.archive >> object;
     } catch (const mrpt::serialization::CExceptionEOF& e) {
-      if (d.in.getPosition() != position) {
+      if (d.lookahead->getPosition() != position) {
         d.fail(object_index, position,
                "truncated, the file ends inside it (" + describeReadError(e.what()) + ")");
       }
@@ -299,6 +305,7 @@ bool RawlogReader::next(RawlogEntry& entry) {
     } catch (const std::exception& e) {
       d.fail(object_index, position, "corrupt or truncated (" + describeReadError(e.what()) + ")");
     }
+    if (!impossible.empty()) d.fail(object_index, position, impossible);
     ++d.stats.objects;
     d.handleObject(object, object_index);
   }

@@ -11,8 +11,10 @@
 #include <mrpt/poses/CPose3DQuat.h>
 
 #include <filesystem>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -87,9 +89,17 @@ void loadSensorConfig(mrpt::hwdrivers::CGenericSensor& sensor,
 }
 
 // MRPT's COpenNI2Sensor aborts the process in doProcess() when no device is attached.
+// OpenNI2 stays initialized from the first probe until the process ends: MRPT's COpenNI2Generic
+// shuts it down when its last instance goes, which unloads the device drivers (and with them
+// what they allocated, then lost to every tool that would name it). The one probe is never
+// destroyed and stays reachable.
+int connectedOpenNI2Devices() {
+  static auto* const probe = new mrpt::hwdrivers::COpenNI2Generic();
+  return probe->getConnectedDevices();
+}
+
 void requireOpenNI2Device(const std::string& path, const std::string& section) {
-  mrpt::hwdrivers::COpenNI2Generic probe;
-  if (probe.getConnectedDevices() <= 0) {
+  if (connectedOpenNI2Devices() <= 0) {
     throw std::runtime_error(where(path, section) +
                              ": cannot open COpenNI2Sensor: no OpenNI2 device is connected");
   }
@@ -148,10 +158,13 @@ void checkSensorSection(const std::string& ini_path, const std::string& section)
   auto sensor = createSensor(ini_path, s);
   loadSensorConfig(*sensor, *ini, ini_path, s.name);
   stereoCalibration(*ini, ini_path, s.name);
-  if (s.driver == "COpenNI2Sensor" && mrpt::hwdrivers::COpenNI2Generic().getConnectedDevices() <= 0) {
-    // MRPT 2.5's ~COpenNI2Sensor throws (std::terminate) when no device was opened: this one
-    // object, which never opened anything, is deliberately not destroyed.
-    new mrpt::hwdrivers::CGenericSensor::Ptr(std::move(sensor));
+  if (s.driver == "COpenNI2Sensor" && connectedOpenNI2Devices() <= 0) {
+    // MRPT 2.5's ~COpenNI2Sensor throws (std::terminate) when no device was opened: such an
+    // object, which never opened anything, is deliberately kept (reachable) and not destroyed.
+    static auto* const never_destroyed = new std::vector<mrpt::hwdrivers::CGenericSensor::Ptr>();
+    static std::mutex guard;
+    const std::lock_guard<std::mutex> lock(guard);
+    never_destroyed->push_back(std::move(sensor));
   }
 }
 

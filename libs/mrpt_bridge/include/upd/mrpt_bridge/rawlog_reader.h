@@ -11,7 +11,9 @@
 //
 // Errors: a missing file throws one line naming it; a corrupt or truncated file throws
 // RawlogError naming the file, the object index, its byte offset and what was read up to there
-// (the observations yielded before it are intact). Externally
+// (the observations yielded before it are intact). An odometry action whose motion model would
+// make MRPT draw an impossible number of particles while reading it, or an action collection of
+// an impossible count, is such damage too, found before MRPT reads the object. Externally
 // stored images are found through CImage::setImagesPathBase(detectImagesDirectory(file)), which
 // the constructor sets (MRPT keeps that path base process-wide: read one rawlog at a time).
 #pragma once

@@ -1,0 +1,222 @@
+#include "rawlog_precheck.h"
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <type_traits>
+
+namespace upd::mrpt_bridge::detail {
+
+size_t LookaheadStream::Read(void* buffer, size_t count) {
+  auto* out = static_cast<std::uint8_t*>(buffer);
+  std::size_t done = std::min(count, ahead_.size() - head_);
+  if (done > 0) {
+    std::memcpy(out, ahead_.data() + head_, done);
+    head_ += done;
+    if (head_ == ahead_.size()) {
+      ahead_.clear();
+      head_ = 0;
+    }
+  }
+  if (done < count) done += in_.Read(out + done, count - done);
+  return done;
+}
+
+size_t LookaheadStream::Write(const void*, size_t) {
+  throw std::logic_error("LookaheadStream is read-only");
+}
+
+uint64_t LookaheadStream::Seek(int64_t, TSeekOrigin) {
+  throw std::logic_error("LookaheadStream reads forward only");
+}
+
+uint64_t LookaheadStream::getTotalBytesCount() const { return in_.getTotalBytesCount(); }
+
+uint64_t LookaheadStream::getPosition() const {
+  return in_.getPosition() - (ahead_.size() - head_);
+}
+
+bool LookaheadStream::peek(std::size_t offset, void* out, std::size_t count) {
+  const std::size_t need = offset + count;
+  while (ahead_.size() - head_ < need) {
+    if (head_ > 0) {  // keep only what is not consumed
+      ahead_.erase(ahead_.begin(), ahead_.begin() + static_cast<std::ptrdiff_t>(head_));
+      head_ = 0;
+    }
+    const std::size_t have = ahead_.size();
+    const std::size_t chunk = std::max<std::size_t>(need - have, 4096);
+    ahead_.resize(have + chunk);
+    const std::size_t got = in_.Read(ahead_.data() + have, chunk);
+    ahead_.resize(have + got);
+    if (got == 0) return false;
+  }
+  std::memcpy(out, ahead_.data() + head_ + offset, count);
+  return true;
+}
+
+namespace {
+
+constexpr std::uint8_t kEndFlag = 0x88;  // MRPT's SERIALIZATION_END_FLAG after each object
+
+template <std::size_t N>
+struct UintOfSize;
+template <>
+struct UintOfSize<1> {
+  using type = std::uint8_t;
+};
+template <>
+struct UintOfSize<4> {
+  using type = std::uint32_t;
+};
+
+// Reads ahead of the stream's position: little-endian values (MRPT's byte order on disk), as
+// MRPT's CArchive would read them next, without consuming them.
+class Cursor {
+ public:
+  explicit Cursor(LookaheadStream& in) : in_(in) {}
+
+  bool bytes(void* out, std::size_t n) {
+    if (!in_.peek(offset_, out, n)) return false;
+    offset_ += n;
+    return true;
+  }
+  template <typename T>
+  bool value(T& v) {
+    static_assert(std::is_integral_v<T>);
+    std::uint8_t b[sizeof(T)];
+    if (!bytes(b, sizeof b)) return false;
+    typename UintOfSize<sizeof(T)>::type u = 0;
+    for (std::size_t i = sizeof(T); i-- > 0;) u = static_cast<decltype(u)>((u << 8) | b[i]);
+    std::memcpy(&v, &u, sizeof v);
+    return true;
+  }
+  /// Fields whose values are not checked: skipped (a read after them fails at the end).
+  void skip(std::size_t n) { offset_ += n; }
+  bool endFlag() {
+    std::uint8_t f = 0;
+    return value(f) && f == kEndFlag;
+  }
+
+ private:
+  LookaheadStream& in_;
+  std::size_t offset_ = 0;
+};
+
+struct ObjectHeader {
+  std::string class_name;  ///< without a namespace
+  int version = -1;
+  bool has_end_flag = true;  ///< false in the format before MRPT 0.5.5
+};
+
+// CArchive::internal_ReadObjectHeader's layout; false where MRPT would refuse it.
+bool readHeader(Cursor& c, ObjectHeader& h) {
+  std::uint8_t length = 0;
+  if (!c.value(length)) return false;
+  h.has_end_flag = (length & 0x80) != 0;
+  if (!h.has_end_flag) {
+    std::uint8_t zeros[3];
+    if (!c.bytes(zeros, 3) || zeros[0] || zeros[1] || zeros[2]) return false;
+  }
+  length &= 0x7F;
+  if (length > 120) return false;
+  std::string name(length, '\0');
+  if (length > 0 && !c.bytes(name.data(), length)) return false;
+  const auto ns = name.rfind("::");
+  h.class_name = ns == std::string::npos ? name : name.substr(ns + 2);
+  if (!h.has_end_flag) {
+    std::int32_t v = 0;
+    if (!c.value(v) || v < 0 || v >= 255) return false;
+    h.version = v;
+    return true;
+  }
+  if (name == "nullptr") return true;
+  std::uint8_t v = 0;
+  if (!c.value(v)) return false;
+  h.version = v;
+  return true;
+}
+
+enum class Parse { Read, Impossible, OtherLayout };
+
+// CActionRobotMovement2D::serializeFrom of MRPT 2.5.8, versions 4-7, up to its end flag: an
+// odometry estimate carries its raw increment (a CPose2D object) and the motion model MRPT
+// rebuilds the distribution from while reading.
+Parse checkMovement2D(Cursor& c, int version, std::string& why) {
+  if (version < 4 || version > 7) return Parse::OtherLayout;
+  std::int32_t method = 0;
+  // Not an odometry estimate (emOdometry = 0): a pose distribution object follows, left to MRPT.
+  if (!c.value(method) || method != 0) return Parse::OtherLayout;
+  ObjectHeader pose;
+  if (!readHeader(c, pose) || pose.class_name != "CPose2D") return Parse::OtherLayout;
+  if (pose.version == 0) {
+    c.skip(3 * sizeof(float));
+  } else if (pose.version == 1) {
+    c.skip(3 * sizeof(double));
+  } else {
+    return Parse::OtherLayout;
+  }
+  if (pose.has_end_flag && !c.endFlag()) return Parse::OtherLayout;
+  std::int32_t model = 0;
+  std::uint32_t particles = 0;
+  if (!c.value(model)) return Parse::OtherLayout;
+  c.skip(6 * sizeof(float));  // the Gaussian model's a1..a4, minStdXY, minStdPHI
+  if (!c.value(particles)) return Parse::OtherLayout;
+  // MRPT draws particles for any model but mmGaussian (0); mmThrun is 1.
+  if (model != 0 && model != 1) {
+    why = "unknown motion model " + std::to_string(model) + " (0 Gaussian, 1 Thrun; MRPT would draw its " +
+          std::to_string(particles) + " particles)";
+    return Parse::Impossible;
+  }
+  if (model == 1 && particles > kMaxOdometryParticles) {
+    why = "a motion model of " + std::to_string(particles) + " particles (more than " +
+          std::to_string(kMaxOdometryParticles) + "; MRPT draws every one while reading the object)";
+    return Parse::Impossible;
+  }
+  c.skip((version >= 5 ? 6 : 4) * sizeof(float));  // the Thrun model's alphas and extra noise
+  std::uint8_t has_velocities = 0, has_encoders = 0;
+  if (!c.value(has_velocities)) return Parse::OtherLayout;
+  if (version >= 7) {
+    if (has_velocities) c.skip(3 * sizeof(double));  // TTwist2D
+  } else {
+    c.skip(2 * sizeof(double));
+  }
+  if (!c.value(has_encoders)) return Parse::OtherLayout;
+  if (version < 7 || has_encoders) c.skip(2 * sizeof(std::int32_t));
+  if (version >= 6) c.skip(sizeof(std::uint64_t));  // the timestamp
+  return Parse::Read;
+}
+
+}  // namespace
+
+std::string precheckNextObject(LookaheadStream& in) {
+  Cursor c(in);
+  ObjectHeader top;
+  if (!readHeader(c, top)) return {};
+  std::string why;
+  if (top.class_name == "CActionRobotMovement2D") {
+    if (checkMovement2D(c, top.version, why) == Parse::Impossible) {
+      return "corrupt CActionRobotMovement2D: " + why;
+    }
+    return {};
+  }
+  if (top.class_name != "CActionCollection" || top.version != 0) return {};
+  std::uint32_t actions = 0;
+  if (!c.value(actions)) return {};
+  if (actions > kMaxActionsPerCollection) {
+    return "corrupt CActionCollection: " + std::to_string(actions) + " actions (more than " +
+           std::to_string(kMaxActionsPerCollection) + ")";
+  }
+  for (std::uint32_t i = 0; i < actions; ++i) {
+    ObjectHeader action;
+    if (!readHeader(c, action) || action.class_name != "CActionRobotMovement2D") return {};
+    const Parse p = checkMovement2D(c, action.version, why);
+    if (p == Parse::Impossible) {
+      return "corrupt CActionRobotMovement2D (action " + std::to_string(i + 1) + " of " +
+             std::to_string(actions) + " in a CActionCollection): " + why;
+    }
+    if (p == Parse::OtherLayout || (action.has_end_flag && !c.endFlag())) return {};
+  }
+  return {};
+}
+
+}  // namespace upd::mrpt_bridge::detail
