@@ -1,10 +1,25 @@
-# Shared build helpers: warnings on every project target, one helper to add a test, one to
-# install a library with its headers into the exported CMake package (upd_nav, namespace upd::).
+# Shared build helpers: warnings on every project target, one helper to add a library, one to
+# add a test, one to install a library with its headers into the exported CMake package
+# (upd_nav, namespace upd::).
 include(GNUInstallDirs)
 
 function(upd_set_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow=local
                                            -Wno-deprecated-copy)
+endfunction()
+
+# upd_add_library(name): the library upd_<name> (alias upd::<name>) of the sources in
+# <dir>/src/*.cpp, its public headers in <dir>/include, C++17, position-independent code (a
+# static build's libraries can go into shared objects), with the project's warnings. The caller
+# adds its links and upd_install_library().
+function(upd_add_library name)
+  file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/src/*.cpp)
+  add_library(upd_${name} ${sources})
+  add_library(upd::${name} ALIAS upd_${name})
+  target_include_directories(upd_${name} PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+  target_compile_features(upd_${name} PUBLIC cxx_std_17)
+  set_target_properties(upd_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  upd_set_warnings(upd_${name})
 endfunction()
 
 # upd_add_test(NAME name SOURCES a.cpp b.cpp LIBS lib1 lib2 [LABEL label]): LABEL is the ctest
