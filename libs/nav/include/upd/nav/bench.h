@@ -54,9 +54,11 @@ struct BenchParams {
   double reference_speed_mps = 0.4;  ///< the optimal time is the optimal path at this [m/s]
   double time_limit_factor = 4.0;    ///< a world's time limit: this x the optimal time ...
   double min_time_limit_s = 60.0;    ///< ... and at least this [s]
-  /// The oracle labels points this close to non-traversable truth non-traversable too, so it
-  /// keeps a clearance as the UPD's band does [m].
-  double oracle_margin_m = 0.1;
+  /// The oracle labels points this close to non-traversable truth non-traversable too [m]. 0:
+  /// the oracle's clearance is the navigator polygon's margin (config/ptg-dune.ini), as the
+  /// other modes'; a margin on top of it makes MRPT's navigator stop in front of gaps and
+  /// rocks (docs/NAVIGATION.md, "Navigation benchmark").
+  double oracle_margin_m = 0.0;
 
   void validate() const;  ///< std::invalid_argument naming the field
 };
