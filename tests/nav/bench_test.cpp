@@ -58,6 +58,31 @@ TEST(NavBench, GeneratedWorldsAreSolvableForTheFootprint) {
   }
 }
 
+// A stop on an open map is the navigator's unless the planner had given up at the end: plans
+// that failed on the way do not make it a planning failure; a map with no way is a false
+// obstacle.
+TEST(NavBench, StopCategoryReflectsThePlannerAtTheEnd) {
+  sim::WorldSpec world{sim::Terrain({-5.0, -5.0}, {5.0, 5.0}), {-3.0, 0.0, 0.0}, {3.0, 0.0}, ""};
+  const NavConfig config;
+  ScenarioResult run;
+  run.trajectory.push_back({});
+  run.trajectory.back().pose_world_robot = {-3.0, 0.0, 0.0};
+  run.failed_plans = 12;  // earlier plans failed, the map is open now (unknown cells are free)
+  run.replanning_stopped = false;
+  EXPECT_EQ(categorize(run, world, config, BenchOutcome::Stuck), FailureCause::Navigator);
+  run.replanning_stopped = true;
+  EXPECT_EQ(categorize(run, world, config, BenchOutcome::Stuck), FailureCause::Planning);
+  // A mapped wall across the whole world between robot and goal: no way on the map.
+  for (double y = -5.0; y <= 5.0; y += 0.05) {
+    maps::GridCell* c = run.grid.cellAt(0.0, y);
+    ASSERT_NE(c, nullptr);
+    c->hits = 10;
+    c->logodds_nontrav = 3.0f;
+  }
+  EXPECT_EQ(categorize(run, world, config, BenchOutcome::Stuck), FailureCause::FalseObstacle);
+  EXPECT_EQ(categorize(run, world, config, BenchOutcome::Success), FailureCause::None);
+}
+
 BenchRow row(int seed, BenchOutcome o, double time_ratio, FailureCause c = FailureCause::None) {
   BenchRow r;
   r.seed = seed;

@@ -77,8 +77,9 @@ TEST_F(NavNavigatorRun, ReachesANearGoalAndLogsEveryStep) {
     EXPECT_TRUE(o.error_code.empty());
     const auto shape = nav.robotShape();
     ASSERT_EQ(shape.size(), 4u);
-    EXPECT_NEAR(std::abs(shape[0].x()), 0.35, 1e-6);
-    EXPECT_NEAR(std::abs(shape[0].y()), 0.225, 1e-6);
+    // The shipped polygon: the 0.7 x 0.45 m footprint grown by 5 cm on every side.
+    EXPECT_NEAR(std::abs(shape[0].x()), 0.40, 1e-6);
+    EXPECT_NEAR(std::abs(shape[0].y()), 0.275, 1e-6);
     nav.closeLog();
   }
   EXPECT_LT(std::hypot(base.pose().x_m - 3.0, base.pose().y_m - 1.0), 0.35);

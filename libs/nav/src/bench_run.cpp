@@ -70,6 +70,8 @@ void BenchParams::validate() const {
                      "time_limit_factor", time_limit_factor, "must be >= 1");
   core::requireParam(std::isfinite(min_time_limit_s) && min_time_limit_s > 0, s,
                      "min_time_limit_s", min_time_limit_s, "must be > 0");
+  core::requireParam(std::isfinite(oracle_margin_m) && oracle_margin_m >= 0, s,
+                     "oracle_margin_m", oracle_margin_m, "must be >= 0");
 }
 
 namespace {
@@ -168,22 +170,46 @@ FailureCause categorize(const ScenarioResult& run, const sim::WorldSpec& world,
   }
   const Route r = planRoute(run.grid, fence, {end.x_m, end.y_m}, world.goal_xy, config.route);
   if (!r.found) return FailureCause::FalseObstacle;
-  if (run.replanning_stopped || run.failed_plans > 0) return FailureCause::Planning;
+  // The planner's state at the end: it had stopped replanning (the navigator was left on a
+  // stale route); plans that failed earlier on the way do not count.
+  if (run.replanning_stopped) return FailureCause::Planning;
   return FailureCause::Navigator;
 }
 
 namespace {
 
-// The oracle's labeller: the ground truth rasterised, looked up per point.
-NavigationLoop::PointLabeller truthLabeller(const sim::WorldSpec& world, double cell_m) {
-  auto truth = std::make_shared<const sim::TruthRaster>(world.terrain, cell_m);
-  return [truth](double x, double y) {
-    const auto ix = static_cast<int>(std::floor((x - truth->origin().x()) / truth->cellSize()));
-    const auto iy = static_cast<int>(std::floor((y - truth->origin().y()) / truth->cellSize()));
-    if (ix < 0 || iy < 0 || ix >= truth->sizeX() || iy >= truth->sizeY()) {
-      return core::Label::Unknown;
+// The oracle's labeller: the ground truth rasterised, its NonTraversable cells grown by
+// margin_m (the oracle keeps that clearance, as the UPD's band does), looked up per point.
+NavigationLoop::PointLabeller truthLabeller(const sim::WorldSpec& world, double cell_m,
+                                            double margin_m) {
+  const sim::TruthRaster truth(world.terrain, cell_m);
+  const int nx = truth.sizeX(), ny = truth.sizeY();
+  auto labels = std::make_shared<std::vector<core::Label>>(static_cast<std::size_t>(nx) * ny);
+  const int reach = static_cast<int>(std::floor(margin_m / cell_m));
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
+      (*labels)[static_cast<std::size_t>(iy) * nx + ix] = truth.at(ix, iy);
     }
-    return truth->at(ix, iy);
+  }
+  for (int iy = 0; iy < ny; ++iy) {
+    for (int ix = 0; ix < nx; ++ix) {
+      if (truth.at(ix, iy) != core::Label::NonTraversable) continue;
+      for (int dy = -reach; dy <= reach; ++dy) {
+        for (int dx = -reach; dx <= reach; ++dx) {
+          const int jx = ix + dx, jy = iy + dy;
+          const bool inside = jx >= 0 && jy >= 0 && jx < nx && jy < ny;
+          if (!inside || (dx * dx + dy * dy) * cell_m * cell_m > margin_m * margin_m) continue;
+          (*labels)[static_cast<std::size_t>(jy) * nx + jx] = core::Label::NonTraversable;
+        }
+      }
+    }
+  }
+  const Eigen::Vector2d origin = truth.origin();
+  return [labels, origin, cell_m, nx, ny](double x, double y) {
+    const auto ix = static_cast<int>(std::floor((x - origin.x()) / cell_m));
+    const auto iy = static_cast<int>(std::floor((y - origin.y()) / cell_m));
+    if (ix < 0 || iy < 0 || ix >= nx || iy >= ny) return core::Label::Unknown;
+    return (*labels)[static_cast<std::size_t>(iy) * nx + ix];
   };
 }
 
@@ -203,7 +229,7 @@ BenchRow runBenchWorld(const BenchWorld& world, const NavConfig& config, BenchPe
   const auto detector =
       p == BenchPerception::Roughness ? core::ObstacleDetector::Roughness : core::ObstacleDetector::Upd;
   const NavigationLoop::PointLabeller labeller =
-      p == BenchPerception::Truth ? truthLabeller(spec, c.loop.truth_cell_m)
+      p == BenchPerception::Truth ? truthLabeller(spec, c.loop.truth_cell_m, params.oracle_margin_m)
                                   : NavigationLoop::PointLabeller{};
   ScenarioResult r = runScenario(spec, "bench", c, detector, "", {}, labeller);
   r.perception = toString(p);

@@ -26,6 +26,11 @@ void LoopParams::validate() const {
                "clearance_search_m", clearance_search_m, "must be > 0");
 }
 
+void PerceptionParams::validate() const {
+  core::requireParam(std::isfinite(upd_radius_m) && upd_radius_m >= 0, "PerceptionParams",
+                     "upd_radius_m", upd_radius_m, "must be >= 0 (0: the robot config's)");
+}
+
 void NavConfig::validate() const {
   pipeline.validate();
   baseline.validate();
@@ -37,9 +42,11 @@ void NavConfig::validate() const {
   base.validate();
   obstacles.validate();
   negative.validate();
+  step_edges.validate();
   route.validate();
   navigator.validate();
   loop.validate();
+  perception.validate();
   if (ptg_ini.empty()) {
     throw std::invalid_argument("NavigatorParams.ptg_ini is not set (the MRPT navigator's ini)");
   }

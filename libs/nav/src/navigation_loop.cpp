@@ -47,6 +47,14 @@ bool routeDiffers(const Route& next, const Route& current, double lookahead_m, d
   return false;
 }
 
+// True when a cell of the route's path is NonTraversable on the grid.
+bool routeBlocked(const maps::TraversabilityGrid& grid, const Route& route) {
+  for (const Eigen::Vector2d& p : route.path_world) {
+    if (maps::cellLabel(grid, p.x(), p.y()) == core::Label::NonTraversable) return true;
+  }
+  return false;
+}
+
 // Collision grids depend on the PTG file (PTGs, shape): cache them per file content so editing
 // the file never reuses stale grids.
 std::string cacheDirFor(const std::string& cache_root, const std::string& ptg_ini) {
@@ -66,6 +74,7 @@ std::string cacheDirFor(const std::string& cache_root, const std::string& ptg_in
 core::FrameScorerParams scorerParams(const NavConfig& config, core::ObstacleDetector detector) {
   core::FrameScorerParams p;
   p.pipeline = config.pipeline;
+  if (config.perception.upd_radius_m > 0) p.pipeline.upd.radius_m = config.perception.upd_radius_m;
   p.detector = detector;
   p.baseline = config.baseline;
   p.obstacles_xy = true;  // the navigator's current-frame obstacles
@@ -120,21 +129,39 @@ const FrameEvidence& NavigationLoop::addFrame(const core::PointCloud& cloud_worl
       last_missing_ground_.push_back(pts[k]);
     }
   }
-  if (!gx.empty()) {
-    const std::vector<core::Label> labels(gx.size(), core::Label::NonTraversable);
-    maps::PointsWorld missing;
-    missing.x = gx.data();
-    missing.y = gy.data();
-    missing.z = gz.data();
-    missing.label = labels.data();
-    missing.size = gx.size();
-    maps::integrateScan(grid_, missing, robot_xy, time_s, config_.fusion);
+  fuseNonTraversable(gx, gy, gz, robot_xy, time_s);
+  // Step edges: where the fused elevations jump by more than the robot can climb (the UPD
+  // smooths low edges away); fused as NonTraversable evidence (at the cell's elevation) and
+  // obstacles at once.
+  last_step_edges_ = maps::findStepEdges(grid_, robot_xy, config_.step_edges);
+  std::vector<float> ex, ey, ez;
+  for (const auto& c : last_step_edges_) {
+    const maps::GridCell* cell = grid_.cellAt(c.x(), c.y());
+    ex.push_back(static_cast<float>(c.x()));
+    ey.push_back(static_cast<float>(c.y()));
+    ez.push_back(cell != nullptr && std::isfinite(cell->elevation_m) ? cell->elevation_m : 0.0f);
   }
+  fuseNonTraversable(ex, ey, ez, robot_xy, time_s);
   std::vector<Eigen::Vector2d> frame_obstacles = last_frame_.obstacles_world;
   frame_obstacles.insert(frame_obstacles.end(), last_missing_ground_.begin(),
                          last_missing_ground_.end());
+  frame_obstacles.insert(frame_obstacles.end(), last_step_edges_.begin(), last_step_edges_.end());
   obstacles_.setFrameObstacles(std::move(frame_obstacles));
   return last_frame_;
+}
+
+void NavigationLoop::fuseNonTraversable(const std::vector<float>& x, const std::vector<float>& y,
+                                        const std::vector<float>& z,
+                                        const Eigen::Vector2d& robot_xy, double time_s) {
+  if (x.empty()) return;
+  const std::vector<core::Label> labels(x.size(), core::Label::NonTraversable);
+  maps::PointsWorld pts;
+  pts.x = x.data();
+  pts.y = y.data();
+  pts.z = z.data();
+  pts.label = labels.data();
+  pts.size = x.size();
+  maps::integrateScan(grid_, pts, robot_xy, time_s, config_.fusion);
 }
 
 void NavigationLoop::labelFrame(const core::PointCloud& cloud_world) {
@@ -194,6 +221,14 @@ void NavigationLoop::replan() {
   Route r = planRoute(grid_, fixed_world_, {s.pose_world_robot.x_m, s.pose_world_robot.y_m},
                       goal_world_, config_.route);
   if (r.found && r.length_m < best_route_m_ - kProgress_m) {
+    best_route_m_ = r.length_m;
+    last_progress_s_ = last_plan_s_;
+  }
+  if (r.found && route_.found && routeBlocked(grid_, route_) &&
+      routeDiffers(r, route_, kRouteLookahead_m, kRouteTolerance_m)) {
+    // The map closed the route being driven and another way is open: what the robot has seen
+    // is progress even when the new way is longer (the way round a wall leads away from the
+    // goal first), so the best length starts again from it.
     best_route_m_ = r.length_m;
     last_progress_s_ = last_plan_s_;
   }

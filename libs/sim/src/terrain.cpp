@@ -195,6 +195,7 @@ Terrain& Terrain::setRoughness(const Roughness& r) {
   roughness_ = r;
   waves_.clear();
   roughness_bound_m_ = 0.0;
+  roughness_gradient_bound_ = 0.0;
   if (r.rms_height_m > 0) {
     constexpr int kWaves = 8;
     // Each wave a sin(.) has variance a^2 / 2; 8 of them sum to rms^2 with a = rms / 2.
@@ -207,6 +208,7 @@ Terrain& Terrain::setRoughness(const Roughness& r) {
       const double phase = 2.0 * kPi * unit(rng);
       const double k = 2.0 * kPi / wavelength;
       waves_.emplace_back(k * std::cos(theta), k * std::sin(theta), phase, amplitude);
+      roughness_gradient_bound_ += amplitude * k;
     }
     roughness_bound_m_ = kWaves * amplitude;
   }
@@ -229,8 +231,8 @@ void Terrain::addShape(const Shape& s) {
 
 void Terrain::rebuildIndex() {
   const Eigen::Vector2d size = max_xy_ - min_xy_;
-  // 0.25 m cells, coarser for huge extents so the index stays below ~250k cells.
-  cell_m_ = std::max(0.25, std::sqrt(size.x() * size.y() / 250000.0));
+  // 0.1 m cells, coarser for huge extents so the index stays below ~250k cells.
+  cell_m_ = std::max(0.1, std::sqrt(size.x() * size.y() / 250000.0));
   inv_cell_ = 1.0 / cell_m_;
   nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_m_)));
   ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_m_)));
@@ -238,6 +240,7 @@ void Terrain::rebuildIndex() {
   cell_shapes_.assign(n, {});
   cell_near_shapes_.assign(n, {});
   cell_max_m_.assign(n, roughness_bound_m_);
+  cell_slope_.assign(n, roughness_gradient_bound_);
   for (std::size_t i = 0; i < shapes_.size(); ++i) indexShape(i);
   max_height_m_ = *std::max_element(cell_max_m_.begin(), cell_max_m_.end());
 }
@@ -269,12 +272,39 @@ void Terrain::indexShape(std::size_t shape_index) {
   };
   const auto id = static_cast<std::uint32_t>(shape_index);
   // The padding makes each cell's lists and bound valid on its closed boundary.
-  cover(1e-6, [&](std::size_t c) {
+  constexpr double kPad_m = 1e-6;
+  const double inf = std::numeric_limits<double>::infinity();
+  // The surface is max(roughness, shapes): its slope is bounded by the steepest of them where
+  // no footprint ends (an edge: a jump) and no rock stands (vertical at its foot).
+  const double shape_slope = s.kind == Shape::Kind::Rock   ? inf
+                             : s.kind == Shape::Kind::Ramp ? s.tan_slope
+                                                           : 0.0;
+  cover(kPad_m, [&](std::size_t c) {
     cell_shapes_[c].push_back(id);
     cell_max_m_[c] = std::max(cell_max_m_[c], s.max_height_m + roughness_bound_m_);
     max_height_m_ = std::max(max_height_m_, cell_max_m_[c]);
+    cell_slope_[c] = std::max(cell_slope_[c], roughness_gradient_bound_ + shape_slope);
   });
-  cover(truth_.border_m + 1e-6, [&](std::size_t c) { cell_near_shapes_[c].push_back(id); });
+  cover(truth_.border_m + kPad_m, [&](std::size_t c) { cell_near_shapes_[c].push_back(id); });
+  // Every cell an edge passes through (or within kPad_m of) has no slope bound: the edge is
+  // walked in steps of at most half a cell, and the cells of each step's bounding box marked.
+  for (const Segment& seg : edges_[shape_index]) {
+    const int n = 1 + static_cast<int>(std::ceil(2.0 * (seg.b - seg.a).norm() / cell_m_));
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector2d p = seg.a + (seg.b - seg.a) * (static_cast<double>(k) / n);
+      const Eigen::Vector2d q = seg.a + (seg.b - seg.a) * (static_cast<double>(k + 1) / n);
+      const auto index = [&](double v, double lo, int cells) {
+        return std::clamp(static_cast<int>(std::floor((v - lo) / cell_m_)), 0, cells - 1);
+      };
+      const int ix0 = index(std::min(p.x(), q.x()) - kPad_m, min_xy_.x(), nx_);
+      const int ix1 = index(std::max(p.x(), q.x()) + kPad_m, min_xy_.x(), nx_);
+      const int iy0 = index(std::min(p.y(), q.y()) - kPad_m, min_xy_.y(), ny_);
+      const int iy1 = index(std::max(p.y(), q.y()) + kPad_m, min_xy_.y(), ny_);
+      for (int iy = iy0; iy <= iy1; ++iy) {
+        for (int ix = ix0; ix <= ix1; ++ix) cell_slope_[static_cast<std::size_t>(iy) * nx_ + ix] = inf;
+      }
+    }
+  }
 }
 
 std::vector<Terrain::Segment> Terrain::shapeEdges(const Shape& s) const {
@@ -313,7 +343,9 @@ std::size_t Terrain::cellOf(double x, double y) const {
 
 double Terrain::roughnessAt(double x, double y) const {
   double h = 0.0;
-  for (const Eigen::Vector4d& w : waves_) h += w[3] * std::sin(w[0] * x + w[1] * y + w[2]);
+  for (const Eigen::Vector4d& w : waves_) {
+    h += w[3] * terrain_detail::fastSin(w[0] * x + w[1] * y + w[2]);
+  }
   return h;
 }
 

@@ -55,26 +55,32 @@ struct Terrain::Ray {
     if (t >= ta && t <= tb) return point(t);
     return std::nullopt;
   }
-  // Between a parameter above the surface and one on or below it. Secant steps are exact on a
-  // plane and fast on smooth relief; at a vertical face they barely move, so once a secant
-  // step fails to halve the bracket only bisection follows (the hit within kBisectTol_m).
+  // Between a parameter above the surface and one on or below it. Regula falsi with the
+  // Illinois rule (the value kept at an end that stays twice is halved, so the bracket shrinks
+  // from both sides) converges superlinearly on smooth relief; at a vertical face a step barely
+  // moves, so after two steps in a row that do not halve the bracket one bisection follows (the
+  // hit within kBisectTol_m).
   Eigen::Vector3d refine(double lo, double hi) const {
     double f_lo = above(lo), f_hi = above(hi);
-    bool secant = true;
+    int side = 0, slow = 0;
     for (int i = 0; i < 128 && hi - lo > kBisectTol_m; ++i) {
       const double width = hi - lo;
-      const bool use_secant = secant && f_lo - f_hi > 0.0;
-      const double t = use_secant ? lo + width * f_lo / (f_lo - f_hi) : 0.5 * (lo + hi);
+      const bool bisect = slow >= 2 || !(f_lo - f_hi > 0.0);
+      const double t = bisect ? 0.5 * (lo + hi) : lo + width * f_lo / (f_lo - f_hi);
       const double f = above(t);
       if (std::abs(f) <= kSurfaceTol_m) return point(t);
       if (f > 0.0) {
         lo = t;
         f_lo = f;
+        if (side == 1) f_hi *= 0.5;
+        side = 1;
       } else {
         hi = t;
         f_hi = f;
+        if (side == -1) f_lo *= 0.5;
+        side = -1;
       }
-      if (use_secant && hi - lo > 0.5 * width) secant = false;
+      slow = hi - lo > 0.5 * width ? slow + 1 : 0;
     }
     return point(f_lo - f_hi > 0.0 ? lo + (hi - lo) * f_lo / (f_lo - f_hi) : hi);
   }
@@ -140,8 +146,11 @@ std::optional<Eigen::Vector3d> Terrain::walkCells(const Ray& ray, double t_in, d
   double t = t_in, t_above = t_in;
   while (true) {
     const double t_end = std::min({t_next_x, t_next_y, t_out});
-    const double bound = cell_max_m_[static_cast<std::size_t>(iy) * nx_ + ix];
-    if (auto hit = marchCell(ray, t, t_end, bound, march_dt, t_above)) return hit;
+    const std::size_t cell = static_cast<std::size_t>(iy) * nx_ + ix;
+    if (auto hit = marchCell(ray, t, t_end, cell_max_m_[cell], march_dt, cell_slope_[cell],
+                             t_above)) {
+      return hit;
+    }
     if (t_end >= t_out) break;
     if (d.z() >= 0.0 && o.z() + t_end * d.z() > max_height_m_) {  // climbing above everything
       to_sky = true;
@@ -161,11 +170,15 @@ std::optional<Eigen::Vector3d> Terrain::walkCells(const Ray& ray, double t_in, d
 }
 
 // One cell [t, t_end] of the walk under the height bound: skipped when the ray stays above it,
-// else marched every march_dt until the ray is on or under the surface (then refined from the
-// last parameter above it, t_above, which the march advances).
+// else marched until the ray is on or under the surface (then refined from the last parameter
+// above it, t_above, which the march advances). A step is march_dt, or longer where the
+// surface's slope is bounded (slope_bound: |grad h| <= it in this cell; infinity: vertical
+// faces): a ray `above` over the surface that descends at -d.z per unit of t against a surface
+// rising at most slope_bound x horizontal cannot meet it within above / (slope_bound x
+// horizontal - d.z), so the longer step skips no crossing the march_dt steps would find.
 std::optional<Eigen::Vector3d> Terrain::marchCell(const Ray& ray, double t, double t_end,
                                                   double bound, double march_dt,
-                                                  double& t_above) const {
+                                                  double slope_bound, double& t_above) const {
   const double za = ray.o.z() + t * ray.d.z(), zb = ray.o.z() + t_end * ray.d.z();
   if (std::min(za, zb) > bound) {
     t_above = std::max(t_above, t_end);
@@ -173,11 +186,18 @@ std::optional<Eigen::Vector3d> Terrain::marchCell(const Ray& ray, double t, doub
   }
   double tc = t;
   if (za > bound && ray.d.z() < 0.0) tc = std::max(t, (bound - ray.o.z()) / ray.d.z());
+  const double closing =
+      std::isfinite(slope_bound) ? slope_bound * std::hypot(ray.d.x(), ray.d.y()) - ray.d.z() : 0.0;
   while (true) {
-    if (ray.above(tc) <= 0.0) return ray.refine(t_above, tc);
+    const double above = ray.above(tc);
+    if (above <= 0.0) return ray.refine(t_above, tc);
     t_above = tc;
     if (tc >= t_end) return std::nullopt;
-    tc = std::min(tc + march_dt, t_end);
+    double dt = march_dt;
+    if (std::isfinite(slope_bound)) {
+      dt = closing > 0.0 ? std::max(dt, above / closing) : std::numeric_limits<double>::infinity();
+    }
+    tc = std::min(tc + dt, t_end);
   }
 }
 

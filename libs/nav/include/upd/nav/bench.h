@@ -10,8 +10,8 @@
 // its length at reference_speed_mps (the navigator's top speed).
 //
 // Perception: the UPD, the roughness index, or the truth (the oracle: the camera's points
-// labelled with the ground truth's traversability, so only what the camera sees is known; the
-// UPD's share of a failure is the difference to it).
+// labelled with the ground truth's traversability grown by oracle_margin_m, so only what the
+// camera sees is known; the UPD's share of a failure is the difference to it).
 //
 // Outcome of a world: collision when any step's footprint overlaps non-traversable truth (even
 // if the goal was reached after); otherwise success when the goal was reached, timeout at the
@@ -22,8 +22,8 @@
 //    holds a route to the goal and the planner kept planning;
 //  - false_obstacle (perception): a stop where the final map holds no route from the robot to
 //    the goal (the truth does: what closed the way is mapped obstacle that is not there);
-//  - planning: a stop while the map holds a route but the loop's planner had given up
-//    (replanning stopped for lack of progress, or plans failed).
+//  - planning: a stop while the map holds a route but the loop's planner had given up at the
+//    end (replanning stopped for lack of progress; plans that failed on the way do not count).
 #pragma once
 
 #include "upd/nav/nav_config.h"
@@ -54,6 +54,11 @@ struct BenchParams {
   double reference_speed_mps = 0.4;  ///< the optimal time is the optimal path at this [m/s]
   double time_limit_factor = 4.0;    ///< a world's time limit: this x the optimal time ...
   double min_time_limit_s = 60.0;    ///< ... and at least this [s]
+  /// The oracle labels points this close to non-traversable truth non-traversable too [m]. 0:
+  /// the oracle's clearance is the navigator polygon's margin (config/ptg-dune.ini), as the
+  /// other modes'; a margin on top of it makes MRPT's navigator stop in front of gaps and
+  /// rocks (docs/NAVIGATION.md, "Navigation benchmark").
+  double oracle_margin_m = 0.0;
 
   void validate() const;  ///< std::invalid_argument naming the field
 };

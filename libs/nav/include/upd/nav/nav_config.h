@@ -14,6 +14,7 @@
 #include "upd/core/baselines.h"
 #include "upd/core/pipeline.h"
 #include "upd/maps/fusion.h"
+#include "upd/maps/step_edges.h"
 #include "upd/maps/traversability_grid.h"
 #include "upd/nav/navigator.h"
 #include "upd/nav/negative_obstacles.h"
@@ -49,6 +50,25 @@ struct LoopParams {
   }
 };
 
+/// What the loop changes in the robot config's pipeline. Loaded from [PerceptionParams].
+struct PerceptionParams {
+  /// d_m of the UPD that labels the navigator's obstacles [m]; 0: the robot config's
+  /// [UpdParams] radius_m. The UPD marks a band of about 0.7 d_m round every obstacle, and the
+  /// route keeps RoutePlannerParams::inflation_m from it: at the paper's 0.5 m a gap narrower
+  /// than about 1.55 m closes for the Dune, at 0.3 m one of 0.95 m (the robot's width plus
+  /// 0.5 m) still does, at 0.2 m it stays open. Low edges the smaller d_m no longer smooths
+  /// away are the step-edge check's (upd/maps/step_edges.h).
+  double upd_radius_m = 0.2;
+
+  void validate() const;
+  template <class V>
+  void visit(V& v) {
+    v("upd_radius_m", upd_radius_m,
+      "d_m of the UPD for the navigator's obstacles [m]; 0: the robot config's [UpdParams] "
+      "radius_m");
+  }
+};
+
 struct NavConfig {
   core::PipelineParams pipeline;
   core::BaselineParams baseline;
@@ -60,9 +80,11 @@ struct NavConfig {
   SimulatedBaseParams base;
   ObstacleParams obstacles;
   NegativeObstacleParams negative;
+  maps::StepEdgeParams step_edges;
   RoutePlannerParams route;
   NavigatorParams navigator;
   LoopParams loop;
+  PerceptionParams perception;
   std::string ptg_ini;        ///< absolute path of the MRPT navigator ini
   std::string ptg_cache_dir;  ///< absolute path; defaultPtgCacheDir() when not configured
 
@@ -78,9 +100,13 @@ void forEachNavSection(NavConfig& c, F&& f) {
   f("CameraMountParams", "Where the depth camera sits on the robot.", c.camera);
   f("DepthNoise", "Noise of the simulated depth camera.", c.depth_noise);
   f("SimulatedBaseParams", "The simulated base that executes the velocity commands.", c.base);
+  f("PerceptionParams", "What the loop changes in the robot config's UPD pipeline.",
+    c.perception);
   f("ObstacleParams", "Which labelled points become obstacles for the reactive navigator.",
     c.obstacles);
   f("NegativeObstacleParams", "Drops and holes seen as missing ground.", c.negative);
+  f("StepEdgeParams", "Step edges found on the grid's elevations (upd/maps/step_edges.h).",
+    c.step_edges);
   f("RoutePlannerParams", "The global route over the traversability grid.", c.route);
   f("NavigatorParams",
     "MRPT's reactive navigator (its PTGs come from the file that `ptg_ini` names; "

@@ -5,7 +5,9 @@
 //  1. hands in the latest depth frame, already in the world frame (z up) at the base's current
 //     pose: addFrame() scores it (upd::FrameScorer: UPD or roughness index), fuses it into the traversability grid,
 //     adds the missing ground of its gaps (negative_obstacles.h) whose near side the map knows
-//     as traversable, and makes all its NonTraversable points the "current frame" obstacles;
+//     as traversable and the step edges of the map's elevations near the robot
+//     (upd/maps/step_edges.h) as NonTraversable evidence, and makes all these and the frame's
+//     NonTraversable points the "current frame" obstacles;
 //  2. calls step(): every replan_period_s the route planner searches the map for a route to the
 //     goal and hands it to the navigator as waypoints; then the reactive navigator senses the
 //     obstacles (map within range + current frame + fixed ones) in the robot frame and sends one
@@ -15,7 +17,9 @@
 // without any, the goal itself) and ends with its own error when it cannot get closer
 // (NavigatorParams::no_progress_timeout_s). Replanning also stops when the route to the goal has
 // not got shorter for that long: a robot circling a walled-in goal finds a new way in through
-// every stretch of wall it has not seen yet, and would otherwise search until the time limit. The
+// every stretch of wall it has not seen yet, and would otherwise search until the time limit. A
+// route that the map closed, replaced by another open way, counts as progress (the new way may
+// be longer: round a wall whose gap is away from the goal). The
 // navigator is created by the first navigateTo(), so a loop that only maps never builds PTGs.
 #pragma once
 
@@ -82,6 +86,8 @@ class NavigationLoop {
   const maps::GridFusionStats& lastFusion() const { return last_fusion_; }
   /// Missing-ground points (world xy) the last frame added as obstacles.
   const std::vector<Eigen::Vector2d>& lastMissingGround() const { return last_missing_ground_; }
+  /// Step-edge cells (world xy) the last frame added as obstacles (upd/maps/step_edges.h).
+  const std::vector<Eigen::Vector2d>& lastStepEdges() const { return last_step_edges_; }
   /// The navigator (nullptr before navigateTo()).
   const Navigator* navigator() const { return navigator_.get(); }
 
@@ -96,6 +102,7 @@ class NavigationLoop {
   FrameEvidence last_frame_;
   maps::GridFusionStats last_fusion_;
   std::vector<Eigen::Vector2d> last_missing_ground_;
+  std::vector<Eigen::Vector2d> last_step_edges_;
   std::unique_ptr<Navigator> navigator_;
   std::vector<Eigen::Vector2d> fixed_world_;
   Eigen::Vector2d goal_world_ = Eigen::Vector2d::Zero();
@@ -108,6 +115,10 @@ class NavigationLoop {
 
   void replan();
   void labelFrame(const core::PointCloud& cloud_world);
+  /// Fuses the points (x, y, z) as NonTraversable evidence.
+  void fuseNonTraversable(const std::vector<float>& x, const std::vector<float>& y,
+                          const std::vector<float>& z, const Eigen::Vector2d& robot_xy,
+                          double time_s);
 };
 
 }  // namespace upd::nav

@@ -214,7 +214,8 @@ class Terrain {
   std::optional<Eigen::Vector3d> walkCells(const Ray& ray, double t_in, double t_out,
                                            bool& to_sky) const;
   std::optional<Eigen::Vector3d> marchCell(const Ray& ray, double t, double t_end, double bound,
-                                           double march_dt, double& t_above) const;
+                                           double march_dt, double slope_bound,
+                                           double& t_above) const;
   static Shape orientedShape(const Eigen::Vector2d& origin, double yaw_rad);
   void addShape(const Shape& s);
   void rebuildIndex();
@@ -240,13 +241,18 @@ class Terrain {
   // Plane waves of the roughness: unit direction scaled by 2 pi / wavelength, phase, amplitude.
   std::vector<Eigen::Vector4d> waves_;
   double roughness_bound_m_ = 0.0;
+  double roughness_gradient_bound_ = 0.0;  ///< sum of amplitude x wavenumber: |grad h| <= this
   // Uniform grid over the extent: per cell the shapes whose footprint touches it (heights),
-  // those within border_m of it (truth) and an upper bound of the height (ray skipping).
+  // those within border_m of it (truth), an upper bound of the height (ray skipping) and one of
+  // the slope (cell_slope_).
   double cell_m_ = 0.25, inv_cell_ = 4.0;
   double max_height_m_ = 0.0;
   int nx_ = 1, ny_ = 1;
   std::vector<std::vector<std::uint32_t>> cell_shapes_, cell_near_shapes_;
   std::vector<double> cell_max_m_;
+  // Per cell an upper bound of the surface's slope |grad h| (infinity where an edge or a rock
+  // makes it unbounded): the ray caster's step length.
+  std::vector<double> cell_slope_;
 };
 
 /// A named world for simulation: terrain, default start pose and goal.
