@@ -91,7 +91,9 @@ TEST_F(NavScenario, RoughnessIndexBlocksTheRamp) {
   EXPECT_NE(r.end, RunEnd::GoalReached);
   EXPECT_LT(r.trajectory.back().z_m, 0.1);  // never got onto the platform
   EXPECT_EQ(maps::cellLabel(r.grid, 8.0, -1.4), core::Label::NonTraversable);
-  EXPECT_EQ(r.collision_steps, 0);
+  // Collisions are not asserted: looking for another way up, the baseline grazes the low end of
+  // the ramp's side wall, which the roughness index reads traversable (the benchmark's
+  // missed_obstacle; docs/NAVIGATION.md).
 }
 
 }  // namespace
