@@ -25,13 +25,17 @@ nlohmann::json readJson(const fs::path& p) {
   return nlohmann::json::parse(in);
 }
 
-// The shipped navigation config without the missing-ground evidence, which the live loop fuses
-// and `upd playback` does not (docs/SENSORS.md): with it off, both build the same map.
-std::string navConfigWithoutMissingGround(const upd::test::TempDir& dir) {
+// The shipped navigation config without what the live loop adds to the map and `upd playback`
+// does not (docs/SENSORS.md): the missing-ground evidence, the step edges and the navigator's own
+// d_m. With them off, both build the same map.
+std::string navConfigAsPlayback(const upd::test::TempDir& dir) {
   const fs::path config = fs::path(UPD_SOURCE_DIR) / "config";
   std::string text = upd::test::readFileBytes(config / "dune-nav.ini");
   text = std::regex_replace(text, std::regex("\\[NegativeObstacleParams\\]\\nenabled = true"),
                             "[NegativeObstacleParams]\nenabled = false");
+  text = std::regex_replace(text, std::regex("\\[StepEdgeParams\\]\\nenabled = true"),
+                            "[StepEdgeParams]\nenabled = false");
+  text = std::regex_replace(text, std::regex("\\nupd_radius_m = [0-9.]+"), "\nupd_radius_m = 0");
   text = std::regex_replace(text, std::regex("ptg_ini = ptg-dune.ini"),
                             "ptg_ini = " + (config / "ptg-dune.ini").string());
   const std::string path = dir.file("nav.ini");
@@ -64,7 +68,7 @@ TEST(LiveSensors, ARecordedStereoRunPlaysBackIntoTheSameMap) {
   const std::string config = (fs::path(UPD_SOURCE_DIR) / "config" / "dune-kinect.ini").string();
   const std::string rawlog = dir.file("run.rawlog");
   const auto live = runUpd("live --sensors " + ini + " --config " + config + " --nav-config " +
-                           navConfigWithoutMissingGround(dir) + " --output " + dir.file("live") +
+                           navConfigAsPlayback(dir) + " --output " + dir.file("live") +
                            " --record " + rawlog);
   ASSERT_EQ(live.exit_code, 0) << live.output;
   const auto summary = readJson(dir.path() / "live" / "summary.json");
