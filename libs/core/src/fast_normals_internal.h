@@ -44,7 +44,6 @@ bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature);
 typedef float LaneF __attribute__((vector_size(kScanLanes * sizeof(float))));
 
 typedef float LaneQ __attribute__((vector_size(4 * sizeof(float))));
-typedef std::int32_t LaneQi __attribute__((vector_size(4 * sizeof(std::int32_t))));
 
 inline void loadLanes(LaneF& v, const float* p) { std::memcpy(&v, p, sizeof v); }
 
@@ -84,7 +83,8 @@ static Moments gatedMoments(const float* X, const float* Y, const float* Z, std:
     std::memcpy(&lo, &v, sizeof lo);
     std::memcpy(&hi, reinterpret_cast<const char*>(&v) + sizeof lo, sizeof hi);
     const LaneQ s = lo + hi;  // s_l = v_l + v_(l+4)
-    const LaneQ p = s + __builtin_shuffle(s, LaneQi{1, 0, 3, 2});  // s0 + s1, ., s2 + s3, .
+    // GCC (12 on) and clang both have __builtin_shufflevector (GCC's __builtin_shuffle is not clang's).
+    const LaneQ p = s + __builtin_shufflevector(s, s, 1, 0, 3, 2);  // s0 + s1, ., s2 + s3, .
     return static_cast<double>(p[0] + p[2]);
   };
   Moments m;
