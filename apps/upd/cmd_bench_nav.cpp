@@ -4,7 +4,7 @@
 // world, the path pictures of each failure, and optionally a check against expected rows.
 #include "cli.h"
 #include "commands.h"
-#include "run_config.h"
+#include "nav_run_config.h"
 
 #include "upd/io/json_io.h"
 #include "upd/nav/bench.h"
@@ -93,16 +93,6 @@ BenchOptions parseOptions(const Args& args) {
   return o;
 }
 
-nav::NavConfig loadConfigs(const Args& args) {
-  const auto config_opt = args.str("--config");
-  const auto nav_opt = args.str("--nav-config");
-  const std::string config_path =
-      config_opt ? *config_opt : nav::defaultConfigDir() + "/dune-kinect.ini";
-  const std::string nav_path = nav_opt ? *nav_opt : nav::defaultConfigDir() + "/dune-nav.ini";
-  loadRunConfig(config_path);  // the shared robot config, checked strictly as every command does
-  return nav::loadNavConfig(config_path, nav_path);
-}
-
 void printRow(int k, int n, const nav::BenchRow& r) {
   std::printf("[%3d/%d] seed %d (%s, %s): %-9s %5.1f s (x%.2f)  %5.2f m (x%.2f)  clearance %.2f m",
               k, n, r.seed, r.difficulty.c_str(), r.obstacles.c_str(), nav::toString(r.outcome),
@@ -120,7 +110,7 @@ int runBenchNav(const std::vector<std::string>& argv) {
                    "--goal-distance-m", "--expect", "--tolerance", "--config", "--nav-config"},
                   {"--quiet", "--all-pictures"});
   const BenchOptions o = parseOptions(args);
-  const nav::NavConfig config = loadConfigs(args);
+  const nav::NavConfig config = loadNavConfigs(navConfigPaths(args));
   std::vector<nav::BenchRow> expected;
   if (o.expect) expected = nav::readBenchCsv(*o.expect);  // a bad file fails before the runs
   namespace fs = std::filesystem;

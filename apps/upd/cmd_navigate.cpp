@@ -3,7 +3,7 @@
 // and MRPT's reactive navigator, until the goal, a navigator error or the time limit.
 #include "cli.h"
 #include "commands.h"
-#include "run_config.h"
+#include "nav_run_config.h"
 
 #include "upd/nav/nav_config.h"
 #include "upd/nav/scenario.h"
@@ -59,14 +59,7 @@ int runNavigate(const std::vector<std::string>& argv) {
   }
   const sim::WorldSpec world = sim::makeWorld(*scenario);  // throws listing the valid names
 
-  // The shipped configs are looked up only for the files not given.
-  const auto config_opt = args.str("--config");
-  const auto nav_opt = args.str("--nav-config");
-  const std::string config_path =
-      config_opt ? *config_opt : nav::defaultConfigDir() + "/dune-kinect.ini";
-  const std::string nav_path = nav_opt ? *nav_opt : nav::defaultConfigDir() + "/dune-nav.ini";
-  loadRunConfig(config_path);  // the shared robot config, checked strictly as every command does
-  nav::NavConfig config = nav::loadNavConfig(config_path, nav_path);
+  nav::NavConfig config = loadNavConfigs(navConfigPaths(args));
   if (const auto t = args.number("--max-time-s")) {
     if (!(*t > 0))
       throw UsageError("option --max-time-s = " + std::to_string(*t) + ": must be > 0");

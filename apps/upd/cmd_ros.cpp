@@ -3,7 +3,7 @@
 // to ros::init, as roslaunch gives them.
 #include "cli.h"
 #include "commands.h"
-#include "run_config.h"
+#include "nav_run_config.h"
 
 #include "upd/nav/nav_config.h"
 
@@ -48,12 +48,7 @@ int runRos(const std::vector<std::string>& argv) {
 
   const Args args(rest, {"--config", "--nav-config"}, {"--exit-after-goal"});
   if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
-  const std::string config_path =
-      args.str("--config").value_or(nav::defaultConfigDir() + "/dune-kinect.ini");
-  const std::string nav_path =
-      args.str("--nav-config").value_or(nav::defaultConfigDir() + "/dune-nav.ini");
-  loadRunConfig(config_path);  // the shared robot config, checked strictly as every command does
-  const nav::NavConfig config = nav::loadNavConfig(config_path, nav_path);
+  const nav::NavConfig config = loadNavConfigs(navConfigPaths(args));
 
   if (!ros::master::check()) {
     throw std::runtime_error("no ROS master at " + ros::master::getURI() +

@@ -1,6 +1,7 @@
 #include "live_options.h"
 
 #include "cli.h"
+#include "nav_run_config.h"
 
 #include "upd/nav/nav_config.h"
 
@@ -59,8 +60,9 @@ LiveOptions parseLiveOptions(const std::vector<std::string>& argv_in) {
                    "--mount", "--base", "--screenshot"},
                   {"--view", "--auto-mount"});
   if (!args.positionals().empty()) throw UsageError("unexpected argument " + args.positionals()[0]);
-  o.config_path = args.str("--config").value_or(nav::defaultConfigDir() + "/dune-kinect.ini");
-  o.nav_path = args.str("--nav-config").value_or(nav::defaultConfigDir() + "/dune-nav.ini");
+  const NavConfigPaths configs = navConfigPaths(args);
+  o.config_path = configs.robot;
+  o.nav_path = configs.nav;
   o.oni = args.str("--oni").value_or("");
   o.sensors = args.str("--sensors").value_or("");
   o.sensor_section = args.str("--sensor-section").value_or("");

@@ -293,8 +293,8 @@ void Terrain::indexShape(std::size_t shape_index) {
     for (int k = 0; k < n; ++k) {
       const Eigen::Vector2d p = seg.a + (seg.b - seg.a) * (static_cast<double>(k) / n);
       const Eigen::Vector2d q = seg.a + (seg.b - seg.a) * (static_cast<double>(k + 1) / n);
-      const auto index = [&](double v, double lo, int cells) {
-        return std::clamp(static_cast<int>(std::floor((v - lo) / cell_m_)), 0, cells - 1);
+      const auto index = [&](double v, double origin, int cells) {
+        return std::clamp(static_cast<int>(std::floor((v - origin) / cell_m_)), 0, cells - 1);
       };
       const int ix0 = index(std::min(p.x(), q.x()) - kPad_m, min_xy_.x(), nx_);
       const int ix1 = index(std::max(p.x(), q.x()) + kPad_m, min_xy_.x(), nx_);
