@@ -54,7 +54,9 @@ std::size_t gatherWithin(const float* x, const float* y, const float* z, std::si
 /// distances cand[0, c) to the points within a bound (the point itself among them, at 0; the
 /// caller knows that no other point is nearer than the want-th); the want-th (squared) into kth.
 /// cand has room for c rounded up to a multiple of 8 and is reordered. On AVX2, where c - want
-/// is small, the c - want largest are dropped one at a time; otherwise a partial selection.
+/// is small, the c - want largest are dropped one at a time; where it is not, the candidates
+/// are first narrowed to a bound near the incoming kth (a guess: the previous point's; only the
+/// speed depends on it), then, if still many, a partial selection.
 double selectMean(float* cand, std::size_t c, std::size_t want, float& kth);
 
 /// The plain versions of the two, whatever the CPU (the tests compare them).

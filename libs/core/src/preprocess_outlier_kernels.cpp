@@ -107,13 +107,53 @@ __attribute__((target("avx2"))) inline __m256 maxAllLanes(__m256 v) {
   return _mm256_max_ps(v, _mm256_shuffle_ps(v, v, 0xb1));
 }
 
+// The candidates of cand[0, c) within the smallest of a few bounds around guess (squared,
+// spaced by a factor 1.6) that keeps at least want of them, packed to the front in order;
+// returns their number (c when no bound keeps want, or guess is not a positive number). Every
+// bound that keeps want keeps the want smallest, so the selection among the rest is the same.
+// cand has room for c rounded up to a multiple of 8.
+__attribute__((target("avx2,popcnt"))) std::size_t narrowAvx2(float* cand, std::size_t c,
+                                                              std::size_t want, float guess) {
+  constexpr int kBounds = 6;
+  constexpr float kFactor[kBounds] = {0.4f, 0.64f, 1.f, 1.6f, 2.56f, 4.1f};
+  if (!(guess > 0.f) || !(guess < std::numeric_limits<float>::max() / 8)) return c;
+  const std::size_t nv = (c + 7) / 8;
+  for (std::size_t j = c; j < nv * 8; ++j) cand[j] = std::numeric_limits<float>::infinity();
+  __m256 bound[kBounds];
+  for (int b = 0; b < kBounds; ++b) bound[b] = _mm256_set1_ps(guess * kFactor[b]);
+  std::size_t count[kBounds] = {};
+  for (std::size_t i = 0; i < nv; ++i) {
+    const __m256 d = _mm256_loadu_ps(cand + 8 * i);
+    for (int b = 0; b < kBounds; ++b) {
+      count[b] += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(
+          _mm256_movemask_ps(_mm256_cmp_ps(d, bound[b], _CMP_LE_OQ)))));
+    }
+  }
+  int pick = 0;
+  while (pick < kBounds && count[pick] < want) ++pick;
+  if (pick == kBounds || count[pick] == c) return c;
+  std::size_t kept = 0;  // (in place: a vector is stored at or before where it was read)
+  for (std::size_t i = 0; i < nv; ++i) {
+    const __m256 d = _mm256_loadu_ps(cand + 8 * i);
+    const auto m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(d, bound[pick], _CMP_LE_OQ)));
+    const __m256i idx = _mm256_cvtepu8_epi32(
+        _mm_cvtsi64_si128(static_cast<long long>(kCompressIndex[m])));
+    _mm256_storeu_ps(cand + kept, _mm256_permutevar8x32_ps(d, idx));
+    kept += static_cast<std::size_t>(__builtin_popcount(m));
+  }
+  return kept;
+}
+
 // By dropping the c - want largest one at a time (the candidates within the previous point's
 // bound exceed want by a few): each drop a maximum over a few vectors, no branch per candidate;
 // then the square roots of the rest summed a vector at a time. Many candidates (the first
-// point of a thread, a point settled by its block's margin): the partial selection.
+// point of a thread, a point gathered within its block's margin): first narrowed to those
+// within a bound near the incoming kth (the previous point's), then, if still many, the
+// partial selection.
 __attribute__((target("avx2,popcnt,bmi"))) double selectMeanAvx2(float* cand, std::size_t c,
                                                                  std::size_t want, float& kth) {
   constexpr std::size_t kMaxVectors = 8;
+  if (c - want > 16) c = narrowAvx2(cand, c, want, kth);
   const std::size_t nv = (c + 7) / 8;
   if (nv > kMaxVectors || c - want > 16) return selectMeanScalar(cand, c, want, kth);
   const float lowest = -std::numeric_limits<float>::infinity();
