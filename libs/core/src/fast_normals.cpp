@@ -223,6 +223,44 @@ Moments gaussianMoments(const std::vector<float>& cx, const std::vector<float>& 
   return m;
 }
 
+// The unit covariances of a thread's points, solved a batch at a time
+// (detail::normalsFromUnitCovariances) and written, oriented, to their cloud indices.
+class NormalBatch {
+ public:
+  // Adds the neighbourhood of point i; false when its covariance has no spread.
+  bool add(const Moments& m, std::size_t i) {
+    if (!detail::unitCovariance(m, cov_[size_])) return false;
+    index_[size_++] = i;
+    return true;
+  }
+  bool full() const { return size_ == kSize; }
+  // Solves and writes the batch; returns the number of points without a normal.
+  template <class Orient>
+  std::size_t flush(const PointCloud& cloud, const Orient& orient, Normals& out) {
+    detail::normalsFromUnitCovariances(cov_, size_, n_, curvature_, ok_);
+    std::size_t failed = 0;
+    for (std::size_t b = 0; b < size_; ++b) {
+      const std::size_t i = index_[b];
+      if (!ok_[b]) {
+        ++failed;
+        continue;
+      }
+      detail::setNormal(out, i, orient(n_[b], cloud.point(i)), curvature_[b]);
+    }
+    size_ = 0;
+    return failed;
+  }
+
+ private:
+  static constexpr std::size_t kSize = 64;
+  std::size_t size_ = 0;
+  double cov_[kSize][6];
+  std::size_t index_[kSize];
+  Eigen::Vector3f n_[kSize];
+  float curvature_[kSize];
+  std::uint8_t ok_[kSize];
+};
+
 }  // namespace
 
 Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
@@ -250,6 +288,7 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
 #pragma omp parallel reduction(+ : invalid)
   {
     std::vector<float> cx, cy, cz;
+    NormalBatch batch;
 #pragma omp for schedule(dynamic, 16)
     for (std::ptrdiff_t cc = 0; cc < n_cells; ++cc) {
       const auto c = static_cast<std::size_t>(cc);
@@ -265,16 +304,14 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
                      : detail::gatedMoments(cx.data(), cy.data(), cz.data(), n_rows, 0, 0, 0,
                                             n_candidates - 1, 1, p.x(), p.y(), p.z(), radius2);
         if (!gaussian) count = static_cast<std::size_t>(m.n);
-        Eigen::Vector3f n;
-        float curvature;
-        const std::size_t i = g.points.order[s];
-        if (count < 3 || !detail::normalFromMoments(m, n, curvature)) {
+        if (count < 3 || !batch.add(m, g.points.order[s])) {
           ++invalid;
           continue;
         }
-        detail::setNormal(out, i, orient(n, cloud.point(i)), curvature);
+        if (batch.full()) invalid += batch.flush(cloud, orient, out);
       }
     }
+    invalid += batch.flush(cloud, orient, out);
   }
   out.invalid = invalid;
   return out;
