@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <initializer_list>
 #include <string>
@@ -25,6 +26,27 @@ constexpr std::int64_t kKeyBias = std::int64_t(1) << 20;  ///< coordinates in [-
 inline bool keyFits(std::int64_t x, std::int64_t y, std::int64_t z) {
   return x >= -kKeyBias && x < kKeyBias && y >= -kKeyBias && y < kKeyBias && z >= -kKeyBias &&
          z < kKeyBias;
+}
+
+/// True when every cell within Chebyshev distance margin of (x, y, z) fits the key.
+inline bool keyFitsAround(const std::int32_t* xyz, std::int32_t margin) {
+  return keyFits(std::int64_t{xyz[0]} - margin, std::int64_t{xyz[1]} - margin,
+                 std::int64_t{xyz[2]} - margin) &&
+         keyFits(std::int64_t{xyz[0]} + margin, std::int64_t{xyz[1]} + margin,
+                 std::int64_t{xyz[2]} + margin);
+}
+
+/// Copies the points [b, e) of coordinate rows (x, y, z), sorted by cell, to (ox, oy, oz), 8 at
+/// a time: up to 7 values past e are read (the rows have that slack) and written (the caller
+/// overwrites them: the next run or its padding).
+inline void copyRunByEights(const float* x, const float* y, const float* z, std::uint32_t b,
+                            std::uint32_t e, float* ox, float* oy, float* oz) {
+  for (std::uint32_t t = b; t < e; t += 8) {
+    const std::size_t o = t - b;
+    std::memcpy(ox + o, x + t, sizeof(float) * 8);
+    std::memcpy(oy + o, y + t, sizeof(float) * 8);
+    std::memcpy(oz + o, z + t, sizeof(float) * 8);
+  }
 }
 
 inline std::uint64_t packKey(std::int64_t x, std::int64_t y, std::int64_t z) {

@@ -142,7 +142,7 @@ using detail::Moments;
 struct RadiusGrid {
   detail::CellGrid grid;
   detail::CellLists points;   // cloud indices by cell
-  std::vector<float> x, y, z;  // by cell: relative to the first finite point
+  std::vector<float> x, y, z;  // by cell: relative to the first finite point (then kFar slack)
 };
 
 void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, RadiusGrid& g) {
@@ -165,7 +165,8 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   detail::listByCell(
       N, g.grid.size(), [&](std::size_t i) { return cell_of[i]; }, g.points);
   const std::size_t n = g.points.order.size();
-  g.x.resize(n), g.y.resize(n), g.z.resize(n);
+  // (Slack for gatherAround's copies, 8 at a time; the candidate rows have kScanLanes = 8 more.)
+  g.x.assign(n + 8, kFar), g.y.assign(n + 8, kFar), g.z.assign(n + 8, kFar);
   for (std::size_t s = 0; s < n; ++s) {
     const Eigen::Vector3f q =
         (cloud.point(g.points.order[s]).cast<double>() - ref).cast<float>();
@@ -183,9 +184,11 @@ std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<floa
   std::size_t total = 0;
   const std::int32_t* xyz = g.grid.xyz(c);
   const std::vector<std::uint32_t>& start = g.points.start;
+  // (Away from the keys' bounds, as nearly always, the neighbours' keys need no range test.)
+  const bool inner = detail::keyFitsAround(xyz, 1);
   for (int d = 0; d < 27; ++d) {
-    const std::uint32_t id =
-        g.grid.find(xyz[0] + d % 3 - 1, xyz[1] + (d / 3) % 3 - 1, xyz[2] + d / 9 - 1);
+    const std::int32_t x = xyz[0] + d % 3 - 1, y = xyz[1] + (d / 3) % 3 - 1, z = xyz[2] + d / 9 - 1;
+    const std::uint32_t id = inner ? g.grid.findFitting(x, y, z) : g.grid.find(x, y, z);
     if (id == kNoIndex) continue;
     around[n_around++] = id;
     total += start[id + 1] - start[id];
@@ -197,7 +200,8 @@ std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<floa
   std::size_t m = 0;
   for (int a = 0; a < n_around; ++a) {
     const std::uint32_t b = start[around[a]], e = start[around[a] + 1];
-    for (std::uint32_t t = b; t < e; ++t, ++m) ox[m] = g.x[t], oy[m] = g.y[t], oz[m] = g.z[t];
+    detail::copyRunByEights(g.x.data(), g.y.data(), g.z.data(), b, e, ox + m, oy + m, oz + m);
+    m += e - b;
   }
   for (int l = 0; l < kScanLanes; ++l) ox[m + l] = oy[m + l] = oz[m + l] = kFar;
   return static_cast<std::ptrdiff_t>(total);
@@ -282,7 +286,7 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
   const bool gaussian = params.weighting == NormalWeighting::Gaussian;
   const float sigma = 0.5f * static_cast<float>(params.radius_m);
   const float inv_2s2 = 1.f / (2.f * sigma * sigma);
-  std::size_t invalid = N - g.x.size();
+  std::size_t invalid = N - g.points.order.size();
   const NormalOrienter orient(cloud.sensor_origin, up, params.vertical_band_rad);
   const auto n_cells = static_cast<std::ptrdiff_t>(g.grid.size());
 #pragma omp parallel reduction(+ : invalid)
