@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "upd/core/point_cloud.h"
@@ -42,6 +43,28 @@ class RangeBoxTest {
 /// appearance, colour averaged. Returns the number of points that passed.
 std::size_t voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* test,
                      PointCloud& out);
+
+/// No packed voxel key has its top bit: the key of a point that does not pass.
+constexpr std::uint64_t kNoKey = ~std::uint64_t(0);
+
+/// What the voxel grid's key pass needs: the anchor, the voxel's inverse edge and
+/// RangeBoxTest's bounds (a test that is off has infinite bounds, which every finite point
+/// passes).
+struct KeyPassParams {
+  double ref_x, ref_y, ref_z, inv;
+  float ox, oy, oz;  // sensor origin
+  double rmin2, rmax2;
+  float bx0, by0, bz0, bx1, by1, bz1;  // box
+};
+
+/// The voxel key of each of the n points (x, y, z) that passes (finite, kept by the range and
+/// box tests, each in RangeBoxTest's arithmetic) into keys, kNoKey for the others. Returns false
+/// when a passing point's voxel lies beyond the keys' range. On AVX2 by intrinsics, 8 points at
+/// a time; voxelKeysPlain is the compiler's vectorization of the plain loop, whatever the CPU.
+bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
+               const KeyPassParams& k, std::uint64_t* keys);
+bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t n,
+                    const KeyPassParams& k, std::uint64_t* keys);
 
 /// The outlier filter's candidates: the squared distances from (qx, qy, qz) to the n points
 /// (x, y, z)[j] (n a multiple of 8) that lie within t, in point order, into cand (room for n).
