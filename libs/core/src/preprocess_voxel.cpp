@@ -1,8 +1,8 @@
 // The voxel grid in one pass over the input, a row at a time: first the cut-off and the voxel
 // key of every point of the row in a vector loop (on AVX2 by intrinsics, 8 points at a time),
-// then the sums, each point's voxel found from
-// its left or upper neighbour's (organized frames: a voxel spans several pixels in a row and
-// several rows) before the hash map is asked, the sums per voxel in point order. Its output is
+// then the sums, each point's voxel found from its left or upper neighbour's (organized frames:
+// a voxel spans several pixels in a row and several rows) before the hash map is asked, the sums
+// per voxel in point order. Its output is
 // voxelDownsample's after cropRange, bit for bit (this file is built without contracting a
 // multiply and an add into one rounding, so that the vector loop's range test is cropRange's).
 #include <algorithm>
