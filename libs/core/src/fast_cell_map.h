@@ -55,6 +55,13 @@ inline std::uint64_t packKey(std::int64_t x, std::int64_t y, std::int64_t z) {
          (static_cast<std::uint64_t>(z + kKeyBias) << 42);
 }
 
+/// What packKey(x + dx, y + dy, z + dz) adds to packKey(x, y, z) where both fit the key (each
+/// 21-bit field stays within its bits: the sum carries into no other field).
+inline std::uint64_t keyOffset(std::int64_t dx, std::int64_t dy, std::int64_t dz) {
+  return static_cast<std::uint64_t>(dx + dy * (std::int64_t(1) << 21) +
+                                    dz * (std::int64_t(1) << 42));
+}
+
 /// Floor division for possibly negative lattice coordinates.
 inline std::int32_t floorDiv(std::int32_t a, std::int32_t b) {
   const std::int32_t q = a / b;
@@ -176,6 +183,8 @@ class CellGrid {
   std::uint32_t find(std::int64_t x, std::int64_t y, std::int64_t z) const {
     return keyFits(x, y, z) ? map_.find(packKey(x, y, z)) : kNoIndex;
   }
+  /// The id of the cell of a packed key, or kNoIndex.
+  std::uint32_t findKey(std::uint64_t key) const { return map_.find(key); }
   /// The same for coordinates the caller knows to fit the key (no range test).
   std::uint32_t findFitting(std::int32_t x, std::int32_t y, std::int32_t z) const {
     return map_.find(packKey(x, y, z));

@@ -184,11 +184,19 @@ std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<floa
   std::size_t total = 0;
   const std::int32_t* xyz = g.grid.xyz(c);
   const std::vector<std::uint32_t>& start = g.points.start;
-  // (Away from the keys' bounds, as nearly always, the neighbours' keys need no range test.)
+  // (Away from the keys' bounds, as nearly always, the neighbours' keys are the cell's plus
+  // an offset, with no range test.)
+  static const std::array<std::uint64_t, 27> offsets = [] {
+    std::array<std::uint64_t, 27> t{};
+    for (int d = 0; d < 27; ++d) t[d] = detail::keyOffset(d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1);
+    return t;
+  }();
   const bool inner = detail::keyFitsAround(xyz, 1);
+  const std::uint64_t key = inner ? detail::packKey(xyz[0], xyz[1], xyz[2]) : 0;
   for (int d = 0; d < 27; ++d) {
-    const std::int32_t x = xyz[0] + d % 3 - 1, y = xyz[1] + (d / 3) % 3 - 1, z = xyz[2] + d / 9 - 1;
-    const std::uint32_t id = inner ? g.grid.findFitting(x, y, z) : g.grid.find(x, y, z);
+    const std::uint32_t id =
+        inner ? g.grid.findKey(key + offsets[d])
+              : g.grid.find(xyz[0] + d % 3 - 1, xyz[1] + (d / 3) % 3 - 1, xyz[2] + d / 9 - 1);
     if (id == kNoIndex) continue;
     around[n_around++] = id;
     total += start[id + 1] - start[id];

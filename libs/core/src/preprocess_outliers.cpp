@@ -303,12 +303,15 @@ class CellSearch {
   // out.
   void shell(int ring, std::vector<std::uint32_t>& out) const {
     out.clear();
-    // (Away from the keys' bounds, as nearly always, the keys need no range test.)
+    // (Away from the keys' bounds, as nearly always, the keys are the cell's plus an offset,
+    // with no range test.)
     const std::int32_t xyz[3] = {cx_, cy_, cz_};
     const bool inner = detail::keyFitsAround(xyz, ring);
+    const std::uint64_t key = inner ? detail::packKey(cx_, cy_, cz_) : 0;
     for (const auto& d : shellOffsets(ring)) {
-      const std::int32_t x = cx_ + d[0], y = cy_ + d[1], z = cz_ + d[2];
-      const std::uint32_t c = inner ? g_->cells.findFitting(x, y, z) : g_->find(x, y, z);
+      const std::uint32_t c =
+          inner ? g_->cells.findKey(key + detail::keyOffset(d[0], d[1], d[2]))
+                : g_->find(cx_ + d[0], cy_ + d[1], cz_ + d[2]);
       if (c != detail::kNoIndex) out.push_back(c);
     }
   }
