@@ -76,7 +76,7 @@ TEST(PreprocessKernels, SelectMeanIsTheMeanOfTheNearestWithTies) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(0.f, 0.01f);
   for (int trial = 0; trial < 600; ++trial) {
-    const std::size_t want = 2 + static_cast<std::size_t>(trial % 30);
+    const std::size_t want = 2 + static_cast<std::size_t>(trial % 50);  // (up to 9 vectors)
     // Mostly a few more candidates than wanted (the drop path), sometimes many (the selection).
     const std::size_t extra = trial % 7 == 0 ? 40 + static_cast<std::size_t>(trial % 50)
                                              : static_cast<std::size_t>(trial % 19);
