@@ -34,7 +34,6 @@ constexpr double kMaxDouble = std::numeric_limits<double>::max();
 
 UPD_AVX2 inline __m256d ge(__m256d a, __m256d b) { return _mm256_cmp_pd(a, b, _CMP_GE_OQ); }
 UPD_AVX2 inline __m256d gt(__m256d a, __m256d b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
-UPD_AVX2 inline __m256d lt(__m256d a, __m256d b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
 // m ? a : b, lane by lane.
 UPD_AVX2 inline __m256d pick(__m256d m, __m256d a, __m256d b) { return _mm256_blendv_pd(b, a, m); }
 // std::max(0.0, v): v where 0 < v, else 0 (NaN too).
