@@ -2,11 +2,14 @@
 // it), against their plain versions and a reference in double: gatherWithin keeps exactly the
 // points within the bound, in point order; selectMean gives
 // the mean of the square roots of the want smallest and the want-th, with ties, few candidates
-// and many. Fixed seeds.
+// and many, whatever the guess of the want-th it is given; the voxel grid's key pass gives the
+// plain loop's keys. Fixed seeds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -73,7 +76,7 @@ TEST(PreprocessKernels, SelectMeanIsTheMeanOfTheNearestWithTies) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(0.f, 0.01f);
   for (int trial = 0; trial < 600; ++trial) {
-    const std::size_t want = 2 + static_cast<std::size_t>(trial % 30);
+    const std::size_t want = 2 + static_cast<std::size_t>(trial % 50);  // (up to 9 vectors)
     // Mostly a few more candidates than wanted (the drop path), sometimes many (the selection).
     const std::size_t extra = trial % 7 == 0 ? 40 + static_cast<std::size_t>(trial % 50)
                                              : static_cast<std::size_t>(trial % 19);
@@ -96,13 +99,65 @@ TEST(PreprocessKernels, SelectMeanIsTheMeanOfTheNearestWithTies) {
     for (const bool plain : {false, true}) {
       std::vector<float> buf(c + 8);
       std::copy(cand.begin(), cand.end(), buf.begin());
-      float kth = -1.f;
+      // The incoming kth is a guess of the want-th (only the speed depends on it): near it,
+      // far on either side, or none.
+      const float guess[] = {-1.f, 0.2f, 0.6f, 1.f, 1.7f, 5.f,
+                             std::numeric_limits<float>::infinity()};
+      float kth = static_cast<float>(sorted[want - 1]) * guess[(trial / 7) % 7];
       const double got = plain ? detail::selectMeanPlain(buf.data(), c, want, kth)
                                : detail::selectMean(buf.data(), c, want, kth);
       EXPECT_NEAR(got, mean, 1e-12 * mean) << "trial " << trial << (plain ? " plain" : "");
       EXPECT_EQ(kth, static_cast<float>(sorted[want - 1])) << "trial " << trial;
     }
   }
+}
+
+// The voxel grid's key pass on AVX2 against the plain loop: the same key for every point (NaN,
+// infinite, on the range's and the box's bounds, beyond the keys' range), the same answer on
+// whether every passing point's voxel fits the key, at every length (the vector part and the
+// rest).
+TEST(PreprocessKernels, VoxelKeysAreThePlainLoopsKeys) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> u(-6.f, 6.f);
+  const float nan = std::numeric_limits<float>::quiet_NaN(),
+              inf = std::numeric_limits<float>::infinity();
+  int refused = 0, passed = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    detail::KeyPassParams k{};
+    k.ref_x = u(rng), k.ref_y = u(rng), k.ref_z = u(rng);
+    k.inv = 1.0 / (trial % 10 == 9 ? 1e-6 : 0.005 + 0.05 * (trial % 5));  // (1e-6: keys overflow)
+    k.ox = u(rng) * 0.1f, k.oy = u(rng) * 0.1f, k.oz = u(rng) * 0.1f;
+    const bool range = trial % 3 != 0, box = trial % 4 == 1;
+    k.rmin2 = range ? 0.16 : -std::numeric_limits<double>::infinity();
+    k.rmax2 = range ? 25.0 : std::numeric_limits<double>::infinity();
+    k.bx0 = box ? -3.f : -inf, k.by0 = box ? -2.f : -inf, k.bz0 = box ? -1.f : -inf;
+    k.bx1 = box ? 3.f : inf, k.by1 = box ? 2.f : inf, k.bz1 = box ? 4.f : inf;
+    const std::size_t n = static_cast<std::size_t>(trial % 70);
+    std::vector<float> x(n), y(n), z(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      x[j] = u(rng), y[j] = u(rng), z[j] = u(rng);
+      switch ((j + static_cast<std::size_t>(trial)) % 11) {
+        case 0: x[j] = nan; break;
+        case 1: z[j] = -inf; break;
+        case 2: x[j] = k.ox + 5.f, y[j] = k.oy, z[j] = k.oz; break;  // on the range's bound
+        case 3: x[j] = k.bx0; break;                                // on the box's bound
+        case 4: y[j] = static_cast<float>(k.ref_y + 7 / k.inv); break;  // on a voxel face
+        default: break;
+      }
+    }
+    std::vector<std::uint64_t> got(n, 1), want(n, 2);
+    const bool ok = detail::voxelKeys(x.data(), y.data(), z.data(), n, k, got.data());
+    const bool ok_plain = detail::voxelKeysPlain(x.data(), y.data(), z.data(), n, k, want.data());
+    ASSERT_EQ(ok, ok_plain) << "trial " << trial;
+    refused += ok ? 0 : 1;
+    if (!ok) continue;  // (the caller throws: the keys are not used)
+    for (std::size_t j = 0; j < n; ++j) {
+      ASSERT_EQ(got[j], want[j]) << "trial " << trial << ", point " << j;
+      passed += want[j] != detail::kNoKey ? 1 : 0;
+    }
+  }
+  EXPECT_GT(refused, 10);
+  EXPECT_GT(passed, 1000);
 }
 
 }  // namespace

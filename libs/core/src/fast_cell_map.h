@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <initializer_list>
 #include <string>
@@ -27,10 +28,38 @@ inline bool keyFits(std::int64_t x, std::int64_t y, std::int64_t z) {
          z < kKeyBias;
 }
 
+/// True when every cell within Chebyshev distance margin of (x, y, z) fits the key.
+inline bool keyFitsAround(const std::int32_t* xyz, std::int32_t margin) {
+  return keyFits(std::int64_t{xyz[0]} - margin, std::int64_t{xyz[1]} - margin,
+                 std::int64_t{xyz[2]} - margin) &&
+         keyFits(std::int64_t{xyz[0]} + margin, std::int64_t{xyz[1]} + margin,
+                 std::int64_t{xyz[2]} + margin);
+}
+
+/// Copies the points [b, e) of coordinate rows (x, y, z), sorted by cell, to (ox, oy, oz), 8 at
+/// a time: up to 7 values past e are read (the rows have that slack) and written (the caller
+/// overwrites them: the next run or its padding).
+inline void copyRunByEights(const float* x, const float* y, const float* z, std::uint32_t b,
+                            std::uint32_t e, float* ox, float* oy, float* oz) {
+  for (std::uint32_t t = b; t < e; t += 8) {
+    const std::size_t o = t - b;
+    std::memcpy(ox + o, x + t, sizeof(float) * 8);
+    std::memcpy(oy + o, y + t, sizeof(float) * 8);
+    std::memcpy(oz + o, z + t, sizeof(float) * 8);
+  }
+}
+
 inline std::uint64_t packKey(std::int64_t x, std::int64_t y, std::int64_t z) {
   return static_cast<std::uint64_t>(x + kKeyBias) |
          (static_cast<std::uint64_t>(y + kKeyBias) << 21) |
          (static_cast<std::uint64_t>(z + kKeyBias) << 42);
+}
+
+/// What packKey(x + dx, y + dy, z + dz) adds to packKey(x, y, z) where both fit the key (each
+/// 21-bit field stays within its bits: the sum carries into no other field).
+inline std::uint64_t keyOffset(std::int64_t dx, std::int64_t dy, std::int64_t dz) {
+  return static_cast<std::uint64_t>(dx + dy * (std::int64_t(1) << 21) +
+                                    dz * (std::int64_t(1) << 42));
 }
 
 /// Floor division for possibly negative lattice coordinates.
@@ -154,6 +183,8 @@ class CellGrid {
   std::uint32_t find(std::int64_t x, std::int64_t y, std::int64_t z) const {
     return keyFits(x, y, z) ? map_.find(packKey(x, y, z)) : kNoIndex;
   }
+  /// The id of the cell of a packed key, or kNoIndex.
+  std::uint32_t findKey(std::uint64_t key) const { return map_.find(key); }
   /// The same for coordinates the caller knows to fit the key (no range test).
   std::uint32_t findFitting(std::int32_t x, std::int32_t y, std::int32_t z) const {
     return map_.find(packKey(x, y, z));

@@ -142,7 +142,7 @@ using detail::Moments;
 struct RadiusGrid {
   detail::CellGrid grid;
   detail::CellLists points;   // cloud indices by cell
-  std::vector<float> x, y, z;  // by cell: relative to the first finite point
+  std::vector<float> x, y, z;  // by cell: relative to the first finite point (then kFar slack)
 };
 
 void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, RadiusGrid& g) {
@@ -165,7 +165,8 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   detail::listByCell(
       N, g.grid.size(), [&](std::size_t i) { return cell_of[i]; }, g.points);
   const std::size_t n = g.points.order.size();
-  g.x.resize(n), g.y.resize(n), g.z.resize(n);
+  // (Slack for gatherAround's copies, 8 at a time; the candidate rows have kScanLanes = 8 more.)
+  g.x.assign(n + 8, kFar), g.y.assign(n + 8, kFar), g.z.assign(n + 8, kFar);
   for (std::size_t s = 0; s < n; ++s) {
     const Eigen::Vector3f q =
         (cloud.point(g.points.order[s]).cast<double>() - ref).cast<float>();
@@ -183,9 +184,19 @@ std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<floa
   std::size_t total = 0;
   const std::int32_t* xyz = g.grid.xyz(c);
   const std::vector<std::uint32_t>& start = g.points.start;
+  // (Away from the keys' bounds, as nearly always, the neighbours' keys are the cell's plus
+  // an offset, with no range test.)
+  static const std::array<std::uint64_t, 27> offsets = [] {
+    std::array<std::uint64_t, 27> t{};
+    for (int d = 0; d < 27; ++d) t[d] = detail::keyOffset(d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1);
+    return t;
+  }();
+  const bool inner = detail::keyFitsAround(xyz, 1);
+  const std::uint64_t key = inner ? detail::packKey(xyz[0], xyz[1], xyz[2]) : 0;
   for (int d = 0; d < 27; ++d) {
     const std::uint32_t id =
-        g.grid.find(xyz[0] + d % 3 - 1, xyz[1] + (d / 3) % 3 - 1, xyz[2] + d / 9 - 1);
+        inner ? g.grid.findKey(key + offsets[d])
+              : g.grid.find(xyz[0] + d % 3 - 1, xyz[1] + (d / 3) % 3 - 1, xyz[2] + d / 9 - 1);
     if (id == kNoIndex) continue;
     around[n_around++] = id;
     total += start[id + 1] - start[id];
@@ -197,7 +208,8 @@ std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<floa
   std::size_t m = 0;
   for (int a = 0; a < n_around; ++a) {
     const std::uint32_t b = start[around[a]], e = start[around[a] + 1];
-    for (std::uint32_t t = b; t < e; ++t, ++m) ox[m] = g.x[t], oy[m] = g.y[t], oz[m] = g.z[t];
+    detail::copyRunByEights(g.x.data(), g.y.data(), g.z.data(), b, e, ox + m, oy + m, oz + m);
+    m += e - b;
   }
   for (int l = 0; l < kScanLanes; ++l) ox[m + l] = oy[m + l] = oz[m + l] = kFar;
   return static_cast<std::ptrdiff_t>(total);
@@ -223,6 +235,44 @@ Moments gaussianMoments(const std::vector<float>& cx, const std::vector<float>& 
   return m;
 }
 
+// The unit covariances of a thread's points, solved a batch at a time
+// (detail::normalsFromUnitCovariances) and written, oriented, to their cloud indices.
+class NormalBatch {
+ public:
+  // Adds the neighbourhood of point i; false when its covariance has no spread.
+  bool add(const Moments& m, std::size_t i) {
+    if (!detail::unitCovariance(m, cov_[size_])) return false;
+    index_[size_++] = i;
+    return true;
+  }
+  bool full() const { return size_ == kSize; }
+  // Solves and writes the batch; returns the number of points without a normal.
+  template <class Orient>
+  std::size_t flush(const PointCloud& cloud, const Orient& orient, Normals& out) {
+    detail::normalsFromUnitCovariances(cov_, size_, n_, curvature_, ok_);
+    std::size_t failed = 0;
+    for (std::size_t b = 0; b < size_; ++b) {
+      const std::size_t i = index_[b];
+      if (!ok_[b]) {
+        ++failed;
+        continue;
+      }
+      detail::setNormal(out, i, orient(n_[b], cloud.point(i)), curvature_[b]);
+    }
+    size_ = 0;
+    return failed;
+  }
+
+ private:
+  static constexpr std::size_t kSize = 64;
+  std::size_t size_ = 0;
+  double cov_[kSize][6];
+  std::size_t index_[kSize];
+  Eigen::Vector3f n_[kSize];
+  float curvature_[kSize];
+  std::uint8_t ok_[kSize];
+};
+
 }  // namespace
 
 Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
@@ -244,12 +294,13 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
   const bool gaussian = params.weighting == NormalWeighting::Gaussian;
   const float sigma = 0.5f * static_cast<float>(params.radius_m);
   const float inv_2s2 = 1.f / (2.f * sigma * sigma);
-  std::size_t invalid = N - g.x.size();
+  std::size_t invalid = N - g.points.order.size();
   const NormalOrienter orient(cloud.sensor_origin, up, params.vertical_band_rad);
   const auto n_cells = static_cast<std::ptrdiff_t>(g.grid.size());
 #pragma omp parallel reduction(+ : invalid)
   {
     std::vector<float> cx, cy, cz;
+    NormalBatch batch;
 #pragma omp for schedule(dynamic, 16)
     for (std::ptrdiff_t cc = 0; cc < n_cells; ++cc) {
       const auto c = static_cast<std::size_t>(cc);
@@ -265,16 +316,14 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
                      : detail::gatedMoments(cx.data(), cy.data(), cz.data(), n_rows, 0, 0, 0,
                                             n_candidates - 1, 1, p.x(), p.y(), p.z(), radius2);
         if (!gaussian) count = static_cast<std::size_t>(m.n);
-        Eigen::Vector3f n;
-        float curvature;
-        const std::size_t i = g.points.order[s];
-        if (count < 3 || !detail::normalFromMoments(m, n, curvature)) {
+        if (count < 3 || !batch.add(m, g.points.order[s])) {
           ++invalid;
           continue;
         }
-        detail::setNormal(out, i, orient(n, cloud.point(i)), curvature);
+        if (batch.full()) invalid += batch.flush(cloud, orient, out);
       }
     }
+    invalid += batch.flush(cloud, orient, out);
   }
   out.invalid = invalid;
   return out;

@@ -35,6 +35,11 @@ bool unitCovariance(const Moments& m, double (&cov)[6]);
 // or false for a neighbourhood without a plane (lambda_1 ~ 0, as pcaNormal).
 bool normalFromUnitCovariance(const double (&cov)[6], Eigen::Vector3f& n, float& curvature);
 
+// normalFromUnitCovariance for cov[0, count): ok[i] is 1 where it gives n[i] and curvature[i],
+// 0 where it returns false; the same values bit for bit, four at a time on AVX2.
+void normalsFromUnitCovariances(const double (*cov)[6], std::size_t count, Eigen::Vector3f* n,
+                                float* curvature, std::uint8_t* ok);
+
 // The same from the moments of a neighbourhood (m.n is the sum of the weights). The caller
 // checks that there are at least 3 points.
 bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature);
@@ -53,7 +58,7 @@ inline void loadLanes(LaneF& v, const float* p) { std::memcpy(&v, p, sizeof v); 
 // vector at a time) are real points of the cloud or kFar padding, and the ones within the
 // radius are neighbours of p like any other (the window only bounds the ball).
 UPD_VECTOR_CLONES
-static Moments gatedMoments(const float* X, const float* Y, const float* Z, std::size_t W,
+[[maybe_unused]] static Moments gatedMoments(const float* X, const float* Y, const float* Z, std::size_t W,
                             std::ptrdiff_t v0, std::ptrdiff_t v1, std::ptrdiff_t a0,
                             std::ptrdiff_t a1, std::ptrdiff_t row_step, float px, float py,
                             float pz, float radius2) {

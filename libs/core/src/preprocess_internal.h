@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "upd/core/point_cloud.h"
@@ -43,6 +44,28 @@ class RangeBoxTest {
 std::size_t voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* test,
                      PointCloud& out);
 
+/// No packed voxel key has its top bit: the key of a point that does not pass.
+constexpr std::uint64_t kNoKey = ~std::uint64_t(0);
+
+/// What the voxel grid's key pass needs: the anchor, the voxel's inverse edge and
+/// RangeBoxTest's bounds (a test that is off has infinite bounds, which every finite point
+/// passes).
+struct KeyPassParams {
+  double ref_x, ref_y, ref_z, inv;
+  float ox, oy, oz;  // sensor origin
+  double rmin2, rmax2;
+  float bx0, by0, bz0, bx1, by1, bz1;  // box
+};
+
+/// The voxel key of each of the n points (x, y, z) that passes (finite, kept by the range and
+/// box tests, each in RangeBoxTest's arithmetic) into keys, kNoKey for the others. Returns false
+/// when a passing point's voxel lies beyond the keys' range. On AVX2 by intrinsics, 8 points at
+/// a time; voxelKeysPlain is the compiler's vectorization of the plain loop, whatever the CPU.
+bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
+               const KeyPassParams& k, std::uint64_t* keys);
+bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t n,
+                    const KeyPassParams& k, std::uint64_t* keys);
+
 /// The outlier filter's candidates: the squared distances from (qx, qy, qz) to the n points
 /// (x, y, z)[j] (n a multiple of 8) that lie within t, in point order, into cand (room for n).
 /// Returns their number. On AVX2 a vector of distances at a time, its lanes within t packed to
@@ -54,7 +77,9 @@ std::size_t gatherWithin(const float* x, const float* y, const float* z, std::si
 /// distances cand[0, c) to the points within a bound (the point itself among them, at 0; the
 /// caller knows that no other point is nearer than the want-th); the want-th (squared) into kth.
 /// cand has room for c rounded up to a multiple of 8 and is reordered. On AVX2, where c - want
-/// is small, the c - want largest are dropped one at a time; otherwise a partial selection.
+/// is small, the c - want largest are dropped one at a time; where it is not, the candidates
+/// are first narrowed to a bound near the incoming kth (a guess: the previous point's; only the
+/// speed depends on it), then, if still many, a partial selection.
 double selectMean(float* cand, std::size_t c, std::size_t want, float& kth);
 
 /// The plain versions of the two, whatever the CPU (the tests compare them).

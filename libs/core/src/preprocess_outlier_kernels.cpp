@@ -107,29 +107,63 @@ __attribute__((target("avx2"))) inline __m256 maxAllLanes(__m256 v) {
   return _mm256_max_ps(v, _mm256_shuffle_ps(v, v, 0xb1));
 }
 
-// By dropping the c - want largest one at a time (the candidates within the previous point's
-// bound exceed want by a few): each drop a maximum over a few vectors, no branch per candidate;
-// then the square roots of the rest summed a vector at a time. Many candidates (the first
-// point of a thread, a point settled by its block's margin): the partial selection.
-__attribute__((target("avx2,popcnt,bmi"))) double selectMeanAvx2(float* cand, std::size_t c,
-                                                                 std::size_t want, float& kth) {
-  constexpr std::size_t kMaxVectors = 8;
+// The candidates of cand[0, c) within the smallest of a few bounds around guess (squared,
+// spaced by a factor 1.6) that keeps at least want of them, packed to the front in order;
+// returns their number (c when no bound keeps want, or guess is not a positive number). Every
+// bound that keeps want keeps the want smallest, so the selection among the rest is the same.
+// cand has room for c rounded up to a multiple of 8.
+__attribute__((target("avx2,popcnt"))) std::size_t narrowAvx2(float* cand, std::size_t c,
+                                                              std::size_t want, float guess) {
+  constexpr int kBounds = 6;
+  constexpr float kFactor[kBounds] = {0.4f, 0.64f, 1.f, 1.6f, 2.56f, 4.1f};
+  if (!(guess > 0.f) || !(guess < std::numeric_limits<float>::max() / 8)) return c;
   const std::size_t nv = (c + 7) / 8;
-  if (nv > kMaxVectors || c - want > 16) return selectMeanScalar(cand, c, want, kth);
-  const float lowest = -std::numeric_limits<float>::infinity();
-  for (std::size_t j = c; j < nv * 8; ++j) cand[j] = lowest;
-  __m256 v[kMaxVectors];
-  for (std::size_t i = 0; i < nv; ++i) v[i] = _mm256_loadu_ps(cand + 8 * i);
+  for (std::size_t j = c; j < nv * 8; ++j) cand[j] = std::numeric_limits<float>::infinity();
+  __m256 bound[kBounds];
+  for (int b = 0; b < kBounds; ++b) bound[b] = _mm256_set1_ps(guess * kFactor[b]);
+  std::size_t count[kBounds] = {};
+  for (std::size_t i = 0; i < nv; ++i) {
+    const __m256 d = _mm256_loadu_ps(cand + 8 * i);
+    for (int b = 0; b < kBounds; ++b) {
+      count[b] += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(
+          _mm256_movemask_ps(_mm256_cmp_ps(d, bound[b], _CMP_LE_OQ)))));
+    }
+  }
+  int pick = 0;
+  while (pick < kBounds && count[pick] < want) ++pick;
+  if (pick == kBounds || count[pick] == c) return c;
+  std::size_t kept = 0;  // (in place: a vector is stored at or before where it was read)
+  for (std::size_t i = 0; i < nv; ++i) {
+    const __m256 d = _mm256_loadu_ps(cand + 8 * i);
+    const auto m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(d, bound[pick], _CMP_LE_OQ)));
+    const __m256i idx = _mm256_cvtepu8_epi32(
+        _mm_cvtsi64_si128(static_cast<long long>(kCompressIndex[m])));
+    _mm256_storeu_ps(cand + kept, _mm256_permutevar8x32_ps(d, idx));
+    kept += static_cast<std::size_t>(__builtin_popcount(m));
+  }
+  return kept;
+}
+
+// selectMeanAvx2's drops and sum over NV vectors (a count known when compiled, so that the
+// vectors stay in registers): cand[0, c) with 8 (NV - 1) < c <= 8 NV, the lanes past c -inf.
+template <std::size_t NV>
+__attribute__((target("avx2,popcnt,bmi"))) double dropAndSum(const float* cand, std::size_t c,
+                                                             std::size_t want, float& kth) {
   const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256 lowest_v = _mm256_set1_ps(lowest);
+  const __m256 lowest_v = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
+  __m256 v[NV];
+  for (std::size_t i = 0; i < NV; ++i) v[i] = _mm256_loadu_ps(cand + 8 * i);
+  const __m256i in_last = _mm256_cmpgt_epi32(
+      _mm256_set1_epi32(static_cast<int>(c - 8 * (NV - 1))), lane_index);
+  v[NV - 1] = _mm256_blendv_ps(lowest_v, v[NV - 1], _mm256_castsi256_ps(in_last));
   __m256 top = lowest_v;
   for (std::size_t drop = 0; drop <= c - want; ++drop) {
     __m256 m = v[0];
-    for (std::size_t i = 1; i < nv; ++i) m = _mm256_max_ps(m, v[i]);
+    for (std::size_t i = 1; i < NV; ++i) m = _mm256_max_ps(m, v[i]);
     top = maxAllLanes(m);
     if (drop == c - want) break;  // (top: the want-th, the largest left)
     // One instance of the largest goes (ties: the others stay, as in a selection).
-    for (std::size_t i = 0; i < nv; ++i) {
+    for (std::size_t i = 0; i < NV; ++i) {
       const auto eq = static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(v[i], top, _CMP_EQ_OQ)));
       if (eq == 0) continue;
       const __m256i lane = _mm256_set1_epi32(static_cast<int>(__builtin_ctz(eq)));
@@ -140,7 +174,7 @@ __attribute__((target("avx2,popcnt,bmi"))) double selectMeanAvx2(float* cand, st
   // The dropped and the padding are -inf: 0 after the max with 0, adding nothing.
   const __m256 zero = _mm256_setzero_ps();
   __m256d sum = _mm256_setzero_pd();
-  for (std::size_t i = 0; i < nv; ++i) {
+  for (std::size_t i = 0; i < NV; ++i) {
     const __m256 d = _mm256_max_ps(v[i], zero);
     sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(d))));
     sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(d, 1))));
@@ -149,6 +183,29 @@ __attribute__((target("avx2,popcnt,bmi"))) double selectMeanAvx2(float* cand, st
   _mm256_store_pd(lanes, sum);
   kth = _mm_cvtss_f32(_mm256_castps256_ps128(top));
   return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) / static_cast<double>(want - 1);
+}
+
+// By dropping the c - want largest one at a time (the candidates within the previous point's
+// bound exceed want by a few): each drop a maximum over a few vectors, no branch per candidate;
+// then the square roots of the rest summed a vector at a time. Many candidates (the first
+// point of a thread, a point gathered within its block's margin): first narrowed to those
+// within a bound near the incoming kth (the previous point's), then, if still many, the
+// partial selection.
+__attribute__((target("avx2,popcnt,bmi"))) double selectMeanAvx2(float* cand, std::size_t c,
+                                                                 std::size_t want, float& kth) {
+  if (c - want > 16) c = narrowAvx2(cand, c, want, kth);
+  if (c - want > 16) return selectMeanScalar(cand, c, want, kth);
+  switch ((c + 7) / 8) {
+    case 1: return dropAndSum<1>(cand, c, want, kth);
+    case 2: return dropAndSum<2>(cand, c, want, kth);
+    case 3: return dropAndSum<3>(cand, c, want, kth);
+    case 4: return dropAndSum<4>(cand, c, want, kth);
+    case 5: return dropAndSum<5>(cand, c, want, kth);
+    case 6: return dropAndSum<6>(cand, c, want, kth);
+    case 7: return dropAndSum<7>(cand, c, want, kth);
+    case 8: return dropAndSum<8>(cand, c, want, kth);
+    default: return selectMeanScalar(cand, c, want, kth);
+  }
 }
 
 SelectMeanFn pickSelectMean() {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -28,6 +29,11 @@ inline void cellOf(const PointCloud& in, std::uint32_t i, std::uint32_t f0, doub
   c[2] = detail::floorToInt(static_cast<double>(in.z[i] - in.z[f0]) * inv_h);
 }
 
+// Coordinates of the padding: their distances are huge and never kept.
+constexpr float kFarPoint = 1e18f;
+// The slack of the rows for copyRunByEights.
+constexpr std::size_t kCopyLanes = 8;
+
 // The finite points binned into cubic cells of edge h (anchored at the first finite point, as
 // the fast UPD's lattice): cell ids from the CellGrid, and the points' coordinates relative
 // to the anchor sorted by cell (counting sort), with their cloud indices.
@@ -36,7 +42,7 @@ struct PointGrid {
   float ox = 0, oy = 0, oz = 0;  // anchor
   detail::CellGrid cells;
   std::vector<std::uint32_t> start;  // n_cells + 1
-  std::vector<float> x, y, z;        // by cell
+  std::vector<float> x, y, z;        // by cell (then kCopyLanes of slack)
   std::vector<std::uint32_t> index;  // by cell: the cloud's index
   std::vector<std::uint32_t> cell_of;  // (buildGrid's buffers)
   detail::CellLists by_cell;
@@ -77,7 +83,10 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   detail::listByCell(
       finite.size(), g.cells.size(), [&](std::size_t f) { return cell_of[f]; }, by_cell);
   g.start.assign(by_cell.start.begin(), by_cell.start.end());
-  g.x.resize(finite.size()), g.y.resize(finite.size()), g.z.resize(finite.size());
+  // (kCopyLanes of slack: BlockPoints::fill copies 8 at a time.)
+  const std::size_t rows = finite.size() + kCopyLanes;
+  g.x.resize(rows), g.y.resize(rows), g.z.resize(rows);
+  for (std::size_t j = finite.size(); j < rows; ++j) g.x[j] = g.y[j] = g.z[j] = kFarPoint;
   g.index.resize(finite.size());
   for (std::size_t j = 0; j < finite.size(); ++j) {
     const std::uint32_t i = finite[by_cell.order[j]];
@@ -133,25 +142,26 @@ class NearestK {
   float d_[kMax];
 };
 
-// The points of a block of cells as one structure of arrays, padded to a multiple of 16 with
-// far-away points (their distances are huge and never kept).
+// The points of a block of cells as one structure of arrays, padded to a multiple of 16 (cap)
+// with far-away points.
 struct BlockPoints {
   std::vector<float> x, y, z;
-  std::size_t n = 0;
+  std::size_t n = 0, cap = 0;
   void fill(const PointGrid& g, const std::vector<std::uint32_t>& cells) {
     n = 0;
     for (const std::uint32_t c : cells) n += g.start[c + 1] - g.start[c];
-    const std::size_t cap = (n + 15) / 16 * 16;
-    x.resize(cap), y.resize(cap), z.resize(cap);
+    cap = (n + 15) / 16 * 16;
+    if (x.size() < cap + kCopyLanes) {
+      x.resize(cap + kCopyLanes), y.resize(cap + kCopyLanes), z.resize(cap + kCopyLanes);
+    }
+    float *bx = x.data(), *by = y.data(), *bz = z.data();
     std::size_t j = 0;
     for (const std::uint32_t c : cells) {
       const std::uint32_t b = g.start[c], e = g.start[c + 1];
-      std::copy(&g.x[b], &g.x[b] + (e - b), &x[j]);
-      std::copy(&g.y[b], &g.y[b] + (e - b), &y[j]);
-      std::copy(&g.z[b], &g.z[b] + (e - b), &z[j]);
+      detail::copyRunByEights(g.x.data(), g.y.data(), g.z.data(), b, e, bx + j, by + j, bz + j);
       j += e - b;
     }
-    for (; j < cap; ++j) x[j] = y[j] = z[j] = 1e18f;  // (the padding: every point written once)
+    for (; j < cap; ++j) bx[j] = by[j] = bz[j] = kFarPoint;  // (every point written once)
   }
 };
 
@@ -257,10 +267,10 @@ class CellSearch {
       // The previous point's k-th distance, a little widened, mostly bounds this one's: fewer
       // candidates to select from. Where it does not, the block's margin.
       const float t = std::min(m2, kth_ * kTighten);
-      std::size_t c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.x.size(), qx, qy,
+      std::size_t c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.cap, qx, qy,
                                            qz, t, cand_.data());
       if (c < want_ && t < m2) {
-        c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.x.size(), qx, qy, qz, m2,
+        c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.cap, qx, qy, qz, m2,
                                  cand_.data());
       }
       if (c >= want_) return detail::selectMean(cand_.data(), c, want_, kth_);
@@ -293,8 +303,15 @@ class CellSearch {
   // out.
   void shell(int ring, std::vector<std::uint32_t>& out) const {
     out.clear();
+    // (Away from the keys' bounds, as nearly always, the keys are the cell's plus an offset,
+    // with no range test.)
+    const std::int32_t xyz[3] = {cx_, cy_, cz_};
+    const bool inner = detail::keyFitsAround(xyz, ring);
+    const std::uint64_t key = inner ? detail::packKey(cx_, cy_, cz_) : 0;
     for (const auto& d : shellOffsets(ring)) {
-      const std::uint32_t c = g_->find(cx_ + d[0], cy_ + d[1], cz_ + d[2]);
+      const std::uint32_t c =
+          inner ? g_->cells.findKey(key + detail::keyOffset(d[0], d[1], d[2]))
+                : g_->find(cx_ + d[0], cy_ + d[1], cz_ + d[2]);
       if (c != detail::kNoIndex) out.push_back(c);
     }
   }
@@ -305,7 +322,7 @@ class CellSearch {
       cells_.insert(cells_.end(), around_.begin(), around_.end());
     }
     block_[ring].fill(*g_, cells_);
-    cand_.resize(std::max(cand_.size(), block_[ring].x.size()));
+    cand_.resize(std::max(cand_.size(), block_[ring].cap));
     built_ = ring;
   }
 
@@ -369,7 +386,7 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
 // of the grid (cheaper than building a k-d tree for a few dozen).
 void allPairsMeanDistances(const PointGrid& g, std::size_t want,
                            const std::vector<std::uint32_t>& todo, std::vector<double>& mean_dist) {
-  const std::size_t n = g.x.size();
+  const std::size_t n = g.index.size();
 #pragma omp parallel if (todo.size() > 1)
   {
     NearestK best(want);
