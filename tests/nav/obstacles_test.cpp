@@ -77,7 +77,9 @@ TEST(NavFrames, KnownPoses) {
 TEST(NavObstacleSource, MapCellsComeOutInTheRobotFrame) {
   // One obstacle cell, centre (3.05, 1.05); the robot at (1, 1) facing +y.
   const auto grid = gridWith({{3.04, 1.06}});
-  ObstacleSource src;
+  ObstacleParams p;
+  p.map_cell_border = false;  // the centre alone
+  ObstacleSource src(p);
   src.setMap(&grid);
   const auto pts = src.pointsInRobot({1.0, 1.0, kPi / 2});
   ASSERT_EQ(pts.size(), 1u);
@@ -86,10 +88,50 @@ TEST(NavObstacleSource, MapCellsComeOutInTheRobotFrame) {
   EXPECT_NEAR(pts[0].y(), -2.05, 1e-9);
 }
 
+// An obstacle may fill its map cell to the border: a polygon that keeps its margin from the
+// obstacle points keeps it from every part of the cell, not only from its centre. Sampled over
+// robot positions round a block of cells: the nearest obstacle point is never farther than the
+// nearest point of the cells plus the points' spacing along the border (half a cell's diagonal
+// would be the centre's excess).
+TEST(NavObstacleSource, MapCellsReachTheirBorder) {
+  const std::vector<Eigen::Vector2d> cells = {{1.05, 0.05}, {1.15, 0.05}, {1.15, 0.15}};
+  const auto grid = gridWith(cells);
+  ObstacleSource src;  // the defaults: the border on, 5 cm decimation
+  ASSERT_TRUE(src.params().map_cell_border);
+  src.setMap(&grid);
+  const double half = 0.05;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.5, 1.7);
+  for (int k = 0; k < 300; ++k) {
+    const Pose2D pose{u(rng), u(rng) - 1.0, 0.0};
+    const Eigen::Vector2d robot(pose.x_m, pose.y_m);
+    double to_cells = 1e9;
+    for (const auto& c : cells) {
+      const Eigen::Vector2d d = ((robot - c).cwiseAbs().array() - half).cwiseMax(0.0).matrix();
+      to_cells = std::min(to_cells, d.norm());
+    }
+    if (to_cells < 0.02) continue;  // inside or at the cells
+    double to_points = 1e9;
+    for (const auto& p : src.pointsInRobot(pose)) to_points = std::min(to_points, p.norm());
+    // Points every half cell along the border: the nearest is at most a quarter cell along the
+    // border from the nearest point of the cells; the centre alone is half a cell farther.
+    EXPECT_LE(to_points, std::hypot(to_cells, 0.5 * half) + 1e-6) << robot.transpose();
+    EXPECT_GE(to_points, to_cells - 1e-6) << robot.transpose();
+  }
+  // The border lies on the cells: nothing beyond them.
+  for (const auto& p : src.pointsInRobot({0.0, 0.0, 0.0})) {
+    EXPECT_GE(p.x(), 1.0 - 1e-6);
+    EXPECT_LE(p.x(), 1.2 + 1e-6);
+    EXPECT_GE(p.y(), 0.0 - 1e-6);
+    EXPECT_LE(p.y(), 0.2 + 1e-6);
+  }
+}
+
 TEST(NavObstacleSource, RangeAndSourcesAreHonoured) {
   const auto grid = gridWith({{1.05, 0.05}, {4.55, 0.05}});
   ObstacleParams p;
   p.range_m = 3.0;
+  p.map_cell_border = false;
   ObstacleSource src(p);
   src.setMap(&grid);
   src.setFrameObstacles({{0.0, 2.0}, {0.0, 3.5}});
@@ -146,6 +188,7 @@ TEST(NavUpdNavInterface, SenseObstaclesGivesRobotFramePoints) {
   const auto grid = gridWith({{3.04, 1.06}});
   ObstacleParams p;
   p.point_height_m = 0.25;
+  p.map_cell_border = false;
   ObstacleSource src(p);
   src.setMap(&grid);
   SimulatedDiffDrive base({1.0, 1.0, kPi / 2});
