@@ -77,9 +77,7 @@ TEST(NavFrames, KnownPoses) {
 TEST(NavObstacleSource, MapCellsComeOutInTheRobotFrame) {
   // One obstacle cell, centre (3.05, 1.05); the robot at (1, 1) facing +y.
   const auto grid = gridWith({{3.04, 1.06}});
-  ObstacleParams p;
-  p.map_cell_border = false;  // the centre alone
-  ObstacleSource src(p);
+  ObstacleSource src;
   src.setMap(&grid);
   const auto pts = src.pointsInRobot({1.0, 1.0, kPi / 2});
   ASSERT_EQ(pts.size(), 1u);
@@ -96,8 +94,9 @@ TEST(NavObstacleSource, MapCellsComeOutInTheRobotFrame) {
 TEST(NavObstacleSource, MapCellsReachTheirBorder) {
   const std::vector<Eigen::Vector2d> cells = {{1.05, 0.05}, {1.15, 0.05}, {1.15, 0.15}};
   const auto grid = gridWith(cells);
-  ObstacleSource src;  // the defaults: the border on, 5 cm decimation
-  ASSERT_TRUE(src.params().map_cell_border);
+  ObstacleParams p;  // 5 cm decimation
+  p.map_cell_border = true;
+  ObstacleSource src(p);
   src.setMap(&grid);
   const double half = 0.05;
   std::mt19937 rng(3);
@@ -131,7 +130,6 @@ TEST(NavObstacleSource, RangeAndSourcesAreHonoured) {
   const auto grid = gridWith({{1.05, 0.05}, {4.55, 0.05}});
   ObstacleParams p;
   p.range_m = 3.0;
-  p.map_cell_border = false;
   ObstacleSource src(p);
   src.setMap(&grid);
   src.setFrameObstacles({{0.0, 2.0}, {0.0, 3.5}});
@@ -188,7 +186,6 @@ TEST(NavUpdNavInterface, SenseObstaclesGivesRobotFramePoints) {
   const auto grid = gridWith({{3.04, 1.06}});
   ObstacleParams p;
   p.point_height_m = 0.25;
-  p.map_cell_border = false;
   ObstacleSource src(p);
   src.setMap(&grid);
   SimulatedDiffDrive base({1.0, 1.0, kPi / 2});
