@@ -96,6 +96,7 @@ TEST(NavObstacleSource, MapCellsReachTheirBorder) {
   const auto grid = gridWith(cells);
   ObstacleParams p;  // 5 cm decimation
   p.map_cell_border = true;
+  p.map_cell_border_range_m = 10.0;  // every cell here
   ObstacleSource src(p);
   src.setMap(&grid);
   const double half = 0.05;
@@ -124,6 +125,24 @@ TEST(NavObstacleSource, MapCellsReachTheirBorder) {
     EXPECT_GE(p.y(), 0.0 - 1e-6);
     EXPECT_LE(p.y(), 0.2 + 1e-6);
   }
+}
+
+// Only cells near the robot give their border: a cell farther than map_cell_border_range_m
+// gives its centre alone, a near one its centre and border (3 x 3 points on the half-cell
+// lattice).
+TEST(NavObstacleSource, CellBordersOnlyNearTheRobot) {
+  const auto grid = gridWith({{1.05, 0.05}, {3.05, 0.05}});
+  ObstacleParams p;
+  p.map_cell_border = true;
+  p.map_cell_border_range_m = 1.5;
+  ObstacleSource src(p);
+  src.setMap(&grid);
+  int near = 0, far = 0;
+  for (const auto& q : src.pointsInRobot({0.0, 0.0, 0.0})) (q.x() < 2.0 ? near : far) += 1;
+  EXPECT_EQ(near, 9);
+  EXPECT_EQ(far, 1);
+  p.map_cell_border_range_m = 0.0;
+  EXPECT_THROW(ObstacleSource{p}, std::invalid_argument);
 }
 
 TEST(NavObstacleSource, RangeAndSourcesAreHonoured) {

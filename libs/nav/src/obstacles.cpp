@@ -15,6 +15,9 @@ void ObstacleParams::validate() const {
                "must be > 0");
   core::requireParam(std::isfinite(decimation_m) && decimation_m > 0, "ObstacleParams", "decimation_m",
                decimation_m, "must be > 0");
+  core::requireParam(std::isfinite(map_cell_border_range_m) && map_cell_border_range_m > 0,
+                     "ObstacleParams", "map_cell_border_range_m", map_cell_border_range_m,
+                     "must be > 0");
   core::requireParam(std::isfinite(point_height_m), "ObstacleParams", "point_height_m", point_height_m,
                "must be finite");
 }
@@ -123,8 +126,9 @@ void ObstacleSource::addMapPoints(const Pose2D& pose_world_robot,
   const double r2 = r * r;
   const auto addCell = [&](int cx, int cy) {
     const Eigen::Vector2d c = g.cellCenter(cx, cy);
-    for (int j = -reach; j <= reach; ++j) {
-      for (int i = -reach; i <= reach; ++i) {
+    const int k = (c - centre).norm() < params_.map_cell_border_range_m ? reach : 0;
+    for (int j = -k; j <= k; ++j) {
+      for (int i = -k; i <= k; ++i) {
         const Eigen::Vector2d p = c + Eigen::Vector2d(i * h, j * h);
         if ((p - centre).squaredNorm() > r2) continue;
         if (!lattice.insert(squareKey(2 * cx + 1 + i, 2 * cy + 1 + j)).second) continue;

@@ -7,9 +7,10 @@
 //    NonTraversable, within range_m of the robot. The map remembers what left the camera's
 //    field of view (the camera cannot see the ground right in front of the bumper). The
 //    obstacle may fill its cell to the border, where the centre alone lets the polygon's margin
-//    overlap it by up to half a cell: with map_cell_border a cell also gives the points of its
-//    border every half cell (not thinned by decimation_m). It is off by default: on the
-//    navigation benchmark it removes those grazes, but MRPT's reactive navigator, with every
+//    overlap it by up to half a cell: with map_cell_border a cell within
+//    map_cell_border_range_m of the robot also gives the points of its border every half cell
+//    (not thinned by decimation_m). It is off by default: on the navigation benchmark, with the
+//    borders at any range, it removes those grazes, but MRPT's reactive navigator, with every
 //    obstacle half a cell nearer, stops in more cluttered places than it stops grazing
 //    (docs/NAVIGATION.md);
 //  - the current frame: every NonTraversable point of the latest scored frame within range_m,
@@ -41,6 +42,7 @@ struct ObstacleParams {
   double range_m = 4.0;           ///< evidence farther than this from the robot is left out [m]
   bool use_map = true;            ///< take NonTraversable cells of the fused grid
   bool map_cell_border = false;   ///< a map cell gives its border too, not only its centre
+  double map_cell_border_range_m = 1.0;  ///< ... when its centre is this close to the robot [m]
   bool use_current_frame = true;  ///< take NonTraversable points of the latest frame
   double decimation_m = 0.05;     ///< at most one point per square of this side [m]
   double point_height_m = 0.2;    ///< z of every obstacle point in the robot frame [m]
@@ -53,6 +55,10 @@ struct ObstacleParams {
     v("map_cell_border", map_cell_border,
       "a non-traversable map cell gives the points of its border (every half cell) besides its "
       "centre");
+    v("map_cell_border_range_m", map_cell_border_range_m,
+      "with map_cell_border, only cells whose centre is within this distance of the robot give "
+      "their border (a graze is a near obstacle; far borders only narrow the navigator's "
+      "choices) [m]");
     v("use_current_frame", use_current_frame, "use the non-traversable points of the latest frame");
     v("decimation_m", decimation_m, "keep at most one obstacle point per square of this side [m]");
     v("point_height_m", point_height_m,
