@@ -1,5 +1,6 @@
 // The navigation config: the shipped files load, the nav file is strict, paths resolve.
 #include "upd/nav/nav_config.h"
+#include "upd/nav/navigation_loop.h"
 
 #include <gtest/gtest.h>
 
@@ -43,6 +44,26 @@ TEST(NavShippedConfig, LoadsWithTheDuneValues) {
   EXPECT_TRUE(fs::exists(c.ptg_ini));
   EXPECT_FALSE(c.ptg_cache_dir.empty());
   EXPECT_NE(fs::path(c.ptg_cache_dir), fs::current_path());
+}
+
+// The loop compares the detectors at one neighbourhood: the roughness baseline runs at the
+// UPD's navigation d_m, not at the robot config's mapping radius (a wider band, and several
+// times the cost per frame).
+TEST(NavShippedConfig, BaselineRunsAtTheUpdsNavigationRadius) {
+  const NavConfig c = loadNavConfig(kConfig + "/dune-kinect.ini", kConfig + "/dune-nav.ini");
+  ASSERT_GT(c.perception.upd_radius_m, 0.0);
+  ASSERT_NE(c.baseline.radius_m, c.perception.upd_radius_m);  // the robot config's differs
+  for (const auto d : {core::ObstacleDetector::Upd, core::ObstacleDetector::Roughness}) {
+    const core::FrameScorerParams p = loopScorerParams(c, d);
+    EXPECT_DOUBLE_EQ(p.pipeline.upd.radius_m, c.perception.upd_radius_m);
+    EXPECT_DOUBLE_EQ(p.baseline.radius_m, c.perception.upd_radius_m);
+    EXPECT_EQ(p.detector, d);
+  }
+  NavConfig keep = c;
+  keep.perception.upd_radius_m = 0.0;  // 0: the robot config's radii
+  const core::FrameScorerParams p = loopScorerParams(keep, core::ObstacleDetector::Roughness);
+  EXPECT_DOUBLE_EQ(p.baseline.radius_m, c.baseline.radius_m);
+  EXPECT_DOUBLE_EQ(p.pipeline.upd.radius_m, c.pipeline.upd.radius_m);
 }
 
 TEST_F(NavTempIni, UnknownKeysAndSectionsOfTheNavFileAreErrors) {

@@ -86,6 +86,65 @@ TEST(NavObstacleSource, MapCellsComeOutInTheRobotFrame) {
   EXPECT_NEAR(pts[0].y(), -2.05, 1e-9);
 }
 
+// An obstacle may fill its map cell to the border: a polygon that keeps its margin from the
+// obstacle points keeps it from every part of the cell, not only from its centre. Sampled over
+// robot positions round a block of cells: the nearest obstacle point is never farther than the
+// nearest point of the cells plus the points' spacing along the border (half a cell's diagonal
+// would be the centre's excess).
+TEST(NavObstacleSource, MapCellsReachTheirBorder) {
+  const std::vector<Eigen::Vector2d> cells = {{1.05, 0.05}, {1.15, 0.05}, {1.15, 0.15}};
+  const auto grid = gridWith(cells);
+  ObstacleParams p;  // 5 cm decimation
+  p.map_cell_border = true;
+  p.map_cell_border_range_m = 10.0;  // every cell here
+  ObstacleSource src(p);
+  src.setMap(&grid);
+  const double half = 0.05;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.5, 1.7);
+  for (int k = 0; k < 300; ++k) {
+    const Pose2D pose{u(rng), u(rng) - 1.0, 0.0};
+    const Eigen::Vector2d robot(pose.x_m, pose.y_m);
+    double to_cells = 1e9;
+    for (const auto& c : cells) {
+      const Eigen::Vector2d d = ((robot - c).cwiseAbs().array() - half).cwiseMax(0.0).matrix();
+      to_cells = std::min(to_cells, d.norm());
+    }
+    if (to_cells < 0.02) continue;  // inside or at the cells
+    double to_points = 1e9;
+    for (const auto& p : src.pointsInRobot(pose)) to_points = std::min(to_points, p.norm());
+    // Points every half cell along the border: the nearest is at most a quarter cell along the
+    // border from the nearest point of the cells; the centre alone is half a cell farther.
+    EXPECT_LE(to_points, std::hypot(to_cells, 0.5 * half) + 1e-6) << robot.transpose();
+    EXPECT_GE(to_points, to_cells - 1e-6) << robot.transpose();
+  }
+  // The border lies on the cells: nothing beyond them.
+  for (const auto& p : src.pointsInRobot({0.0, 0.0, 0.0})) {
+    EXPECT_GE(p.x(), 1.0 - 1e-6);
+    EXPECT_LE(p.x(), 1.2 + 1e-6);
+    EXPECT_GE(p.y(), 0.0 - 1e-6);
+    EXPECT_LE(p.y(), 0.2 + 1e-6);
+  }
+}
+
+// Only cells near the robot give their border: a cell farther than map_cell_border_range_m
+// gives its centre alone, a near one its centre and border (3 x 3 points on the half-cell
+// lattice).
+TEST(NavObstacleSource, CellBordersOnlyNearTheRobot) {
+  const auto grid = gridWith({{1.05, 0.05}, {3.05, 0.05}});
+  ObstacleParams p;
+  p.map_cell_border = true;
+  p.map_cell_border_range_m = 1.5;
+  ObstacleSource src(p);
+  src.setMap(&grid);
+  int near = 0, far = 0;
+  for (const auto& q : src.pointsInRobot({0.0, 0.0, 0.0})) (q.x() < 2.0 ? near : far) += 1;
+  EXPECT_EQ(near, 9);
+  EXPECT_EQ(far, 1);
+  p.map_cell_border_range_m = 0.0;
+  EXPECT_THROW(ObstacleSource{p}, std::invalid_argument);
+}
+
 TEST(NavObstacleSource, RangeAndSourcesAreHonoured) {
   const auto grid = gridWith({{1.05, 0.05}, {4.55, 0.05}});
   ObstacleParams p;

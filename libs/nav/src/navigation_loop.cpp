@@ -71,23 +71,28 @@ std::string cacheDirFor(const std::string& cache_root, const std::string& ptg_in
   return (fs::path(cache_root) / hex).string();
 }
 
-core::FrameScorerParams scorerParams(const NavConfig& config, core::ObstacleDetector detector) {
+}  // namespace
+
+core::FrameScorerParams loopScorerParams(const NavConfig& config, core::ObstacleDetector detector) {
   core::FrameScorerParams p;
   p.pipeline = config.pipeline;
-  if (config.perception.upd_radius_m > 0) p.pipeline.upd.radius_m = config.perception.upd_radius_m;
-  p.detector = detector;
   p.baseline = config.baseline;
+  if (config.perception.upd_radius_m > 0) {
+    // The baseline is compared at the UPD's neighbourhood (BaselineParams::radius_m is "the
+    // same d_m as the UPD"): its band round obstacles, and its cost per frame, follow d_m.
+    p.pipeline.upd.radius_m = config.perception.upd_radius_m;
+    p.baseline.radius_m = config.perception.upd_radius_m;
+  }
+  p.detector = detector;
   p.obstacles_xy = true;  // the navigator's current-frame obstacles
   return p;
 }
-
-}  // namespace
 
 NavigationLoop::NavigationLoop(RobotBase& base, const NavConfig& config, core::ObstacleDetector detector,
                                const std::string& navlog_path)
     : base_(base),
       config_(config),
-      scorer_(scorerParams(config, detector)),
+      scorer_(loopScorerParams(config, detector)),
       navlog_path_(navlog_path),
       grid_(config.grid),
       obstacles_(config.obstacles) {

@@ -52,8 +52,9 @@ struct LoopParams {
 
 /// What the loop changes in the robot config's pipeline. Loaded from [PerceptionParams].
 struct PerceptionParams {
-  /// d_m of the UPD that labels the navigator's obstacles [m]; 0: the robot config's
-  /// [UpdParams] radius_m. The UPD marks a band of about 0.7 d_m round every obstacle, and the
+  /// d_m of the UPD that labels the navigator's obstacles [m], and of the roughness baseline
+  /// when it does instead (compared at the same neighbourhood); 0: the robot config's
+  /// [UpdParams] and [BaselineParams] radius_m. The UPD marks a band of about 0.7 d_m round every obstacle, and the
   /// route keeps RoutePlannerParams::inflation_m from it: at the paper's 0.5 m a gap narrower
   /// than about 1.55 m closes for the Dune, at 0.3 m one of 0.95 m (the robot's width plus
   /// 0.5 m) still does, at 0.2 m it stays open. Low edges the smaller d_m no longer smooths
@@ -64,8 +65,8 @@ struct PerceptionParams {
   template <class V>
   void visit(V& v) {
     v("upd_radius_m", upd_radius_m,
-      "d_m of the UPD for the navigator's obstacles [m]; 0: the robot config's [UpdParams] "
-      "radius_m");
+      "d_m of the UPD (or the roughness baseline) for the navigator's obstacles [m]; 0: the "
+      "robot config's [UpdParams] and [BaselineParams] radius_m");
   }
 };
 

@@ -41,6 +41,10 @@
 
 namespace upd::nav {
 
+/// The frame scorer's parameters for the loop: the robot config's pipeline and baseline, both
+/// at PerceptionParams::upd_radius_m (when > 0), with the current frame's obstacle points.
+core::FrameScorerParams loopScorerParams(const NavConfig& config, core::ObstacleDetector detector);
+
 class NavigationLoop {
  public:
   /// base must outlive the loop. navlog_path: where the navigator writes its MRPT navlog

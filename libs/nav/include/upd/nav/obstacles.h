@@ -5,20 +5,30 @@
 // frame (p_robot = R(-yaw) (p_world - t)):
 //  - the fused traversability grid: the centre of every cell that labelOf() reads as
 //    NonTraversable, within range_m of the robot. The map remembers what left the camera's
-//    field of view (the camera cannot see the ground right in front of the bumper);
+//    field of view (the camera cannot see the ground right in front of the bumper). The
+//    obstacle may fill its cell to the border, where the centre alone lets the polygon's margin
+//    overlap it by up to half a cell: with map_cell_border a cell within
+//    map_cell_border_range_m of the robot also gives the points of its border every half cell
+//    (not thinned by decimation_m). It is off by default: on the navigation benchmark, with the
+//    borders at any range, it removes those grazes, but MRPT's reactive navigator, with every
+//    obstacle half a cell nearer, stops in more cluttered places than it stops grazing
+//    (docs/NAVIGATION.md);
 //  - the current frame: every NonTraversable point of the latest scored frame within range_m,
 //    so an obstacle acts at once even before the map has fused it (or when the map disagrees);
 //  - fixed obstacles: points the caller knows a priori, such as the fence around the mission
 //    area (the simulated worlds are bounded; the robot must not leave them).
-// Points are thinned to one per decimation_m x decimation_m cell (in the world frame, so the
-// result does not flicker as the robot turns) and carry z = point_height_m, which must fall in the
-// navigator's [min_obstacles_height, max_obstacles_height] band.
+// The other sources' points are thinned to one per decimation_m x decimation_m cell (in the
+// world frame, so the result does not flicker as the robot turns). Every point carries
+// z = point_height_m, which must fall in the navigator's [min_obstacles_height,
+// max_obstacles_height] band.
 #pragma once
 
 #include "upd/nav/robot_base.h"
 
 #include <Eigen/Core>
 
+#include <cstdint>
+#include <unordered_set>
 #include <vector>
 
 namespace upd::maps {
@@ -31,6 +41,8 @@ namespace upd::nav {
 struct ObstacleParams {
   double range_m = 4.0;           ///< evidence farther than this from the robot is left out [m]
   bool use_map = true;            ///< take NonTraversable cells of the fused grid
+  bool map_cell_border = false;   ///< a map cell gives its border too, not only its centre
+  double map_cell_border_range_m = 1.0;  ///< ... when its centre is this close to the robot [m]
   bool use_current_frame = true;  ///< take NonTraversable points of the latest frame
   double decimation_m = 0.05;     ///< at most one point per square of this side [m]
   double point_height_m = 0.2;    ///< z of every obstacle point in the robot frame [m]
@@ -40,6 +52,13 @@ struct ObstacleParams {
   void visit(V& v) {
     v("range_m", range_m, "obstacle evidence within this distance of the robot is used [m]");
     v("use_map", use_map, "use the non-traversable cells of the fused map");
+    v("map_cell_border", map_cell_border,
+      "a non-traversable map cell gives the points of its border (every half cell) besides its "
+      "centre");
+    v("map_cell_border_range_m", map_cell_border_range_m,
+      "with map_cell_border, only cells whose centre is within this distance of the robot give "
+      "their border (a graze is a near obstacle; far borders only narrow the navigator's "
+      "choices) [m]");
     v("use_current_frame", use_current_frame, "use the non-traversable points of the latest frame");
     v("decimation_m", decimation_m, "keep at most one obstacle point per square of this side [m]");
     v("point_height_m", point_height_m,
@@ -74,6 +93,10 @@ class ObstacleSource {
   std::vector<Eigen::Vector2d> pointsInRobot(const Pose2D& pose_world_robot) const;
 
  private:
+  // The map's NonTraversable cells within range (their borders too with map_cell_border).
+  void addMapPoints(const Pose2D& pose_world_robot, std::unordered_set<std::uint64_t>& taken_squares,
+                    std::vector<Eigen::Vector2d>& out) const;
+
   ObstacleParams params_;
   const maps::TraversabilityGrid* grid_ = nullptr;
   std::vector<Eigen::Vector2d> frame_world_;
