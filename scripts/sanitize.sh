@@ -6,12 +6,15 @@
 #   scripts/sanitize.sh [ctest args...]    e.g. scripts/sanitize.sh -R RawlogReader
 # UPD_SANITIZE_SCOPE="core sim io" builds only those libraries' tests (tests/<library>/, ctest
 # label <library>) and what they link, and runs only them: what CI runs
-# (UPD_SANITIZE_SCOPE="core sim io maps mrpt_bridge", scripts/test.sh). Default: every test.
+# (UPD_SANITIZE_SCOPE="core sim io maps mrpt_bridge nav gdal learn", scripts/test.sh). The
+# tests that run the `upd` binary (NavCli.*, the Kinect and ROS bag/node tests) come only with
+# apps in the scope (apps/upd built instrumented). Default: every test.
 # UPD_SANITIZE_EXCLUDE=REGEX leaves out more tests (ctest -E).
 # Always left out: install_consumer (builds an outside project against the installed,
 # instrumented libraries without the sanitizer runtime) and the closed-loop navigation
-# scenarios (NavScenario.*: minutes each when instrumented; their code paths run in
-# nav_simulation_test and nav_navigator_test); UPD_SANITIZE_ALL=1 runs them too.
+# scenarios (NavScenario.*: minutes each when instrumented; NavScenarioStart.* runs the first
+# seconds of each, and their parts run in nav_simulation_test and nav_navigator_test);
+# UPD_SANITIZE_ALL=1 runs them too.
 set -euo pipefail
 UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${UPD_ASAN_BUILD:-$UPD_ROOT/build-asan}"
@@ -31,13 +34,29 @@ if [ "$scope" != all ]; then
       echo "sanitize: UPD_SANITIZE_SCOPE names '$lib': no tests/$lib/*_test.cpp" >&2
       exit 2
     fi
-    for f in "$UPD_ROOT"/tests/"$lib"/*_test.cpp; do targets+=("${lib}_$(basename "$f" .cpp)"); done
+    for f in "$UPD_ROOT"/tests/"$lib"/*_test.cpp; do
+      # A test that runs the `upd` binary needs apps/upd built instrumented: only with apps.
+      if [[ " ${scope//,/ } " != *" apps "* ]] && grep -qE 'UPD_BINARY|runUpd\(' "$f"; then
+        echo "sanitize: leaving out ${lib}_$(basename "$f" .cpp) (runs upd: add apps to the scope)"
+        continue
+      fi
+      targets+=("${lib}_$(basename "$f" .cpp)")
+    done
     labels="${labels:+$labels|}$lib"
   done
 fi
 
 cmake -S "$UPD_ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUPD_BUILD_BENCH=OFF \
       -DUPD_SANITIZE=address,undefined "${launcher[@]}" "${shared[@]}" >/dev/null
+if ((${#targets[@]})); then
+  # An optional library's tests (learn, freenect, ros) exist only when it was configured.
+  known=" $(cmake --build "$BUILD" --target help | sed -n 's/^\.\.\. \([^ ]*\).*/\1/p' | tr '\n' ' ') "
+  present=()
+  for t in "${targets[@]}"; do
+    if [[ "$known" == *" $t "* ]]; then present+=("$t"); else echo "sanitize: $t not configured"; fi
+  done
+  targets=("${present[@]}")
+fi
 if ((${#targets[@]})); then
   cmake --build "$BUILD" -j"$JOBS" --target "${targets[@]}"
 else
@@ -51,6 +70,8 @@ export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$UPD_ROOT/scripts/lsan.supp:pr
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
 exclude="install_consumer"
 [ "${UPD_SANITIZE_ALL:-0}" = 1 ] || exclude="$exclude|^NavScenario\."
+# The programs left out above appear to ctest as <program>_NOT_BUILT.
+[ "$scope" = all ] || exclude="$exclude|_NOT_BUILT\$"
 [ -n "${UPD_SANITIZE_EXCLUDE:-}" ] && exclude="$exclude|$UPD_SANITIZE_EXCLUDE"
 select=()
 [ -n "$labels" ] && select=(-L "^($labels)\$")
