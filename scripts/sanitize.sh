@@ -6,9 +6,10 @@
 #   scripts/sanitize.sh [ctest args...]    e.g. scripts/sanitize.sh -R RawlogReader
 # UPD_SANITIZE_SCOPE="core sim io" builds only those libraries' tests (tests/<library>/, ctest
 # label <library>) and what they link, and runs only them: what CI runs
-# (UPD_SANITIZE_SCOPE="core sim io maps mrpt_bridge nav gdal learn", scripts/test.sh). The
-# tests that run the `upd` binary (NavCli.*, the Kinect and ROS bag/node tests) come only with
-# apps in the scope (apps/upd built instrumented). Default: every test.
+# (scripts/test.sh). An entry LIB/NAME takes one program, tests/LIB/NAME_test.cpp
+# (apps/bad_input). The tests that run the `upd` binary (NavCli.*, the Kinect and ROS bag/node
+# tests) come only with apps in the scope or named (apps/upd built instrumented). Default:
+# every test.
 # UPD_SANITIZE_EXCLUDE=REGEX leaves out more tests (ctest -E).
 # Always left out: install_consumer (builds an outside project against the installed,
 # instrumented libraries without the sanitizer runtime) and the closed-loop navigation
@@ -29,20 +30,25 @@ targets=()
 labels=""
 scope="${UPD_SANITIZE_SCOPE:-all}"
 if [ "$scope" != all ]; then
-  for lib in ${scope//,/ }; do
-    if ! compgen -G "$UPD_ROOT/tests/$lib/*_test.cpp" >/dev/null; then
-      echo "sanitize: UPD_SANITIZE_SCOPE names '$lib': no tests/$lib/*_test.cpp" >&2
+  for entry in ${scope//,/ }; do
+    lib="${entry%%/*}"
+    files=("$UPD_ROOT"/tests/"$lib"/*_test.cpp)
+    [ "$entry" = "$lib" ] || files=("$UPD_ROOT/tests/$entry"_test.cpp)
+    if [ ! -f "${files[0]}" ]; then
+      echo "sanitize: UPD_SANITIZE_SCOPE names '$entry': no tests/$entry*_test.cpp" >&2
       exit 2
     fi
-    for f in "$UPD_ROOT"/tests/"$lib"/*_test.cpp; do
-      # A test that runs the `upd` binary needs apps/upd built instrumented: only with apps.
-      if [[ " ${scope//,/ } " != *" apps "* ]] && grep -qE 'UPD_BINARY|runUpd\(' "$f"; then
+    for f in "${files[@]}"; do
+      # A test that runs the `upd` binary needs apps/upd built instrumented: only with apps
+      # in the scope, or when the program is named.
+      if [ "$entry" = "$lib" ] && [[ " ${scope//,/ } " != *" apps "* ]] &&
+         grep -qE 'UPD_BINARY|runUpd\(' "$f"; then
         echo "sanitize: leaving out ${lib}_$(basename "$f" .cpp) (runs upd: add apps to the scope)"
         continue
       fi
       targets+=("${lib}_$(basename "$f" .cpp)")
     done
-    labels="${labels:+$labels|}$lib"
+    [[ "|$labels|" == *"|$lib|"* ]] || labels="${labels:+$labels|}$lib"
   done
 fi
 

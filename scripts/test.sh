@@ -4,8 +4,8 @@
 # In CI (CI=true), or with UPD_RELIABILITY=1, bounded reliability steps follow
 # (docs/RELIABILITY.md): the fuzzers of the cloud readers, the robot config and the core
 # pipeline and a rawlog object stream for at most UPD_FUZZ_SECONDS each (default 90; a fixed
-# seed and 2,000 inputs, so a run is repeatable), and the tests of the libraries (core, sim, io,
-# maps, mrpt_bridge, nav, gdal, learn; not those that run `upd`) under ASan + UBSan.
+# seed and 2,000 inputs, so a run is repeatable), and under ASan + UBSan the tests of the
+# libraries (core, sim, io, maps, mrpt_bridge, nav, gdal, learn) and of `upd` on bad inputs.
 # Longer and wider: scripts/fuzz.sh SECONDS [TARGET...] and scripts/sanitize.sh (every test).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
@@ -16,6 +16,8 @@ if [ "${CI:-}" = true ] || [ "${UPD_RELIABILITY:-0}" = 1 ]; then
   UPD_FUZZ_SEED="${UPD_FUZZ_SEED:-1}" UPD_FUZZ_RUNS="${UPD_FUZZ_RUNS:-2000}" \
     "$UPD_ROOT/scripts/fuzz.sh" "${UPD_FUZZ_SECONDS:-90}" pcd ply xyz kitti_bin pipeline ini rawlog
   # The libraries and their tests under ASan + UBSan + LeakSanitizer, the navigation scenarios
-  # shortened (the apps, the Kinect and ROS tests: by hand; docs/RELIABILITY.md, "In CI").
-  UPD_SANITIZE_SCOPE="core sim io maps mrpt_bridge nav gdal learn" "$UPD_ROOT/scripts/sanitize.sh"
+  # shortened, and `upd` on the bad-input catalogue and damaged rawlogs (the other apps tests,
+  # the Kinect and ROS tests: by hand; docs/RELIABILITY.md, "In CI").
+  UPD_SANITIZE_SCOPE="core sim io maps mrpt_bridge nav gdal learn apps/bad_input apps/playback_damage" \
+    "$UPD_ROOT/scripts/sanitize.sh"
 fi
