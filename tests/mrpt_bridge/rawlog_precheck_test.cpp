@@ -267,7 +267,8 @@ TEST(RawlogPrecheck, JpegThatWouldEndTheProcessIsDamage) {
   std::size_t head = 0;
   std::string bad_marker = good;
   bad_marker[jpeg_at + jpeg_bytes - 1] = '\x9A';
-  EXPECT_EQ(damageReason(tmp, bad_marker, &head),
+  const std::string bad_marker_reason = damageReason(tmp, bad_marker, &head);
+  EXPECT_EQ(bad_marker_reason,
             "corrupt CObservationStereoImages: image JPEG of " + std::to_string(jpeg_bytes) +
                 " bytes at byte " + std::to_string(head + jpeg_at) +
                 " does not decode (Unsupported marker type 0x9a; MRPT's JPEG "
@@ -277,7 +278,8 @@ TEST(RawlogPrecheck, JpegThatWouldEndTheProcessIsDamage) {
   const auto sof = huge.find("\xFF\xC0", jpeg_at);  // baseline frame: length, precision, H, W
   ASSERT_LT(sof, jpeg_at + jpeg_bytes);
   huge.replace(sof + 5, 4, std::string("\x40\x00\x40\x00", 4));  // 16384 x 16384
-  EXPECT_EQ(damageReason(tmp, huge, &head),
+  const std::string huge_reason = damageReason(tmp, huge, &head);
+  EXPECT_EQ(huge_reason,
             "corrupt CObservationStereoImages: image JPEG at byte " +
                 std::to_string(head + jpeg_at) +
                 ": its header says 268435456 pixels (more than 16777216)");
