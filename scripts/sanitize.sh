@@ -7,7 +7,7 @@
 # UPD_SANITIZE_SCOPE="core sim io" builds only those libraries' tests (tests/<library>/, ctest
 # label <library>) and what they link, and runs only them: what CI runs
 # (scripts/test.sh). An entry LIB/NAME takes one program, tests/LIB/NAME_test.cpp
-# (apps/bad_input). The tests that run the `upd` binary (NavCli.*, the Kinect and ROS bag/node
+# (apps/bad_input). The tests that run the `upd` binary (NavCli.*, BenchCli.*, the Kinect and ROS bag/node
 # tests) come only with apps in the scope or named (apps/upd built instrumented). Default:
 # every test.
 # UPD_SANITIZE_EXCLUDE=REGEX leaves out more tests (ctest -E).
