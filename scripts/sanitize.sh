@@ -7,9 +7,9 @@
 # UPD_SANITIZE_SCOPE="core sim io" builds only those libraries' tests (tests/<library>/, ctest
 # label <library>) and what they link, and runs only them: what CI runs
 # (scripts/test.sh). An entry LIB/NAME takes one program, tests/LIB/NAME_test.cpp
-# (apps/bad_input). The tests that run the `upd` binary (NavCli.*, BenchCli.*, the Kinect and ROS bag/node
-# tests) come only with apps in the scope or named (apps/upd built instrumented). Default:
-# every test.
+# (apps/bad_input). The tests that run the `upd` binary (NavCli.*, BenchCli.*, the Kinect
+# and ROS bag/node tests) come only with apps in the scope or named (apps/upd built
+# instrumented). Default: every test.
 # UPD_SANITIZE_EXCLUDE=REGEX leaves out more tests (ctest -E).
 # Always left out: install_consumer (builds an outside project against the installed,
 # instrumented libraries without the sanitizer runtime) and the closed-loop navigation
