@@ -99,7 +99,14 @@ TEST(PlaybackSoak, MemoryIsFlatOnceTheCourseIsMapped) {
         maps_max, t["grid_bytes"].get<std::size_t>() + t["octree_bytes"].get<std::size_t>());
   }
   EXPECT_GT(rss0, 0u);
+#if defined(__SANITIZE_ADDRESS__)
+  // An instrumented `upd` (this test is built as `upd` is): AddressSanitizer's quarantine and
+  // padding move its resident memory by tens of MiB from sample to sample (572-612 MiB over
+  // 10,000 frames), which measures the sanitizer's allocator, not the maps; their bytes are
+  // checked below.
+#else
   EXPECT_LE(rss_max, rss0 + (8u << 20)) << trace.dump();
+#endif
   EXPECT_LE(maps_max, maps0 + maps0 / 10) << trace.dump();
   // The exported maps hold the whole course.
   EXPECT_GT(s["grid"]["known"].get<std::size_t>(), 30000u);

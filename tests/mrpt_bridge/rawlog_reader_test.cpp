@@ -383,7 +383,8 @@ TEST(RawlogReader, ImpossibleActionCountIsDamage) {
   } catch (const RawlogError& err) {
     EXPECT_EQ(err.objectIndex(), 1u);
     EXPECT_EQ(err.byteOffset(), at);
-    EXPECT_EQ(err.reason(), "corrupt CActionCollection: 4294967280 actions (more than 4096)");
+    EXPECT_EQ(err.reason(), "corrupt CActionCollection: action count 4294967280 at byte " +
+                                std::to_string(count_at) + " (more than 4096 actions)");
   }
 }
 

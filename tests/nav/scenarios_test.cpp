@@ -1,13 +1,16 @@
 // The closed loop on every scenario with the shipped configs: the goal is reached without
 // touching non-traversable ground truth; the walled-in goal ends with the navigator's error in
 // bounded time; with the roughness index instead of the UPD the ramp blocks the way (the
-// paper's failure case). One test per scenario so they run in parallel.
+// paper's failure case). One test per scenario so they run in parallel. NavScenarioStart runs
+// the first simulated seconds of each (the whole loop, in a tenth of the time): what the
+// sanitizer build runs in CI, where the whole runs take minutes each.
 #include "upd/maps/traversability_grid.h"
 #include "upd/nav/nav_config.h"
 #include "upd/nav/scenario.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 namespace core = upd::core;
@@ -98,6 +101,29 @@ TEST_F(NavScenario, RoughnessIndexBlocksTheRamp) {
   // the ramp's side wall, which the roughness index reads traversable (the benchmark's
   // missed_obstacle; docs/NAVIGATION.md).
 }
+
+// The first 6 s of every scenario: the loop runs (perception, map, planner, navigator, base),
+// the robot heads for the goal and touches no obstacle.
+class NavScenarioStart : public NavScenario, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(NavScenarioStart, RobotHeadsForTheGoalWithoutCollision) {
+  config_.loop.max_time_s = 6.0;
+  const ScenarioResult r = run(GetParam());
+  ASSERT_GE(r.trajectory.size(), 2u);
+  const Pose2D start = r.trajectory.front().pose_world_robot;
+  const double start_distance_m =
+      std::hypot(start.x_m - r.goal_xy.x(), start.y_m - r.goal_xy.y());
+  EXPECT_LT(r.final_distance_to_goal_m, start_distance_m - 0.5) << toString(r.end);
+  EXPECT_EQ(r.collision_steps, 0);
+  EXPECT_GT(r.min_clearance_m, 0.0);
+  EXPECT_NE(r.end, RunEnd::NavigatorError) << r.navigator.error_message;
+}
+
+INSTANTIATE_TEST_SUITE_P(Worlds, NavScenarioStart,
+                         ::testing::Values("rocks", "ramp", "ditch", "corridor"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           return std::string(info.param);
+                         });
 
 }  // namespace
 }  // namespace upd::nav

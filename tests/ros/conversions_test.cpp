@@ -6,6 +6,7 @@
 #include <sensor_msgs/point_cloud2_iterator.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace {
@@ -173,14 +174,21 @@ TEST(RosConversions, ScoredCloudHasTheSixFieldsWithTheirValues) {
   for (const auto& fl : msg.fields) names.push_back(fl.name);
   EXPECT_EQ(names, (std::vector<std::string>{"x", "y", "z", "zeta", "label", "cost"}));
   ASSERT_EQ(msg.width * msg.height, 2u);
-  sensor_msgs::PointCloud2ConstIterator<float> x(msg, "x"), zeta(msg, "zeta"), cost(msg, "cost");
-  sensor_msgs::PointCloud2ConstIterator<std::uint8_t> label(msg, "label");
+  // The fields are packed (a point is 21 bytes): the floats are read byte by byte.
+  using Bytes = sensor_msgs::PointCloud2ConstIterator<std::uint8_t>;
+  Bytes x(msg, "x"), zeta(msg, "zeta"), cost(msg, "cost"), label(msg, "label");
+  const auto get = [](const Bytes& field, std::size_t k) {
+    float v = 0;
+    std::memcpy(&v, &field[k * sizeof(float)], sizeof v);
+    return v;
+  };
+  EXPECT_EQ(msg.point_step, 21u);
   ++x, ++zeta, ++cost, ++label;
-  EXPECT_EQ(x[0], 4.f);
-  EXPECT_EQ(x[2], 6.f);
-  EXPECT_FLOAT_EQ(*zeta, 0.2f);
+  EXPECT_EQ(get(x, 0), 4.f);
+  EXPECT_EQ(get(x, 2), 6.f);
+  EXPECT_FLOAT_EQ(get(zeta, 0), 0.2f);
   EXPECT_EQ(*label, 1);
-  EXPECT_FLOAT_EQ(*cost, 1.0f);
+  EXPECT_FLOAT_EQ(get(cost, 0), 1.0f);
   // The xyz part reads back as a cloud.
   EXPECT_EQ(ros1::cloudFromPointCloud2(msg).size(), 2u);
 }

@@ -1,5 +1,7 @@
 #include "rawlog_precheck.h"
 
+#include "rawlog_precheck_cursor.h"
+
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
@@ -44,7 +46,9 @@ bool LookaheadStream::peek(std::size_t offset, void* out, std::size_t count) {
       head_ = 0;
     }
     const std::size_t have = ahead_.size();
-    const std::size_t chunk = std::max<std::size_t>(need - have, 4096);
+    // In steps of at most 1 MiB: a corrupt size near the end of a file asks for more than is there,
+    // and is not allocated ahead of the bytes.
+    const std::size_t chunk = std::clamp<std::size_t>(need - have, 4096, 1 << 20);
     ahead_.resize(have + chunk);
     const std::size_t got = in_.Read(ahead_.data() + have, chunk);
     ahead_.resize(have + got);
@@ -54,61 +58,6 @@ bool LookaheadStream::peek(std::size_t offset, void* out, std::size_t count) {
   return true;
 }
 
-namespace {
-
-constexpr std::uint8_t kEndFlag = 0x88;  // MRPT's SERIALIZATION_END_FLAG after each object
-
-template <std::size_t N>
-struct UintOfSize;
-template <>
-struct UintOfSize<1> {
-  using type = std::uint8_t;
-};
-template <>
-struct UintOfSize<4> {
-  using type = std::uint32_t;
-};
-
-// Reads ahead of the stream's position: little-endian values (MRPT's byte order on disk), as
-// MRPT's CArchive would read them next, without consuming them.
-class Cursor {
- public:
-  explicit Cursor(LookaheadStream& in) : in_(in) {}
-
-  bool bytes(void* out, std::size_t n) {
-    if (!in_.peek(offset_, out, n)) return false;
-    offset_ += n;
-    return true;
-  }
-  template <typename T>
-  bool value(T& v) {
-    static_assert(std::is_integral_v<T>);
-    std::uint8_t b[sizeof(T)];
-    if (!bytes(b, sizeof b)) return false;
-    typename UintOfSize<sizeof(T)>::type u = 0;
-    for (std::size_t i = sizeof(T); i-- > 0;) u = static_cast<decltype(u)>((u << 8) | b[i]);
-    std::memcpy(&v, &u, sizeof v);
-    return true;
-  }
-  /// Fields whose values are not checked: skipped (a read after them fails at the end).
-  void skip(std::size_t n) { offset_ += n; }
-  bool endFlag() {
-    std::uint8_t f = 0;
-    return value(f) && f == kEndFlag;
-  }
-
- private:
-  LookaheadStream& in_;
-  std::size_t offset_ = 0;
-};
-
-struct ObjectHeader {
-  std::string class_name;  ///< without a namespace
-  int version = -1;
-  bool has_end_flag = true;  ///< false in the format before MRPT 0.5.5
-};
-
-// CArchive::internal_ReadObjectHeader's layout; false where MRPT would refuse it.
 bool readHeader(Cursor& c, ObjectHeader& h) {
   std::uint8_t length = 0;
   if (!c.value(length)) return false;
@@ -136,11 +85,19 @@ bool readHeader(Cursor& c, ObjectHeader& h) {
   return true;
 }
 
-enum class Parse { Read, Impossible, OtherLayout };
+bool withinBound(const char* field, std::uint64_t value, std::uint64_t at, std::uint64_t max,
+                 const char* unit, std::string& why) {
+  if (value <= max) return true;
+  why = std::string(field) + " " + std::to_string(value) + " at byte " + std::to_string(at) +
+        " (more than " + std::to_string(max) + " " + unit + ")";
+  return false;
+}
+
+namespace {
 
 // CActionRobotMovement2D::serializeFrom of MRPT 2.5.8, versions 4-7, up to its end flag: an
-// odometry estimate carries its raw increment (a CPose2D object) and the motion model MRPT
-// rebuilds the distribution from while reading.
+// odometry estimate carries its raw increment (a CPose2D object) and the motion model MRPT rebuilds
+// the distribution from while reading.
 Parse checkMovement2D(Cursor& c, int version, std::string& why) {
   if (version < 4 || version > 7) return Parse::OtherLayout;
   std::int32_t method = 0;
@@ -163,13 +120,14 @@ Parse checkMovement2D(Cursor& c, int version, std::string& why) {
   if (!c.value(particles)) return Parse::OtherLayout;
   // MRPT draws particles for any model but mmGaussian (0); mmThrun is 1.
   if (model != 0 && model != 1) {
-    why = "unknown motion model " + std::to_string(model) + " (0 Gaussian, 1 Thrun; MRPT would draw its " +
-          std::to_string(particles) + " particles)";
+    why = "unknown motion model " + std::to_string(model) +
+          " (0 Gaussian, 1 Thrun; MRPT would draw its " + std::to_string(particles) + " particles)";
     return Parse::Impossible;
   }
   if (model == 1 && particles > kMaxOdometryParticles) {
     why = "a motion model of " + std::to_string(particles) + " particles (more than " +
-          std::to_string(kMaxOdometryParticles) + "; MRPT draws every one while reading the object)";
+          std::to_string(kMaxOdometryParticles) +
+          "; MRPT draws every one while reading the object)";
     return Parse::Impossible;
   }
   c.skip((version >= 5 ? 6 : 4) * sizeof(float));  // the Thrun model's alphas and extra noise
@@ -186,36 +144,80 @@ Parse checkMovement2D(Cursor& c, int version, std::string& why) {
   return Parse::Read;
 }
 
+// CActionCollection::serializeFrom, version 0: a count, then the action objects.
+Parse checkActions(Cursor& c, int version, std::string& why) {
+  if (version != 0) return Parse::OtherLayout;
+  const std::uint64_t at = c.position();
+  std::uint32_t actions = 0;
+  if (!c.value(actions)) return Parse::OtherLayout;
+  if (!withinBound("action count", actions, at, kMaxActionsPerCollection, "actions", why)) {
+    why = "corrupt CActionCollection: " + why;
+    return Parse::Impossible;
+  }
+  for (std::uint32_t i = 0; i < actions; ++i) {
+    ObjectHeader action;
+    if (!readHeader(c, action) || action.class_name != "CActionRobotMovement2D") {
+      return Parse::OtherLayout;
+    }
+    const Parse p = checkMovement2D(c, action.version, why);
+    if (p == Parse::Impossible) {
+      why = "corrupt CActionRobotMovement2D (action " + std::to_string(i + 1) + " of " +
+            std::to_string(actions) + " in a CActionCollection): " + why;
+      return p;
+    }
+    if (p == Parse::OtherLayout || (action.has_end_flag && !c.endFlag())) return Parse::OtherLayout;
+  }
+  return c.endFlag() ? Parse::Read : Parse::OtherLayout;
+}
+
+// CSensoryFrame::serializeFrom, version 2: a count, then the observation objects.
+Parse checkFrame(Cursor& c, int version, std::string& why) {
+  if (version != 2) return Parse::OtherLayout;
+  const std::uint64_t at = c.position();
+  std::uint32_t count = 0;
+  if (!c.value(count)) return Parse::OtherLayout;
+  if (!withinBound("observation count", count, at, kMaxObservationsPerFrame, "observations", why)) {
+    why = "corrupt CSensoryFrame: " + why;
+    return Parse::Impossible;
+  }
+  for (std::uint32_t i = 0; i < count; ++i) {
+    ObjectHeader obs;
+    if (!readHeader(c, obs)) return Parse::OtherLayout;
+    const Parse p = checkObservation(c, obs, why);
+    if (p == Parse::Impossible) {
+      why = "corrupt " + obs.class_name + " (observation " + std::to_string(i + 1) + " of " +
+            std::to_string(count) + " in a CSensoryFrame): " + why;
+    }
+    if (p != Parse::Read) return p;
+  }
+  return c.endFlag() ? Parse::Read : Parse::OtherLayout;
+}
+
+Parse checkTopLevel(Cursor& c, const ObjectHeader& top, std::string& why) {
+  if (top.class_name == "CActionCollection") return checkActions(c, top.version, why);
+  if (top.class_name == "CSensoryFrame") return checkFrame(c, top.version, why);
+  Parse p = Parse::OtherLayout;
+  if (top.class_name == "CActionRobotMovement2D") {
+    p = checkMovement2D(c, top.version, why);
+    if (p == Parse::Read && top.has_end_flag && !c.endFlag()) p = Parse::OtherLayout;
+  } else {
+    p = checkObservation(c, top, why);
+  }
+  if (p == Parse::Impossible) why = "corrupt " + top.class_name + ": " + why;
+  return p;
+}
+
 }  // namespace
 
-std::string precheckNextObject(LookaheadStream& in) {
+std::string precheckNextObject(LookaheadStream& in, std::size_t* checked_bytes) {
+  if (checked_bytes) *checked_bytes = 0;
   Cursor c(in);
   ObjectHeader top;
   if (!readHeader(c, top)) return {};
   std::string why;
-  if (top.class_name == "CActionRobotMovement2D") {
-    if (checkMovement2D(c, top.version, why) == Parse::Impossible) {
-      return "corrupt CActionRobotMovement2D: " + why;
-    }
-    return {};
-  }
-  if (top.class_name != "CActionCollection" || top.version != 0) return {};
-  std::uint32_t actions = 0;
-  if (!c.value(actions)) return {};
-  if (actions > kMaxActionsPerCollection) {
-    return "corrupt CActionCollection: " + std::to_string(actions) + " actions (more than " +
-           std::to_string(kMaxActionsPerCollection) + ")";
-  }
-  for (std::uint32_t i = 0; i < actions; ++i) {
-    ObjectHeader action;
-    if (!readHeader(c, action) || action.class_name != "CActionRobotMovement2D") return {};
-    const Parse p = checkMovement2D(c, action.version, why);
-    if (p == Parse::Impossible) {
-      return "corrupt CActionRobotMovement2D (action " + std::to_string(i + 1) + " of " +
-             std::to_string(actions) + " in a CActionCollection): " + why;
-    }
-    if (p == Parse::OtherLayout || (action.has_end_flag && !c.endFlag())) return {};
-  }
+  const Parse p = checkTopLevel(c, top, why);
+  if (p == Parse::Impossible) return why;
+  if (p == Parse::Read && checked_bytes) *checked_bytes = c.walked();
   return {};
 }
 

@@ -5,11 +5,17 @@
 // its deserialization: with any motion model but the Gaussian one it draws as many particles as
 // the stream says, so a corrupt count of 10^9 keeps a playback busy for minutes and gigabytes
 // before the object ends. CActionCollection resizes its list of actions to the count it reads.
+// The observations resize their buffers to the sizes they read: a CObservation2DRangeScan's
+// corrupt scan size makes MRPT allocate 4.3 GB per vector (its aligned allocator returns null
+// when that fails, and MRPT then writes through it), a CImage's JPEG size of 2^32 - 1 wraps to a
+// 9-byte buffer that MRPT then reads 4 GB into.
 // precheckNextObject() reads those fields of the next top-level object (a CActionCollection and
-// the CActionRobotMovement2D actions in it, or a bare CActionRobotMovement2D) as MRPT 2.5.8
-// lays them out (CArchive's object header: a length byte with its high bit set, the class name,
-// a version byte; the body; the end flag 0x88), and names what is impossible. Bytes that follow
-// another layout are left to MRPT, which reports what it finds.
+// the CActionRobotMovement2D actions in it, or a bare CActionRobotMovement2D; a CSensoryFrame
+// and the observations in it, or a bare observation: 2D and 3D range scans, images, stereo
+// images, with the poses, cameras, images and matrices inside them) as MRPT 2.5.8 lays them
+// out (CArchive's object header: a length byte with its high bit set, the class name, a version
+// byte; the body; the end flag 0x88), and names what is impossible. Bytes that follow another
+// layout are left to MRPT, which reports what it finds.
 #pragma once
 
 #include <mrpt/io/CStream.h>
@@ -26,6 +32,19 @@ namespace upd::mrpt_bridge::detail {
 constexpr std::uint32_t kMaxOdometryParticles = 100000;
 /// Most actions in one CActionCollection (a robot writes one or two per step).
 constexpr std::uint32_t kMaxActionsPerCollection = 4096;
+/// Most observations in one CSensoryFrame (a robot writes one per sensor and step).
+constexpr std::uint32_t kMaxObservationsPerFrame = 4096;
+/// Most rays in a CObservation2DRangeScan (a laser scanner gives a few thousand; MRPT allocates
+/// 9 bytes a ray).
+constexpr std::uint32_t kMaxScanRays = 1000000;
+/// Most pixels of an image, range image, matrix or 3D point list (2^24: 4096 x 4096; a depth
+/// camera gives 1-2 M), and most pixels along one side.
+constexpr std::uint64_t kMaxImagePixels = std::uint64_t{1} << 24;
+constexpr std::uint32_t kMaxImageSide = 65535;
+/// Most bytes of a compressed (JPEG) image in a CImage.
+constexpr std::uint32_t kMaxEncodedImageBytes = 1u << 28;
+/// Most bytes of a string (a sensor label, a camera name, an external file name).
+constexpr std::uint32_t kMaxStringBytes = 1u << 16;
 
 /// A read-only stream over another that can look at the bytes ahead of its position without
 /// consuming them. Its position is the count of bytes consumed (the underlying stream's
@@ -52,9 +71,11 @@ class LookaheadStream : public mrpt::io::CStream {
   std::size_t head_ = 0;
 };
 
-/// Why the next top-level object must not be handed to MRPT ("corrupt CActionRobotMovement2D
-/// (action 1 of 1 in a CActionCollection): ..."), or "" when nothing impossible was found.
-/// Consumes nothing.
-std::string precheckNextObject(LookaheadStream& in);
+/// Why the next top-level object must not be handed to MRPT ("corrupt CObservation2DRangeScan
+/// (observation 1 of 1 in a CSensoryFrame): scan size 4294967295 at byte 1234 (more than
+/// 1000000 rays)"), or "" when nothing impossible was found. Consumes nothing. checked_bytes,
+/// when given, is set to the object's length when every field of it was walked (its layout is
+/// one the checks know, to its end flag), 0 when the checks stopped before its end.
+std::string precheckNextObject(LookaheadStream& in, std::size_t* checked_bytes = nullptr);
 
 }  // namespace upd::mrpt_bridge::detail

@@ -202,17 +202,22 @@ sensor_msgs::PointCloud2 pointCloud2FromScored(const core::ScoredFrame& frame) {
   const core::PointCloud& c = frame.cloud_world;
   mod.resize(c.size());
   msg.is_dense = false;
-  sensor_msgs::PointCloud2Iterator<float> xyz(msg, "x"), zeta(msg, "zeta"), cost(msg, "cost");
-  sensor_msgs::PointCloud2Iterator<std::uint8_t> label(msg, "label");
+  // The label byte leaves every float after it unaligned (a point is 21 bytes): the floats are
+  // copied in byte by byte (a float reference there is undefined behaviour; UBSan).
+  using Bytes = sensor_msgs::PointCloud2Iterator<std::uint8_t>;
+  Bytes xyz(msg, "x"), zeta(msg, "zeta"), cost(msg, "cost"), label(msg, "label");
+  const auto put = [](Bytes& field, std::size_t k, float v) {
+    std::memcpy(&field[k * sizeof(float)], &v, sizeof v);
+  };
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const auto& cl = frame.classes;
   for (std::size_t i = 0; i < c.size(); ++i, ++xyz, ++zeta, ++cost, ++label) {
-    xyz[0] = c.x[i];
-    xyz[1] = c.y[i];
-    xyz[2] = c.z[i];
-    *zeta = i < frame.upd.zeta.size() ? frame.upd.zeta[i] : nan;
+    put(xyz, 0, c.x[i]);
+    put(xyz, 1, c.y[i]);
+    put(xyz, 2, c.z[i]);
+    put(zeta, 0, i < frame.upd.zeta.size() ? frame.upd.zeta[i] : nan);
     *label = static_cast<std::uint8_t>(i < cl.label.size() ? cl.label[i] : core::Label::Unknown);
-    *cost = i < cl.cost.size() ? cl.cost[i] : nan;
+    put(cost, 0, i < cl.cost.size() ? cl.cost[i] : nan);
   }
   return msg;
 }

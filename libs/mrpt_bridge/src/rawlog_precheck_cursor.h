@@ -1,0 +1,82 @@
+// The reading side of the rawlog pre-check (private to the bridge): a cursor over the bytes ahead
+// of a LookaheadStream that reads MRPT 2.5.8's serialized values without consuming them, and the
+// checks of the objects a rawlog holds. Each check walks an object as MRPT's serializeFrom() reads
+// it, stops with Parse::Impossible and a reason naming the field, its value and its byte where MRPT
+// would allocate or read what no sensor produces, and with Parse::OtherLayout where the bytes
+// follow a layout it does not know (MRPT then reports what it finds).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <type_traits>
+
+#include "rawlog_precheck.h"
+
+namespace upd::mrpt_bridge::detail {
+
+enum class Parse { Read, Impossible, OtherLayout };
+
+/// Reads ahead of the stream's position: little-endian values (MRPT's byte
+/// order on disk), as MRPT's CArchive would read them next, without consuming
+/// them.
+class Cursor {
+ public:
+  explicit Cursor(LookaheadStream& in) : in_(in), base_(in.getPosition()) {}
+
+  bool bytes(void* out, std::size_t n) {
+    if (!in_.peek(offset_, out, n)) return false;
+    offset_ += n;
+    return true;
+  }
+  template <typename T>
+  bool value(T& v) {
+    static_assert(std::is_integral_v<T> && sizeof(T) <= 8);
+    std::uint8_t b[sizeof(T)];
+    if (!bytes(b, sizeof b)) return false;
+    std::uint64_t u = 0;
+    for (std::size_t i = sizeof(T); i-- > 0;) u = (u << 8) | b[i];
+    std::memcpy(&v, &u, sizeof v);  // little-endian host, as MRPT assumes
+    return true;
+  }
+  /// Fields whose values are not checked: skipped (a read after them fails at
+  /// the end).
+  void skip(std::uint64_t n) { offset_ += static_cast<std::size_t>(n); }
+  /// The byte of the decompressed stream the next value is at.
+  std::uint64_t position() const { return base_ + offset_; }
+  /// Bytes walked since the cursor was made.
+  std::size_t walked() const { return offset_; }
+  bool endFlag() {
+    std::uint8_t f = 0;
+    return value(f) && f == 0x88;  // MRPT's SERIALIZATION_END_FLAG after each object
+  }
+
+ private:
+  LookaheadStream& in_;
+  std::uint64_t base_;
+  std::size_t offset_ = 0;
+};
+
+struct ObjectHeader {
+  std::string class_name;  ///< without a namespace
+  int version = -1;
+  bool has_end_flag = true;  ///< false in the format before MRPT 0.5.5
+};
+
+/// CArchive::internal_ReadObjectHeader's layout; false where MRPT would refuse
+/// it.
+bool readHeader(Cursor& c, ObjectHeader& h);
+
+/// A count or size read from the stream at byte `at`, checked against its
+/// bound: false, with `why` naming the field ("scan size 4294967295 at byte
+/// 1234 (more than 1000000 rays)"), when it exceeds it.
+bool withinBound(const char* field, std::uint64_t value, std::uint64_t at, std::uint64_t max,
+                 const char* unit, std::string& why);
+
+/// An observation object whose header has been read (a CObservation2DRangeScan,
+/// CObservation3DRangeScan, CObservationImage or CObservationStereoImages; any
+/// other class is OtherLayout), up to and including its end flag.
+Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why);
+
+}  // namespace upd::mrpt_bridge::detail

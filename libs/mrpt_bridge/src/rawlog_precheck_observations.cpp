@@ -1,0 +1,409 @@
+// The observations of a rawlog, walked as MRPT 2.5.8's serializeFrom() reads them (the versions it
+// writes, and the older ones whose layout differs only in the fields named here), with every size
+// MRPT allocates from checked before MRPT reads it.
+#include "rawlog_precheck_cursor.h"
+
+#include <csetjmp>
+#include <cstdio>  // before jpeglib.h, which uses FILE and size_t without including them
+#include <vector>
+
+#include <jpeglib.h>
+
+namespace upd::mrpt_bridge::detail {
+namespace {
+
+constexpr Parse kRead = Parse::Read;
+constexpr Parse kOther = Parse::OtherLayout;
+constexpr Parse kImpossible = Parse::Impossible;
+
+// An object header of one of the classes named; false for any other.
+bool header(Cursor& c, ObjectHeader& h, std::initializer_list<const char*> classes) {
+  if (!readHeader(c, h)) return false;
+  for (const char* name : classes) {
+    if (h.class_name == name) return true;
+  }
+  return false;
+}
+
+bool endOf(Cursor& c, const ObjectHeader& h) { return !h.has_end_flag || c.endFlag(); }
+
+// A std::string: a 32-bit length, then the bytes (MRPT resizes the string to the length first).
+Parse string(Cursor& c, const char* field, std::string& why) {
+  const std::uint64_t at = c.position();
+  std::uint32_t length = 0;
+  if (!c.value(length)) return kOther;
+  if (!withinBound(field, length, at, kMaxStringBytes, "bytes", why)) return kImpossible;
+  c.skip(length);
+  return kRead;
+}
+
+// Rows and columns of an image or matrix, each read as 32 bits.
+Parse sides(Cursor& c, const char* field, std::uint64_t& rows, std::uint64_t& cols,
+            std::string& why) {
+  const std::uint64_t at = c.position();
+  std::uint32_t r = 0, k = 0;
+  if (!c.value(r) || !c.value(k)) return kOther;
+  const std::string name(field);
+  if (!withinBound((name + " rows").c_str(), r, at, kMaxImageSide, "rows", why) ||
+      !withinBound((name + " columns").c_str(), k, at + 4, kMaxImageSide, "columns", why) ||
+      !withinBound((name + " pixels").c_str(), std::uint64_t{r} * k, at, kMaxImagePixels, "pixels",
+                   why)) {
+    return kImpossible;
+  }
+  rows = r;
+  cols = k;
+  return kRead;
+}
+
+// CMatrix, CMatrixF, CMatrixD (version 0): rows, columns, then the elements.
+Parse matrix(Cursor& c, const char* field, std::string& why) {
+  ObjectHeader h;
+  if (!header(c, h, {"CMatrix", "CMatrixF", "CMatrixD"}) || h.version != 0) return kOther;
+  std::uint64_t rows = 0, cols = 0;
+  const Parse p = sides(c, field, rows, cols, why);
+  if (p != kRead) return p;
+  c.skip(rows * cols * (h.class_name == "CMatrixD" ? sizeof(double) : sizeof(float)));
+  return endOf(c, h) ? kRead : kOther;
+}
+
+// CPose3D (version 0-1: a homogeneous matrix object, 2: x y z and a quaternion, 3: x y z and a
+// rotation matrix), CPose3DQuat (0), CPose2D (0: floats, 1: doubles).
+Parse pose(Cursor& c, std::string& why) {
+  ObjectHeader h;
+  if (!header(c, h, {"CPose3D", "CPose3DQuat", "CPose2D"})) return kOther;
+  const int v = h.version;
+  if (h.class_name == "CPose3D" && v <= 1) {
+    const Parse p = matrix(c, "pose matrix", why);
+    if (p != kRead) return p;
+  } else if (h.class_name == "CPose3D" && (v == 2 || v == 3)) {
+    c.skip((v == 2 ? 7 : 12) * sizeof(double));
+  } else if (h.class_name == "CPose3DQuat" && v == 0) {
+    c.skip(7 * sizeof(double));
+  } else if (h.class_name == "CPose2D" && (v == 0 || v == 1)) {
+    c.skip(3 * (v == 0 ? sizeof(float) : sizeof(double)));
+  } else {
+    return kOther;
+  }
+  return endOf(c, h) ? kRead : kOther;
+}
+
+// TCamera, version 6 (MRPT 2.5): 13 doubles (the intrinsics, the distortion, the focal length), the
+// resolution, the camera's name, the distortion model (a byte).
+Parse camera(Cursor& c, std::string& why) {
+  ObjectHeader h;
+  if (!header(c, h, {"TCamera"}) || h.version != 6) return kOther;
+  c.skip(13 * sizeof(double) + 2 * sizeof(std::uint32_t));
+  const Parse p = string(c, "camera name length", why);
+  if (p != kRead) return p;
+  c.skip(1);
+  return endOf(c, h) ? kRead : kOther;
+}
+
+// MRPT decodes a CImage's JPEG with libjpeg and its default error handler, which ends the process
+// (exit) on a fatal error in the data, and allocates the image the JPEG's header states. The same
+// bytes go through the same calls of the same libjpeg here first (read the header, decompress every
+// line, finish: the end markers too), with a handler that returns instead.
+struct JpegFailure {
+  jpeg_error_mgr mgr;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX];
+};
+
+[[noreturn]] void jpegErrorExit(j_common_ptr info) {
+  auto* failure = reinterpret_cast<JpegFailure*>(info->err);
+  info->err->format_message(info, failure->message);
+  std::longjmp(failure->jump, 1);
+}
+
+void jpegQuiet(j_common_ptr) {}  // warnings (a missing end marker): MRPT reads on
+
+// "" when the JPEG decodes; else why. Only plain data crosses the setjmp.
+std::string jpegFailure(const std::uint8_t* data, std::size_t size, std::uint64_t* pixels) {
+  jpeg_decompress_struct info;
+  JpegFailure failure;
+  info.err = jpeg_std_error(&failure.mgr);
+  failure.mgr.error_exit = jpegErrorExit;
+  failure.mgr.output_message = jpegQuiet;
+  failure.message[0] = '\0';
+  JSAMPARRAY row = nullptr;
+  if (setjmp(failure.jump) != 0) {
+    jpeg_destroy_decompress(&info);
+    return failure.message;
+  }
+  jpeg_create_decompress(&info);
+  jpeg_mem_src(&info, data, static_cast<unsigned long>(size));
+  jpeg_read_header(&info, TRUE);
+  *pixels = std::uint64_t{info.image_width} * info.image_height;
+  if (*pixels > kMaxImagePixels) {
+    jpeg_destroy_decompress(&info);
+    return "too large";
+  }
+  jpeg_start_decompress(&info);
+  row = (*info.mem->alloc_sarray)(reinterpret_cast<j_common_ptr>(&info), JPOOL_IMAGE,
+                                  info.output_width * info.output_components, 1);
+  while (info.output_scanline < info.output_height) jpeg_read_scanlines(&info, row, 1);
+  jpeg_finish_decompress(&info);
+  jpeg_destroy_decompress(&info);
+  return "";
+}
+
+// A CImage with colour (version 1-9): a JPEG of its byte count, or (version 8 on) raw RGB pixels of
+// the negated width and height.
+Parse colourImage(Cursor& c, int version, std::string& why) {
+  std::int32_t width = 1, height = 1;
+  const std::uint64_t at = c.position();
+  if (version >= 7 && (!c.value(width) || !c.value(height))) return kOther;
+  if (width >= 1 && height >= 1) {
+    const std::uint64_t bytes_at = c.position();
+    std::uint32_t bytes = 0;
+    if (!c.value(bytes)) return kOther;
+    // MRPT allocates bytes + 10 in 32 bits: 2^32 - 1 wraps to a 9-byte buffer it reads into.
+    if (!withinBound("image JPEG size", bytes, bytes_at, kMaxEncodedImageBytes, "bytes", why)) {
+      return kImpossible;
+    }
+    // MRPT hands libjpeg a buffer of bytes + 10.
+    std::vector<std::uint8_t> jpeg(std::size_t{bytes} + 10, 0);
+    if (!c.bytes(jpeg.data(), bytes)) return kOther;  // cut: MRPT reports it
+    std::uint64_t pixels = 0;
+    const std::string failure = jpegFailure(jpeg.data(), jpeg.size(), &pixels);
+    if (pixels > kMaxImagePixels) {
+      why = "image JPEG at byte " + std::to_string(bytes_at + 4) + ": its header says " +
+            std::to_string(pixels) + " pixels (more than " + std::to_string(kMaxImagePixels) + ")";
+      return kImpossible;
+    }
+    if (!failure.empty()) {
+      why = "image JPEG of " + std::to_string(bytes) + " bytes at byte " +
+            std::to_string(bytes_at + 4) + " does not decode (" + failure +
+            "; MRPT's JPEG reader would end the process)";
+      return kImpossible;
+    }
+    return kRead;
+  }
+  if (width < 0 && height < 0) {  // raw pixels; -INT_MIN does not exist
+    const std::uint64_t w = 0 - static_cast<std::int64_t>(width);
+    const std::uint64_t h = 0 - static_cast<std::int64_t>(height);
+    if (!withinBound("image width", w, at, kMaxImageSide, "pixels", why) ||
+        !withinBound("image height", h, at + 4, kMaxImageSide, "pixels", why) ||
+        !withinBound("image pixels", w * h, at, kMaxImagePixels, "pixels", why)) {
+      return kImpossible;
+    }
+    c.skip(w * h * 3);
+    return kRead;
+  }
+  if (width < 0 || height < 0) {  // MRPT would resize to a negative side read as unsigned
+    why = "image size " + std::to_string(width) + " x " + std::to_string(height) + " at byte " +
+          std::to_string(at) + " (a negative side with a positive one)";
+    return kImpossible;
+  }
+  return kRead;  // 0 x N: nothing follows
+}
+
+// A grey CImage (version 2-9): width, height, origin, byte count[, depth], [zip flag], bytes.
+Parse greyImage(Cursor& c, int version, std::string& why) {
+  const std::uint64_t at = c.position();
+  std::int32_t width = 0, height = 0, origin = 0, depth = 0;
+  std::uint32_t bytes = 0;
+  if (!c.value(width) || !c.value(height) || !c.value(origin) || !c.value(bytes)) return kOther;
+  if (version >= 9 && !c.value(depth)) return kOther;
+  const auto w = static_cast<std::uint32_t>(width), h = static_cast<std::uint32_t>(height);
+  if (!withinBound("image width", w, at, kMaxImageSide, "pixels", why) ||
+      !withinBound("image height", h, at + 4, kMaxImageSide, "pixels", why) ||
+      !withinBound("image pixels", std::uint64_t{w} * h, at, kMaxImagePixels, "pixels", why)) {
+    return kImpossible;
+  }
+  std::uint8_t zip = version == 3 || (version == 4 && bytes > 16 * 1024);
+  if (version >= 5 && !c.value(zip)) return kOther;
+  if (zip) return kOther;  // MRPT 2.5 refuses a zipped image itself
+  // MRPT checks the byte count against the buffer it allocated (an ASSERT that throws).
+  c.skip(bytes);
+  return kRead;
+}
+
+// CImage, versions 0-9 and 100 (saved without OpenCV): stored externally (a file name) or embedded.
+Parse image(Cursor& c, std::string& why) {
+  ObjectHeader h;
+  if (!header(c, h, {"CImage"})) return kOther;
+  const int v = h.version;
+  Parse p = kOther;
+  std::uint8_t external = 0, colour = 0;
+  if (v == 0) {  // width, height, channels, origin, bytes: read into the resized
+                 // image
+    const std::uint64_t at = c.position();
+    std::uint32_t w = 0, height = 0, channels = 0, bytes = 0;
+    std::uint8_t origin = 0;
+    if (!c.value(w) || !c.value(height) || !c.value(channels) || !c.value(origin) ||
+        !c.value(bytes)) {
+      return kOther;
+    }
+    const std::uint64_t size = std::uint64_t{w} * height * channels;
+    if (!withinBound("image width", w, at, kMaxImageSide, "pixels", why) ||
+        !withinBound("image height", height, at + 4, kMaxImageSide, "pixels", why) ||
+        !withinBound("image channels", channels, at + 8, 4, "channels", why) ||
+        !withinBound("image byte count", bytes, at + 13, size, "bytes (width x height x channels)",
+                     why)) {
+      return kImpossible;
+    }
+    c.skip(bytes);
+    p = kRead;
+  } else if (v == 1) {
+    p = colourImage(c, v, why);
+  } else if (v == 100 || (v >= 2 && v <= 9)) {
+    if ((v == 100 || v >= 6) && !c.value(external)) return kOther;
+    if (external) {
+      p = string(c, "image file name length", why);
+    } else if (v == 100) {
+      p = kRead;
+    } else if (!c.value(colour)) {
+      return kOther;
+    } else {
+      p = colour ? colourImage(c, v, why) : greyImage(c, v, why);
+    }
+  }
+  if (p != kRead) return p;
+  return endOf(c, h) ? kRead : kOther;
+}
+
+// An image flag, then the image when the flag is set.
+Parse optionalImage(Cursor& c, std::string& why) {
+  std::uint8_t has = 0;
+  if (!c.value(has)) return kOther;
+  return has ? image(c, why) : kRead;
+}
+
+// CObservation2DRangeScan, versions 4-7.
+Parse scan2D(Cursor& c, int version, std::string& why) {
+  if (version < 4 || version > 7) return kOther;
+  c.skip(sizeof(float) + 1 + sizeof(float));  // aperture, rightToLeft, maxRange
+  Parse p = pose(c, why);
+  if (p == kRead && version < 6) p = matrix(c, "sensor pose covariance", why);
+  if (p != kRead) return p;
+  const std::uint64_t at = c.position();
+  std::uint32_t rays = 0;
+  if (!c.value(rays)) return kOther;
+  if (!withinBound("scan size", rays, at, kMaxScanRays, "rays", why)) return kImpossible;
+  c.skip(std::uint64_t{rays} * (sizeof(float) + 1));              // ranges, validity
+  c.skip(sizeof(float) + sizeof(std::uint64_t) + sizeof(float));  // stdError, stamp, beam
+  if (version >= 5) {
+    p = string(c, "sensor label length", why);
+    if (p != kRead) return p;
+    c.skip(sizeof(double));  // deltaPitch
+  }
+  std::uint8_t intensity = 0;
+  if (version >= 7 && !c.value(intensity)) return kOther;
+  if (intensity) c.skip(std::uint64_t{rays} * sizeof(std::int32_t));
+  return kRead;
+}
+
+// CObservation3DRangeScan, versions 0-10: the 3D points, the range image and the other images.
+Parse scan3DImages(Cursor& c, int version, std::string& why) {
+  std::uint8_t has_points = 1, has_range = 0;
+  if (version > 0 && !c.value(has_points)) return kOther;
+  if (has_points) {
+    const std::uint64_t at = c.position();
+    std::uint32_t n = 0;
+    if (!c.value(n)) return kOther;
+    if (!withinBound("3D point count", n, at, kMaxImagePixels, "points", why)) return kImpossible;
+    c.skip(std::uint64_t{n} * (3 * sizeof(float) + (version == 0 ? 1 : 0) +
+                               (version >= 8 ? 2 * sizeof(std::uint16_t) : 0)));
+  }
+  if (version == 0) return kRead;
+  if (!c.value(has_range)) return kOther;
+  if (version >= 9) c.skip(sizeof(float));  // rangeUnits
+  if (has_range) {
+    if (version < 9) {
+      const Parse p = matrix(c, "range image", why);
+      if (p != kRead) return p;
+    } else {
+      std::uint64_t rows = 0, cols = 0;
+      const Parse p = sides(c, "range image", rows, cols, why);
+      if (p != kRead) return p;
+      c.skip(rows * cols * sizeof(std::uint16_t));
+    }
+  }
+  Parse p = optionalImage(c, why);                     // intensity
+  if (p == kRead) p = optionalImage(c, why);           // confidence
+  if (p == kRead && version >= 2) p = camera(c, why);  // depth camera
+  if (p == kRead && version >= 4) p = camera(c, why);  // intensity camera
+  if (p == kRead && version >= 4) p = pose(c, why);    // intensity camera's pose
+  return p;
+}
+
+Parse scan3D(Cursor& c, int version, std::string& why) {
+  if (version > 10) return kOther;
+  c.skip(sizeof(float));  // maxRange
+  Parse p = pose(c, why);
+  if (p == kRead) p = scan3DImages(c, version, why);
+  if (p != kRead) return p;
+  c.skip(sizeof(float) + sizeof(std::uint64_t));  // stdError, timestamp
+  if ((p = string(c, "sensor label length", why)) != kRead) return p;
+  if (version >= 3) {
+    for (const char* field :
+         {"external points file name length", "external range file name length"}) {
+      c.skip(1);  // stored externally
+      if ((p = string(c, field, why)) != kRead) return p;
+    }
+  }
+  if (version >= 5) c.skip(1);  // range_is_depth
+  if (version >= 6) c.skip(1);  // intensity channel
+  std::uint8_t labels = 0;
+  if (version >= 7 && !c.value(labels)) return kOther;
+  if (labels) return kOther;  // pixel labels: left to MRPT
+  if (version < 10) return kRead;
+  std::uint8_t layers = 0;
+  if (!c.value(layers)) return kOther;
+  for (unsigned i = 0; i < layers; ++i) {
+    if ((p = string(c, "range layer name length", why)) != kRead) return p;
+    std::uint64_t rows = 0, cols = 0;
+    if ((p = sides(c, "range layer", rows, cols, why)) != kRead) return p;
+    c.skip(rows * cols * sizeof(std::uint16_t));
+  }
+  return kRead;
+}
+
+// CObservationImage, version 4: camera pose, camera, image, timestamp, label.
+Parse monoImage(Cursor& c, int version, std::string& why) {
+  if (version != 4) return kOther;
+  Parse p = pose(c, why);
+  if (p == kRead) p = camera(c, why);
+  if (p == kRead) p = image(c, why);
+  if (p != kRead) return p;
+  c.skip(sizeof(std::uint64_t));
+  return string(c, "sensor label length", why);
+}
+
+// CObservationStereoImages, version 6: pose, two cameras, the left image, the disparity and right
+// flags and images, timestamp, the right camera's pose, label.
+Parse stereoImages(Cursor& c, int version, std::string& why) {
+  if (version != 6) return kOther;
+  Parse p = pose(c, why);
+  if (p == kRead) p = camera(c, why);
+  if (p == kRead) p = camera(c, why);
+  if (p == kRead) p = image(c, why);
+  if (p != kRead) return p;
+  std::uint8_t disparity = 0, right = 0;
+  if (!c.value(disparity) || !c.value(right)) return kOther;
+  if (right && (p = image(c, why)) != kRead) return p;
+  if (disparity && (p = image(c, why)) != kRead) return p;
+  c.skip(sizeof(std::uint64_t));
+  if ((p = pose(c, why)) != kRead) return p;
+  return string(c, "sensor label length", why);
+}
+
+}  // namespace
+
+Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
+  Parse p = kOther;
+  if (h.class_name == "CObservation2DRangeScan") {
+    p = scan2D(c, h.version, why);
+  } else if (h.class_name == "CObservation3DRangeScan") {
+    p = scan3D(c, h.version, why);
+  } else if (h.class_name == "CObservationImage") {
+    p = monoImage(c, h.version, why);
+  } else if (h.class_name == "CObservationStereoImages") {
+    p = stereoImages(c, h.version, why);
+  }
+  if (p != kRead) return p;
+  return endOf(c, h) ? kRead : kOther;
+}
+
+}  // namespace upd::mrpt_bridge::detail

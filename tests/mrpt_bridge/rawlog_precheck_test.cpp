@@ -1,0 +1,299 @@
+// The rawlog pre-check against MRPT 2.5.8's own writer: every object MRPT writes is walked to its
+// end (the check follows the layout byte for byte), and each size MRPT would allocate from,
+// corrupted in a file written here, is damage naming the object, the field and its byte.
+#include "../../libs/mrpt_bridge/src/rawlog_precheck.h"
+#include "temp_dir.h"
+#include "upd/mrpt_bridge/rawlog_reader.h"
+
+#include <mrpt/img/CImage.h>
+#include <mrpt/io/CFileOutputStream.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationComment.h>
+#include <mrpt/obs/CObservationImage.h>
+#include <mrpt/obs/CObservationStereoImages.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <fstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+using upd::mrpt_bridge::RawlogEntry;
+using upd::mrpt_bridge::RawlogError;
+using upd::mrpt_bridge::RawlogReader;
+using upd::mrpt_bridge::detail::LookaheadStream;
+using upd::mrpt_bridge::detail::precheckNextObject;
+using upd::test::TempDir;
+
+std::string serialized(const mrpt::serialization::CSerializable& o) {
+  mrpt::io::CMemoryStream mem;
+  mrpt::serialization::archiveFrom(mem) << o;
+  const auto* data = static_cast<const char*>(mem.getRawBufferData());
+  return std::string(data, data + mem.getTotalBytesCount());
+}
+
+// The distinctive sizes below are found in the bytes by value (the payloads are zeros).
+std::string u32(std::uint32_t v) {
+  std::string s(4, '\0');
+  for (int i = 0; i < 4; ++i) s[i] = static_cast<char>((v >> (8 * i)) & 0xFF);
+  return s;
+}
+
+mrpt::obs::CObservation2DRangeScan::Ptr scan2D() {
+  auto s = mrpt::obs::CObservation2DRangeScan::Create();
+  s->resizeScan(777);
+  s->setScanHasIntensity(true);
+  s->sensorLabel = "LASERLABEL";
+  return s;
+}
+
+mrpt::obs::CObservation3DRangeScan::Ptr scan3D() {
+  auto d = mrpt::obs::CObservation3DRangeScan::Create();
+  d->hasPoints3D = true;
+  d->resizePoints3DVectors(555);
+  d->hasRangeImage = true;
+  d->rangeImage_setSize(33, 44);
+  d->hasIntensityImage = true;
+  d->intensityImage.resize(44, 33, mrpt::img::CH_RGB);
+  d->hasConfidenceImage = true;
+  d->confidenceImage.resize(44, 33, mrpt::img::CH_GRAY);
+  d->rangeImageOtherLayers["STRONGEST"].resize(33, 44);
+  d->sensorLabel = "DEPTH";
+  return d;
+}
+
+mrpt::obs::CObservationImage::Ptr greyImage() {
+  auto o = mrpt::obs::CObservationImage::Create();
+  o->image.resize(37, 29, mrpt::img::CH_GRAY);
+  o->image.filledRectangle(0, 0, 36, 28, mrpt::img::TColor(0, 0, 0));
+  return o;
+}
+
+mrpt::obs::CObservationStereoImages::Ptr stereo() {
+  auto o = mrpt::obs::CObservationStereoImages::Create();
+  o->imageLeft.resize(48, 40, mrpt::img::CH_RGB);
+  o->imageLeft.filledRectangle(0, 0, 47, 39, mrpt::img::TColor(10, 200, 30));
+  o->imageRight.resize(50, 40, mrpt::img::CH_RGB);
+  o->imageRight.filledRectangle(0, 0, 49, 39, mrpt::img::TColor(30, 20, 100));
+  o->hasImageRight = true;
+  o->sensorLabel = "STEREO";
+  return o;
+}
+
+std::size_t walked(const std::string& bytes, std::string* why = nullptr) {
+  mrpt::io::CMemoryStream mem;
+  mem.assignMemoryNotOwn(bytes.data(), bytes.size());
+  LookaheadStream in(mem);
+  std::size_t checked = 0;
+  const std::string reason = precheckNextObject(in, &checked);
+  if (why) *why = reason;
+  EXPECT_EQ(in.getPosition(), 0u) << "the check consumed bytes";
+  return checked;
+}
+
+// Every field of every object MRPT writes is where the check expects it: the walk ends exactly at
+// the object's end, with nothing found impossible.
+TEST(RawlogPrecheck, ObjectsMrptWritesAreWalkedToTheirEnd) {
+  const bool jpeg_off = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+  for (bool jpeg : {false, true}) {
+    mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(!jpeg);
+    mrpt::obs::CSensoryFrame frame;
+    frame.insert(scan2D());
+    frame.insert(scan3D());
+    frame.insert(greyImage());
+    frame.insert(stereo());
+    mrpt::obs::CActionCollection actions;
+    mrpt::obs::CActionRobotMovement2D odometry;
+    odometry.estimationMethod = mrpt::obs::CActionRobotMovement2D::emOdometry;
+    actions.insert(odometry);
+    const mrpt::serialization::CSerializable::Ptr bare[] = {scan2D(), scan3D(), greyImage(),
+                                                            stereo()};
+    const mrpt::serialization::CSerializable* objects[] = {
+        bare[0].get(), bare[1].get(), bare[2].get(), bare[3].get(), &frame, &actions};
+    for (const auto* o : objects) {
+      SCOPED_TRACE(std::string(o->GetRuntimeClass()->className) + (jpeg ? " (JPEG)" : ""));
+      const std::string bytes = serialized(*o);
+      std::string why;
+      EXPECT_EQ(walked(bytes, &why), bytes.size());
+      EXPECT_EQ(why, "");
+    }
+  }
+  mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(jpeg_off);
+}
+
+struct Corruption {
+  const char* name;
+  std::string object;       ///< the bytes of the object, as MRPT wrote them
+  std::string field;        ///< the bytes of the field to corrupt (found once in `object`)
+  std::size_t field_skip;   ///< bytes from the start of `field` to the value replaced
+  std::string value;        ///< written over the value
+  std::string reason_head;  ///< the reason up to " at byte "
+  std::string reason_tail;  ///< the reason after the byte
+};
+
+std::vector<Corruption> corruptions(bool in_frame) {
+  auto wrap = [&](const mrpt::obs::CObservation::Ptr& o) {
+    if (!in_frame) return serialized(*o);
+    mrpt::obs::CSensoryFrame f;
+    f.insert(o);
+    return serialized(f);
+  };
+  const std::string where = in_frame ? " (observation 1 of 1 in a CSensoryFrame): " : ": ";
+  const std::string s2 = "corrupt CObservation2DRangeScan" + where;
+  const std::string s3 = "corrupt CObservation3DRangeScan" + where;
+  const std::string im = "corrupt CObservationImage" + where;
+  const std::string st = "corrupt CObservationStereoImages" + where;
+  const bool jpeg_off = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+  mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+  const std::string stereo_bytes = wrap(stereo());
+  mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(true);  // raw colour pixels in the 3D scan
+  const std::string scan3d_bytes = wrap(scan3D());
+  mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(jpeg_off);
+  const std::string ones = u32(0xFFFFFFFFu);
+  return {
+      {"scan size", wrap(scan2D()), u32(777), 0, ones, s2 + "scan size 4294967295",
+       " (more than 1000000 rays)"},
+      {"scan size just above", wrap(scan2D()), u32(777), 0, u32(1000001), s2 + "scan size 1000001",
+       " (more than 1000000 rays)"},
+      {"label", wrap(scan2D()), u32(10) + "LASERLABEL", 0, u32(2200000000u),
+       s2 + "sensor label length 2200000000", " (more than 65536 bytes)"},
+      {"3D points", scan3d_bytes, u32(555), 0, u32(0x40000000u), s3 + "3D point count 1073741824",
+       " (more than 16777216 points)"},
+      {"range image rows", scan3d_bytes, u32(33) + u32(44), 0, u32(70000),
+       s3 + "range image rows 70000", " (more than 65535 rows)"},
+      {"range image pixels", scan3d_bytes, u32(33) + u32(44), 0, u32(60000) + u32(60000),
+       s3 + "range image pixels 3600000000", " (more than 16777216 pixels)"},
+      // MRPT writes a layer's columns, then its rows, and reads rows, then columns.
+      {"range layer", scan3d_bytes, "STRONGEST", 9, u32(70000), s3 + "range layer rows 70000",
+       " (more than 65535 rows)"},
+      {"intensity image width", scan3d_bytes, u32(static_cast<std::uint32_t>(-44)), 0,
+       u32(static_cast<std::uint32_t>(-70000)), s3 + "image width 70000",
+       " (more than 65535 pixels)"},
+      {"grey image height", wrap(greyImage()), u32(37) + u32(29), 4, u32(0x80000000u),
+       im + "image height 2147483648", " (more than 65535 pixels)"},
+      {"JPEG size", stereo_bytes, u32(48) + u32(40), 8, ones, st + "image JPEG size 4294967295",
+       " (more than 268435456 bytes)"},
+  };
+}
+
+// Each size MRPT would allocate from, corrupted in a rawlog written here, is damage at that object
+// before MRPT reads it; the reason names the field, its value and its byte in the file.
+TEST(RawlogPrecheck, CorruptSizesAreDamageNamingObjectFieldAndByte) {
+  TempDir tmp;
+  for (bool in_frame : {true, false}) {
+    for (const Corruption& c : corruptions(in_frame)) {
+      SCOPED_TRACE(std::string(c.name) + (in_frame ? " in a frame" : " bare"));
+      const auto field_at = c.object.find(c.field);
+      ASSERT_NE(field_at, std::string::npos);
+      ASSERT_EQ(c.object.find(c.field, field_at + 1), std::string::npos) << "not unique";
+      mrpt::obs::CObservationComment before;
+      before.text = "before";
+      const std::string head = serialized(before);
+      std::string bytes = head + c.object;
+      const std::size_t value_at = head.size() + field_at + c.field_skip;
+      bytes.replace(value_at, c.value.size(), c.value);
+      const fs::path file = tmp.path() / "corrupt.rawlog";
+      std::ofstream(file, std::ios::binary)
+          .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      RawlogReader reader(file.string());
+      RawlogEntry e;
+      ASSERT_TRUE(reader.next(e));
+      EXPECT_EQ(e.className(), "CObservationComment");
+      try {
+        reader.next(e);
+        ADD_FAILURE() << "the object was read";
+      } catch (const RawlogError& err) {
+        EXPECT_EQ(err.objectIndex(), 1u);
+        EXPECT_EQ(err.byteOffset(), head.size());
+        EXPECT_EQ(err.reason().rfind(c.reason_head + " at byte " + std::to_string(value_at), 0), 0u)
+            << err.reason();
+        EXPECT_EQ(err.reason().substr(err.reason().size() - c.reason_tail.size()), c.reason_tail);
+      }
+    }
+  }
+}
+
+// The reason RawlogReader gives for a file of a comment and then `object`.
+std::string damageReason(const TempDir& tmp, const std::string& object, std::size_t* head_size) {
+  mrpt::obs::CObservationComment before;
+  before.text = "before";
+  const std::string head = serialized(before);
+  *head_size = head.size();
+  const fs::path file = tmp.path() / "damaged.rawlog";
+  const std::string bytes = head + object;
+  std::ofstream(file, std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  RawlogReader reader(file.string());
+  RawlogEntry e;
+  EXPECT_TRUE(reader.next(e));
+  try {
+    reader.next(e);
+  } catch (const RawlogError& err) {
+    EXPECT_EQ(err.objectIndex(), 1u);
+    EXPECT_EQ(err.byteOffset(), head.size());
+    return err.reason();
+  }
+  return "(read)";
+}
+
+// MRPT decodes an image's JPEG with libjpeg's default error handler, which ends the process on a
+// fatal error (found by fuzz_rawlog: an unknown marker after the image data), and allocates what
+// the JPEG's header states (libjpeg itself refuses more than 65,500 a side): both are damage at the
+// object, found before MRPT decodes it.
+TEST(RawlogPrecheck, JpegThatWouldEndTheProcessIsDamage) {
+  TempDir tmp;
+  const bool jpeg_off = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+  mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+  const std::string good = serialized(*stereo());
+  mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(jpeg_off);
+  const auto size_at = good.find(u32(48) + u32(40)) + 8;  // the left image's JPEG byte count
+  ASSERT_NE(size_at, std::string::npos + 8);
+  std::uint32_t jpeg_bytes = 0;
+  for (int i = 3; i >= 0; --i)
+    jpeg_bytes = (jpeg_bytes << 8) | static_cast<std::uint8_t>(good[size_at + i]);
+  const std::size_t jpeg_at = size_at + 4;
+  ASSERT_EQ(good.substr(jpeg_at, 2), "\xFF\xD8");  // start of image
+  ASSERT_EQ(good.substr(jpeg_at + jpeg_bytes - 2, 2),
+            "\xFF\xD9");  // end of image
+  std::size_t head = 0;
+  std::string bad_marker = good;
+  bad_marker[jpeg_at + jpeg_bytes - 1] = '\x9A';
+  const std::string bad_marker_reason = damageReason(tmp, bad_marker, &head);
+  EXPECT_EQ(bad_marker_reason,
+            "corrupt CObservationStereoImages: image JPEG of " + std::to_string(jpeg_bytes) +
+                " bytes at byte " + std::to_string(head + jpeg_at) +
+                " does not decode (Unsupported marker type 0x9a; MRPT's JPEG "
+                "reader would end "
+                "the process)");
+  std::string huge = good;
+  const auto sof = huge.find("\xFF\xC0", jpeg_at);  // baseline frame: length, precision, H, W
+  ASSERT_LT(sof, jpeg_at + jpeg_bytes);
+  huge.replace(sof + 5, 4, std::string("\x40\x00\x40\x00", 4));  // 16384 x 16384
+  const std::string huge_reason = damageReason(tmp, huge, &head);
+  EXPECT_EQ(huge_reason,
+            "corrupt CObservationStereoImages: image JPEG at byte " +
+                std::to_string(head + jpeg_at) +
+                ": its header says 268435456 pixels (more than 16777216)");
+  EXPECT_EQ(damageReason(tmp, good, &head), "(read)");
+}
+
+// Sizes at their bounds are read by MRPT as usual (a 2D scan of 1,000,000 rays).
+TEST(RawlogPrecheck, SizesAtTheBoundAreRead) {
+  auto s = mrpt::obs::CObservation2DRangeScan::Create();
+  s->resizeScan(upd::mrpt_bridge::detail::kMaxScanRays);
+  const std::string bytes = serialized(*s);
+  std::string why;
+  EXPECT_EQ(walked(bytes, &why), bytes.size());
+  EXPECT_EQ(why, "");
+}
+
+}  // namespace
