@@ -72,6 +72,12 @@ std::uint64_t squareKey(std::int64_t ix, std::int64_t iy) {
   return (static_cast<std::uint64_t>(ix) << 32) ^ (static_cast<std::uint64_t>(iy) & 0xffffffffull);
 }
 
+/// The key of the decimation square (edge 1 / inv_decimation_m) that holds p_world.
+std::uint64_t decimationSquare(const Eigen::Vector2d& p_world, double inv_decimation_m) {
+  return squareKey(static_cast<std::int64_t>(std::floor(p_world.x() * inv_decimation_m)),
+                   static_cast<std::int64_t>(std::floor(p_world.y() * inv_decimation_m)));
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector2d> ObstacleSource::pointsInRobot(const Pose2D& pose_world_robot) const {
@@ -83,15 +89,11 @@ std::vector<Eigen::Vector2d> ObstacleSource::pointsInRobot(const Pose2D& pose_wo
   const auto inRange = [&](const Eigen::Vector2d& p_world) {
     return p_world.allFinite() && (p_world - centre).squaredNorm() <= r2;
   };
-  const auto squareOf = [&](const Eigen::Vector2d& p_world) {
-    return squareKey(static_cast<std::int64_t>(std::floor(p_world.x() * inv)),
-                     static_cast<std::int64_t>(std::floor(p_world.y() * inv)));
-  };
   if (params_.use_map && grid_ != nullptr) addMapPoints(pose_world_robot, taken, out);
   // One point per decimation square of the world frame: the first source that claims the
   // square gives its point (map cells first, so the set is stable from step to step).
   const auto add = [&](const Eigen::Vector2d& p_world) {
-    if (!inRange(p_world) || !taken.insert(squareOf(p_world)).second) return;
+    if (!inRange(p_world) || !taken.insert(decimationSquare(p_world, inv)).second) return;
     out.push_back(worldToRobot(pose_world_robot, p_world));
   };
   if (params_.use_current_frame) {
@@ -132,8 +134,7 @@ void ObstacleSource::addMapPoints(const Pose2D& pose_world_robot,
         const Eigen::Vector2d p = c + Eigen::Vector2d(i * h, j * h);
         if ((p - centre).squaredNorm() > r2) continue;
         if (!lattice.insert(squareKey(2 * cx + 1 + i, 2 * cy + 1 + j)).second) continue;
-        taken_squares.insert(squareKey(static_cast<std::int64_t>(std::floor(p.x() * inv)),
-                                       static_cast<std::int64_t>(std::floor(p.y() * inv))));
+        taken_squares.insert(decimationSquare(p, inv));
         out.push_back(worldToRobot(pose_world_robot, p));
       }
     }
