@@ -4,6 +4,7 @@
 #include "upd/io/atomic_file.h"
 #include "upd/io/json_io.h"
 #include "upd/maps/grid_export.h"
+#include "upd/nav/scene_objects.h"
 
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/io/zip.h>
@@ -11,7 +12,6 @@
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/opengl/CPointCloudColoured.h>
 #include <mrpt/opengl/CSetOfLines.h>
-#include <mrpt/rtti/CObject.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
@@ -39,19 +39,6 @@ std::shared_ptr<mrpt::opengl::CPointCloudColoured> gridCells(
   return cells;
 }
 
-// A CSetOfLines made (and so destroyed) by MRPT's own code. MRPT 2.5.8's headers declare its
-// CRenderizableShaderPoints base 32-byte aligned, but GCC 12 lays that base out 16 bytes off
-// the 32-byte grid inside CSetOfLines: the destructor that CSetOfLines::Create() instantiates
-// here is a member call on a misaligned object (UBSan, found by scripts/sanitize.sh on
-// `upd playback`). The object MRPT's class factory makes has the same layout, but its
-// destructor is compiled inside libmrpt-opengl.
-mrpt::opengl::CSetOfLines::Ptr newLines() {
-  auto lines = std::dynamic_pointer_cast<mrpt::opengl::CSetOfLines>(
-      mrpt::rtti::classFactory("mrpt::opengl::CSetOfLines"));
-  if (!lines) throw std::logic_error("MRPT's class factory does not know CSetOfLines");
-  return lines;
-}
-
 // The grid's known cells and the trajectory as an MRPT scene (SceneViewer3D), written as
 // COpenGLScene::saveToFile does (gzip, level 1) but through io::writeFileAtomically.
 void write3DScene(const maps::TraversabilityGrid& grid,
@@ -63,7 +50,7 @@ void write3DScene(const maps::TraversabilityGrid& grid,
   plane->setColor(0.7, 0.7, 0.7, 0.4);
   scene.insert(plane);
   scene.insert(gridCells(grid));
-  auto path_lines = newLines();
+  auto path_lines = nav::newSetOfLines();
   path_lines->setColor(0.1, 0.2, 0.9);
   path_lines->setLineWidth(3);
   for (std::size_t k = 1; k < trajectory.size(); ++k) {

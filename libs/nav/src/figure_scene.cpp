@@ -2,6 +2,8 @@
 // (figure_scene.h).
 #include "figure_scene.h"
 
+#include "upd/nav/scene_objects.h"
+
 #include <mrpt/core/format.h>
 
 #include <Eigen/Geometry>
@@ -122,7 +124,7 @@ mrpt::opengl::CPointCloudColoured::Ptr cloudPoints(const ScoredCloud& c, const F
 }
 
 mrpt::opengl::CSetOfLines::Ptr normalLines(const Frame& f) {
-  auto lines = mrpt::opengl::CSetOfLines::Create();
+  auto lines = newSetOfLines();
   lines->setColor_u8(mrpt::img::TColor(30, 30, 30));
   lines->setLineWidth(1.5f);
   Frame cloud_box;

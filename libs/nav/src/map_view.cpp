@@ -3,6 +3,7 @@
 #include "upd/nav/map_view.h"
 #include "figure_scene.h"
 #include "map_scene.h"
+#include "upd/nav/scene_objects.h"
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/opengl/CBox.h>
@@ -164,7 +165,7 @@ mrpt::opengl::CRenderizable::Ptr octreeVoxels(const MapSnapshot& m, FigureColor 
 // A polyline through points, lifted by dz [m] above them.
 mrpt::opengl::CSetOfLines::Ptr polyline(const std::vector<Eigen::Vector3f>& points, mrpt::img::TColor colour,
                                         float width, float dz) {
-  auto lines = mrpt::opengl::CSetOfLines::Create();
+  auto lines = newSetOfLines();
   lines->setColor_u8(colour);
   lines->setLineWidth(width);
   for (std::size_t k = 1; k < points.size(); ++k) {
