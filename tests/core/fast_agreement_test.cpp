@@ -98,6 +98,44 @@ TEST(FastNormals, OrganizedScansFindTheExactNeighbourhoods) {
   EXPECT_LE(validity_differs, c.size() / 1000);
 }
 
+// The organized normals' invalid count is the number of pixels left without a normal, a pixel
+// without a point gets none, and the others do unless their window found no plane; on image
+// widths that are and are not a multiple of the vector width, with NaN holes and a NaN row.
+TEST(FastNormals, OrganizedInvalidCountIsThePixelsWithoutANormal) {
+  const PointCloud full = kinectFrame().scene.cloud;
+  for (const std::size_t width : {full.width, full.width - 3}) {
+    PointCloud c;
+    c.resizeOrganized(width, full.height);
+    c.sensor_origin = full.sensor_origin;
+    std::size_t holes = 0;
+    for (std::size_t v = 0; v < c.height; ++v) {
+      for (std::size_t u = 0; u < width; ++u) {
+        const std::size_t i = v * width + u, j = v * full.width + u;
+        if ((u * 7 + v * 13) % 29 == 0 || v == 40) continue;  // (NaN: resizeOrganized's fill)
+        c.x[i] = full.x[j], c.y[i] = full.y[j], c.z[i] = full.z[j];
+      }
+    }
+    for (std::size_t i = 0; i < c.size(); ++i) holes += c.isFinite(i) ? 0 : 1;
+    NormalParams p;
+    p.radius_m = 0.05;
+    Normals n;
+    computeNormalsOrganized(c, p, Eigen::Vector3f::UnitZ(), n);
+    ASSERT_EQ(n.size(), c.size());
+    std::size_t without = 0, finite_without = 0;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      if (!c.isFinite(i)) {
+        ASSERT_FALSE(n.isValid(i)) << "pixel " << i;
+        ASSERT_TRUE(std::isnan(n.curvature[i])) << "pixel " << i;
+      }
+      without += n.isValid(i) ? 0 : 1;
+      finite_without += c.isFinite(i) && !n.isValid(i) ? 1 : 0;
+    }
+    EXPECT_EQ(n.invalid, without) << "width " << width;
+    EXPECT_GT(holes, c.size() / 20);
+    EXPECT_LT(finite_without, (c.size() - holes) / 50) << "width " << width;
+  }
+}
+
 // A generated scene on a 0.02 m grid with 2 mm of noise, and its exact normals (r = 0.05 m).
 Scene noisyScene(const std::string& name) {
   SceneParams sp;

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 namespace upd::core {
 namespace {
@@ -178,6 +179,48 @@ TEST_P(TiltedPlane, ZetaIsOneAndSlopeEqualsTilt) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Tilts, TiltedPlane, ::testing::Values(0.0, 5.0, 20.0, 35.0, 60.0));
+
+// The label counts are those of the labels written, and each label follows the rule: unknown
+// where zeta is NaN or k < min_neighbors, else non-traversable where zeta < zeta_min or the slope
+// of r exceeds max_slope. Over several of the stage's chunks, with NaN, vanishing r and k at the
+// bound; fixed seed.
+TEST(Classify, LabelsFollowTheRuleAndTheCountsAreTheLabelsWritten) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.f, 1.f), zeta(0.9f, 1.f);
+  const std::size_t n = 30011;
+  UpdResult r = UpdResult::unscored(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i % 13 == 0) continue;  // unscored
+    r.rx[i] = u(rng), r.ry[i] = u(rng), r.rz[i] = 2.f + u(rng);
+    if (i % 17 == 0) r.rx[i] = r.ry[i] = r.rz[i] = 0.f;  // no direction: the steepest slope
+    r.zeta[i] = zeta(rng);
+    r.k[i] = static_cast<std::uint32_t>(8 + i % 5);  // below, at and over min_neighbors
+  }
+  ClassifyParams p;
+  p.min_neighbors = 10;
+  const Classification c = classify(r, kUp, p);
+  ASSERT_EQ(c.label.size(), n);
+  std::size_t counts[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool valid = !std::isnan(r.zeta[i]) && r.k[i] >= 10;
+    const Eigen::Vector3f v(r.rx[i], r.ry[i], r.rz[i]);
+    const double slope = v.squaredNorm() > 0 ? std::acos(v.normalized().dot(kUp)) : M_PI;
+    if (std::abs(slope - p.max_slope_rad) > 1e-5) {  // (acos to 2e-7 rad)
+      const Label want = !valid ? Label::Unknown
+                         : r.zeta[i] < p.zeta_min || slope > p.max_slope_rad
+                             ? Label::NonTraversable
+                             : Label::Traversable;
+      ASSERT_EQ(c.label[i], want) << "point " << i;
+    }
+    ++counts[static_cast<int>(c.label[i])];
+  }
+  EXPECT_EQ(c.traversable, counts[static_cast<int>(Label::Traversable)]);
+  EXPECT_EQ(c.non_traversable, counts[static_cast<int>(Label::NonTraversable)]);
+  EXPECT_EQ(c.unknown, counts[static_cast<int>(Label::Unknown)]);
+  EXPECT_GT(c.traversable, 1000u);
+  EXPECT_GT(c.non_traversable, 1000u);
+  EXPECT_GT(c.unknown, 1000u);
+}
 
 // Results compared point by point: zeta, k and labels.
 struct Diff {

@@ -3,7 +3,7 @@
 // points within the bound, in point order; selectMean gives
 // the mean of the square roots of the want smallest and the want-th, with ties, few candidates
 // and many, whatever the guess of the want-th it is given; the voxel grid's key pass gives the
-// plain loop's keys. Fixed seeds.
+// plain loop's keys; the sensor-rate range cut keeps what RangeBoxTest keeps. Fixed seeds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -158,6 +158,71 @@ TEST(PreprocessKernels, VoxelKeysAreThePlainLoopsKeys) {
   }
   EXPECT_GT(refused, 10);
   EXPECT_GT(passed, 1000);
+}
+
+// The sensor-rate range cut: the version the CPU gets and the plain loop both keep exactly the
+// points RangeBoxTest keeps (points on the range's and the box's bounds, NaN and infinite
+// coordinates, every length up to a few vectors), the others NaN, and count them alike.
+TEST(PreprocessKernels, CropCopyKeepsWhatRangeBoxTestKeeps) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(-6.f, 6.f);
+  const float nan = std::numeric_limits<float>::quiet_NaN(),
+              inf = std::numeric_limits<float>::infinity();
+  std::size_t kept_total = 0, cut_total = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    PreprocessParams p;
+    p.range_enabled = trial % 3 != 0;
+    p.range_min_m = 0.4;
+    p.range_max_m = 5.0;
+    p.box_enabled = trial % 4 == 1;
+    p.box_min_m = {-3.f, -2.f, -1.f};
+    p.box_max_m = {3.f, 2.f, 4.f};
+    const Eigen::Vector3f origin(u(rng) * 0.1f, u(rng) * 0.1f, u(rng) * 0.1f);
+    const detail::KeyPassParams k = detail::rangeBoxBounds(&p, origin);
+    const detail::RangeBoxTest test(p, origin);
+    const std::size_t n = static_cast<std::size_t>(trial % 70);
+    std::vector<float> x(n), y(n), z(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      x[j] = u(rng), y[j] = u(rng), z[j] = u(rng);
+      switch ((j + static_cast<std::size_t>(trial)) % 9) {
+        case 0: x[j] = nan; break;
+        case 1: z[j] = -inf; break;
+        case 2: x[j] = origin.x() + 5.f, y[j] = origin.y(), z[j] = origin.z(); break;  // range
+        case 3: x[j] = origin.x(), y[j] = origin.y() - 0.4f, z[j] = origin.z(); break;
+        case 4: x[j] = -3.f; break;  // on the box's bound
+        case 5: z[j] = 4.f; break;
+        default: break;
+      }
+    }
+    for (const bool plain : {false, true}) {
+      std::vector<float> ox(n, 7.f), oy(n, 7.f), oz(n, 7.f);
+      const detail::CropCounts c =
+          plain ? detail::cropCopyPlain(x.data(), y.data(), z.data(), n, k, ox.data(), oy.data(),
+                                        oz.data())
+                : detail::cropCopy(x.data(), y.data(), z.data(), n, k, ox.data(), oy.data(),
+                                   oz.data());
+      std::size_t finite = 0, kept = 0;
+      for (std::size_t j = 0; j < n; ++j) {
+        const Eigen::Vector3f q(x[j], y[j], z[j]);
+        const bool keeps = q.allFinite() && test.keeps(q);
+        finite += q.allFinite() ? 1 : 0;
+        kept += keeps ? 1 : 0;
+        if (keeps) {
+          ASSERT_EQ(ox[j], x[j]) << "trial " << trial << ", point " << j << ", plain " << plain;
+          ASSERT_EQ(oy[j], y[j]);
+          ASSERT_EQ(oz[j], z[j]);
+        } else {
+          ASSERT_TRUE(std::isnan(ox[j]) && std::isnan(oy[j]) && std::isnan(oz[j]))
+              << "trial " << trial << ", point " << j << ", plain " << plain;
+        }
+      }
+      EXPECT_EQ(c.finite, finite) << "trial " << trial;
+      EXPECT_EQ(c.kept, kept) << "trial " << trial;
+      if (!plain) kept_total += kept, cut_total += finite - kept;
+    }
+  }
+  EXPECT_GT(kept_total, 1000u);
+  EXPECT_GT(cut_total, 1000u);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 
@@ -185,6 +186,10 @@ TEST(Preprocess, RangeCutIntoReusedBuffersEqualsTheCopyingPath) {
   }
   c.x[10] = std::numeric_limits<float>::infinity();
   c.sensor_origin = {0.1f, -0.2f, 0.3f};
+  c.r.resize(c.size()), c.g.resize(c.size()), c.b.resize(c.size());
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    c.r[i] = static_cast<std::uint8_t>(i), c.g[i] = static_cast<std::uint8_t>(i / 3), c.b[i] = 5;
+  }
   for (const bool box : {false, true}) {
     PreprocessParams p;
     p.disableAll();
@@ -202,6 +207,8 @@ TEST(Preprocess, RangeCutIntoReusedBuffersEqualsTheCopyingPath) {
     ASSERT_EQ(out.size(), expected.size()) << "box " << box;
     EXPECT_EQ(out.width, expected.width);
     EXPECT_EQ(out.height, expected.height);
+    EXPECT_EQ(out.sensor_origin, expected.sensor_origin);
+    EXPECT_TRUE(out.r == expected.r && out.g == expected.g && out.b == expected.b);
     std::size_t removed = 0;
     for (std::size_t i = 0; i < out.size(); ++i) {
       const bool nan_expected = std::isnan(expected.x[i]);

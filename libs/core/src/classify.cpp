@@ -45,15 +45,20 @@ struct ClassifyConstants {
   std::uint32_t min_k;
 };
 
+struct LabelCounts {
+  std::size_t traversable = 0, non_traversable = 0;
+};
+
 // Points [begin, end): branch-free (every value computed, then selected), so that the loop
-// vectorizes in each UPD_VECTOR_CLONES version.
+// vectorizes in each UPD_VECTOR_CLONES version. Returns the counts of the two labels written.
 UPD_VECTOR_CLONES
-void classifyRange(const float* __restrict rx, const float* __restrict ry,
+LabelCounts classifyRange(const float* __restrict rx, const float* __restrict ry,
                    const float* __restrict rz, const float* __restrict zeta,
                    const std::uint32_t* __restrict k, const ClassifyConstants& c, std::size_t begin,
                    std::size_t end, std::uint8_t* __restrict label_out, float* __restrict cost,
                    float* __restrict slope_out) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::uint32_t trav = 0, nontrav = 0;  // (32-bit lanes, as the floats': one vector width)
   for (std::size_t i = begin; i < end; ++i) {
     const float z = zeta[i];
     const int valid = (z == z ? 1 : 0) & (k[i] >= c.min_k ? 1 : 0);
@@ -71,7 +76,10 @@ void classifyRange(const float* __restrict rx, const float* __restrict ry,
     label_out[i] = static_cast<std::uint8_t>(2 - valid * (2 - blocked));
     cost[i] = valid ? (blocked ? 1.f : trav_cost) : nan;
     slope_out[i] = valid ? slope : nan;
+    trav += static_cast<std::uint32_t>(valid & (1 - blocked));
+    nontrav += static_cast<std::uint32_t>(valid & blocked);
   }
+  return {trav, nontrav};
 }
 
 }  // namespace
@@ -100,13 +108,12 @@ void classify(const UpdResult& upd, const Eigen::Vector3f& up, const ClassifyPar
   for (std::ptrdiff_t ch = 0; ch < n_chunks; ++ch) {
     const std::size_t begin = static_cast<std::size_t>(ch) * kChunk;
     const std::size_t end = std::min(n, begin + kChunk);
-    classifyRange(upd.rx.data(), upd.ry.data(), upd.rz.data(), upd.zeta.data(), upd.k.data(), c,
-                  begin, end, reinterpret_cast<std::uint8_t*>(out.label.data()), out.cost.data(),
-                  out.slope_rad.data());
-    for (std::size_t i = begin; i < end; ++i) {
-      trav += out.label[i] == Label::Traversable ? 1 : 0;
-      nontrav += out.label[i] == Label::NonTraversable ? 1 : 0;
-    }
+    const LabelCounts counts = classifyRange(
+        upd.rx.data(), upd.ry.data(), upd.rz.data(), upd.zeta.data(), upd.k.data(), c, begin,
+        end, reinterpret_cast<std::uint8_t*>(out.label.data()), out.cost.data(),
+        out.slope_rad.data());
+    trav += counts.traversable;
+    nontrav += counts.non_traversable;
   }
   out.traversable = trav;
   out.non_traversable = nontrav;

@@ -3,7 +3,6 @@
 // = |r| / k (eq. 8).
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 #include "fast_upd_internal.h"
@@ -16,9 +15,13 @@ namespace {
 typedef float Vec16 __attribute__((vector_size(16 * sizeof(float))));
 typedef float Vec8 __attribute__((vector_size(8 * sizeof(float))));
 
-// Vec16 from a plain array (no 64-byte alignment asked). Through a reference: a function
-// returning a 64-byte vector has a different ABI with and without AVX-512.
-inline void loadVec16(Vec16& v, const float* p) { std::memcpy(&v, p, sizeof v); }
+// Vec16 read in place from a plain array (no 64-byte alignment asked, any alias): the vector
+// loads feed the multiply-adds directly. (Copied out by memcpy, the 8 vectors of a cell were
+// moved through the stack 16 bytes at a time, half of a point's instructions.)
+typedef float Vec16Unaligned __attribute__((vector_size(16 * sizeof(float)), aligned(4), may_alias));
+inline const Vec16Unaligned& vec16At(const float* p) {
+  return *reinterpret_cast<const Vec16Unaligned*>(p);
+}
 
 // The blend of a cell's 8 nodes as a polynomial. Each point of the cell takes r and k from
 // its nodes: trilinear weights w_o, and each node's value carried towards the point by half
@@ -89,8 +92,7 @@ std::size_t interpolate(const PointCloud& cloud, const Lattice& lat, const std::
     const float fz = lat.gz(Z[i]) - static_cast<float>(cell_xyz[3 * c + 2]);
     const float(*k)[16] = blends[c].c;
     // Summed as a tree: short dependency chains let consecutive points overlap.
-    Vec16 c8[8];
-    for (int m = 0; m < 8; ++m) loadVec16(c8[m], k[m]);
+    const Vec16Unaligned* c8 = &vec16At(k[0]);
     const Vec16 forms =
         ((c8[0] + c8[1] * fx) + (c8[2] * fy + c8[3] * fz)) +
         ((c8[4] * (fx * fy) + c8[5] * (fx * fz)) + (c8[6] * (fy * fz) + c8[7] * (fx * fy * fz)));

@@ -199,17 +199,27 @@ void blockNodeSums(const LatticeIndex& index, const Bins& bins, const CellRow* r
     w.octant[o].push_back(v);
   }
   index.around(b, bins.sums, w.cells);
-  for (int o = 0; o < 8; ++o) w.cand[o].reset(w.cells.size());
+  unsigned with_nodes = 0;  // bit o: octant o has nodes
+  for (int o = 0; o < 8; ++o) {
+    w.cand[o].reset(w.cells.size());
+    with_nodes |= (w.octant[o].empty() ? 0u : 1u) << o;
+  }
   const std::int32_t* cell_xyz = bins.grid.coords().data();
   float row[Candidates::kFields];
   for (const std::uint32_t c : w.cells) {
     std::int32_t gap2[3][2];
     octantGaps(&cell_xyz[3 * c], origin, half, B, gap2);
-    Candidates::rowOf(c, cell_xyz, rows, origin, row);
+    // The octants some ball may reach the cell from, as a mask (no branch per octant); then
+    // the cell's row once, appended to each of them in octant order.
+    unsigned reach = 0;
     for (int o = 0; o < 8; ++o) {
       const std::int32_t d2 = gap2[0][o & 1] + gap2[1][(o >> 1) & 1] + gap2[2][o >> 2];
-      if (d2 <= m * m && !w.octant[o].empty()) w.cand[o].append(row);
+      reach |= (d2 <= m * m ? 1u : 0u) << o;
     }
+    reach &= with_nodes;
+    if (reach == 0) continue;
+    Candidates::rowOf(c, cell_xyz, rows, origin, row);
+    for (; reach != 0; reach &= reach - 1) w.cand[__builtin_ctz(reach)].append(row);
   }
   const auto mf = static_cast<float>(m);
   for (int o = 0; o < 8; ++o) {

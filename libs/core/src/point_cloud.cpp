@@ -5,6 +5,8 @@
 
 #include "upd/core/openmp.h"
 
+#include "preprocess_internal.h"
+
 namespace upd::core {
 
 namespace {
@@ -45,14 +47,19 @@ void copyColour(const PointCloud& in, PointCloud& out) {
 }
 }  // namespace
 
-std::size_t copyCloud(const PointCloud& in, PointCloud& out) {
-  if (&out == &in) return in.countFinite();
+void detail::copyAllButPoints(const PointCloud& in, PointCloud& out) {
   const std::size_t n = in.size();
   out.x.resize(n), out.y.resize(n), out.z.resize(n);
   copyColour(in, out);
   out.width = in.width;
   out.height = in.height;
   out.sensor_origin = in.sensor_origin;
+}
+
+std::size_t copyCloud(const PointCloud& in, PointCloud& out) {
+  if (&out == &in) return in.countFinite();
+  const std::size_t n = in.size();
+  detail::copyAllButPoints(in, out);
   const float *x = in.x.data(), *y = in.y.data(), *z = in.z.data();
   float *ox = out.x.data(), *oy = out.y.data(), *oz = out.z.data();
   std::size_t finite = 0;

@@ -1,6 +1,7 @@
 #include "upd/core/preprocess.h"
 
 #include "preprocess_internal.h"
+#include "upd/core/openmp.h"
 
 #include <algorithm>
 #include <cmath>
@@ -144,27 +145,26 @@ PointCloud preprocess(const PointCloud& in, const PreprocessParams& p, Preproces
 }
 
 namespace {
-// cropRange in place on an organized cloud: the points outside the range or the box, and the
-// non-finite ones, become NaN (the same tests, in the same precision). Returns the finite points
-// left. In the static shares of the other frame stages.
-std::size_t cropOrganizedInPlace(PointCloud& c, const PreprocessParams& p) {
-  const RangeBoxTest test(p, c.sensor_origin);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const std::size_t n = c.size();
-  float *x = c.x.data(), *y = c.y.data(), *z = c.z.data();
-  std::size_t kept = 0;
-#pragma omp parallel for schedule(static) if (n > 65536) reduction(+ : kept)
-  for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
-    const auto i = static_cast<std::size_t>(ii);
-    const Eigen::Vector3f q(x[i], y[i], z[i]);
-    // A non-finite point becomes NaN too, as in cropRange.
-    if (q.allFinite() && test.keeps(q)) {
-      ++kept;
-    } else {
-      x[i] = y[i] = z[i] = nan;
-    }
+// cropRange of an organized cloud into out (its buffers reused) in one pass: the points outside
+// the range or the box, and the non-finite ones, become NaN (the same tests, in the same
+// precision). In the static shares of the other frame stages.
+detail::CropCounts cropOrganized(const PointCloud& in, const PreprocessParams& p,
+                                 PointCloud& out) {
+  const std::size_t n = in.size();
+  detail::copyAllButPoints(in, out);
+  const detail::KeyPassParams k = detail::rangeBoxBounds(&p, in.sensor_origin);
+  std::size_t finite = 0, kept = 0;
+#pragma omp parallel if (n > 65536) reduction(+ : finite, kept)
+  {
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    const std::size_t b = n * me / team, e = n * (me + 1) / team;
+    const detail::CropCounts c = detail::cropCopy(in.x.data() + b, in.y.data() + b,
+                                                  in.z.data() + b, e - b, k, out.x.data() + b,
+                                                  out.y.data() + b, out.z.data() + b);
+    finite += c.finite;
+    kept += c.kept;
   }
-  return kept;
+  return {finite, kept};
 }
 }  // namespace
 
@@ -206,16 +206,18 @@ void preprocess(const PointCloud& in, const PreprocessParams& p, PointCloud& out
     return;
   }
   p.validate();
-  const std::size_t finite = copyCloud(in, out);
   PreprocessStats st;
   st.points_in = in.size();
-  st.non_finite = in.size() - finite;
-  if (p.range_enabled || p.box_enabled) {
-    const std::size_t after_crop = cropOrganizedInPlace(out, p);  // as preprocess() counts
-    st.range_removed = finite - after_crop;
-    st.after_voxel = after_crop;
+  if ((p.range_enabled || p.box_enabled) && &out != &in) {
+    const detail::CropCounts c = cropOrganized(in, p, out);  // as preprocess() counts
+    st.non_finite = in.size() - c.finite;
+    st.range_removed = c.finite - c.kept;
+    st.after_voxel = c.kept;
     st.points_out = out.size();
+  } else if (p.range_enabled || p.box_enabled) {  // in place
+    out = preprocess(in, p, &st);
   } else {
+    st.non_finite = in.size() - copyCloud(in, out);
     st.after_voxel = st.points_out = in.size();
   }
   if (stats) *stats = st;

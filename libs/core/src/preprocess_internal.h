@@ -66,6 +66,29 @@ bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
 bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t n,
                     const KeyPassParams& k, std::uint64_t* keys);
 
+/// KeyPassParams' sensor origin and range and box bounds from p (null: every test off; the
+/// key fields zero).
+KeyPassParams rangeBoxBounds(const PreprocessParams* p, const Eigen::Vector3f& sensor_origin);
+
+/// What cropCopy counted: the finite points, and those of them that passed.
+struct CropCounts {
+  std::size_t finite = 0, kept = 0;
+};
+
+/// The range and box cut of n points (x, y, z) into (ox, oy, oz): a point that passes (finite,
+/// kept by the range and box tests of k, each in RangeBoxTest's arithmetic) is copied, any
+/// other becomes NaN; cropRange's points of an organized cloud. One pass, on AVX2 by
+/// intrinsics 8 points at a time; cropCopyPlain is the plain loop, whatever the CPU. The output
+/// arrays must not overlap the input ones.
+CropCounts cropCopy(const float* x, const float* y, const float* z, std::size_t n,
+                    const KeyPassParams& k, float* ox, float* oy, float* oz);
+CropCounts cropCopyPlain(const float* x, const float* y, const float* z, std::size_t n,
+                         const KeyPassParams& k, float* ox, float* oy, float* oz);
+
+/// out takes in's layout, colour and sensor origin, its point arrays resized to in's but not
+/// written (the colour copied by the OpenMP team in static shares).
+void copyAllButPoints(const PointCloud& in, PointCloud& out);
+
 /// The outlier filter's candidates: the squared distances from (qx, qy, qz) to the n points
 /// (x, y, z)[j] (n a multiple of 8) that lie within t, in point order, into cand (room for n).
 /// Returns their number. On AVX2 a vector of distances at a time, its lanes within t packed to

@@ -33,25 +33,29 @@ inline std::int32_t floorClamped(double v) {
   return t - (v < static_cast<double>(t) ? 1 : 0);
 }
 
+// Finite, and kept by the range and box tests of k: RangeBoxTest's arithmetic, branch-free
+// (& instead of &&), so that the loops calling it vectorize.
+inline bool passes(float fx, float fy, float fz, const KeyPassParams& k) {
+  constexpr float kMaxF = std::numeric_limits<float>::max();
+  const bool finite = (std::abs(fx) <= kMaxF) & (std::abs(fy) <= kMaxF) & (std::abs(fz) <= kMaxF);
+  const auto sx = static_cast<double>(fx - k.ox), sy = static_cast<double>(fy - k.oy),
+             sz = static_cast<double>(fz - k.oz);
+  const double d2 = (sx * sx + sy * sy) + sz * sz;  // (Eigen's squaredNorm of 3: the same)
+  const bool in_range = (d2 >= k.rmin2) & (d2 <= k.rmax2);
+  const bool in_box = (fx >= k.bx0) & (fy >= k.by0) & (fz >= k.bz0) & (fx <= k.bx1) &
+                      (fy <= k.by1) & (fz <= k.bz1);
+  return finite & in_range & in_box;
+}
+
 // voxelKeys (preprocess_internal.h), branch-free, so that it vectorizes.
 UPD_VECTOR_CLONES
 bool voxelKeysLoop(const float* __restrict x, const float* __restrict y, const float* __restrict z,
                std::size_t n, const KeyPassParams& k, std::uint64_t* __restrict keys) {
-  constexpr float kMaxF = std::numeric_limits<float>::max();
   constexpr std::int32_t kBias = static_cast<std::int32_t>(kKeyBias);
   std::uint32_t bad = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const float fx = x[j], fy = y[j], fz = z[j];
-    const bool finite =
-        (std::abs(fx) <= kMaxF) & (std::abs(fy) <= kMaxF) & (std::abs(fz) <= kMaxF);
-    const auto sx = static_cast<double>(fx - k.ox), sy = static_cast<double>(fy - k.oy),
-               sz = static_cast<double>(fz - k.oz);
-    const double d2 = (sx * sx + sy * sy) + sz * sz;  // (Eigen's squaredNorm of 3: the same)
-    const bool in_range = (d2 >= k.rmin2) & (d2 <= k.rmax2);
-    const bool in_box = (fx >= k.bx0) & (fy >= k.by0) & (fz >= k.bz0) & (fx <= k.bx1) &
-                        (fy <= k.by1) & (fz <= k.bz1);
-    // (& instead of &&: no branch, so that the loop vectorizes.)
-    const bool pass = finite & in_range & in_box;
+    const bool pass = passes(fx, fy, fz, k);
     const std::int32_t cx = floorClamped((static_cast<double>(fx) - k.ref_x) * k.inv);
     const std::int32_t cy = floorClamped((static_cast<double>(fy) - k.ref_y) * k.inv);
     const std::int32_t cz = floorClamped((static_cast<double>(fz) - k.ref_z) * k.inv);
@@ -64,6 +68,27 @@ bool voxelKeysLoop(const float* __restrict x, const float* __restrict y, const f
     keys[j] = pass ? key : kNoKey;
   }
   return bad == 0;
+}
+
+// cropCopy (preprocess_internal.h), branch-free, so that it vectorizes: the point or NaN
+// stored.
+UPD_VECTOR_CLONES
+CropCounts cropCopyLoop(const float* __restrict x, const float* __restrict y,
+                        const float* __restrict z, std::size_t n, const KeyPassParams& k,
+                        float* __restrict ox, float* __restrict oy, float* __restrict oz) {
+  constexpr float kMaxF = std::numeric_limits<float>::max();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::size_t finite_count = 0, kept = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const float fx = x[j], fy = y[j], fz = z[j];
+    const bool pass = passes(fx, fy, fz, k);
+    finite_count += (std::abs(fx) <= kMaxF) & (std::abs(fy) <= kMaxF) & (std::abs(fz) <= kMaxF);
+    kept += pass ? 1 : 0;
+    ox[j] = pass ? fx : nan;
+    oy[j] = pass ? fy : nan;
+    oz[j] = pass ? fz : nan;
+  }
+  return {finite_count, kept};
 }
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -181,6 +206,57 @@ VoxelKeysFn pickVoxelKeys() { return voxelKeysLoop; }
 
 const VoxelKeysFn pickedVoxelKeys = pickVoxelKeys();
 
+#if defined(__GNUC__) && defined(__x86_64__)
+// cropCopy by AVX2 intrinsics, 8 points at a time (the rest by the loop): voxelKeysAvx2's tests,
+// hence cropCopyLoop's output.
+__attribute__((target("avx2,popcnt"))) CropCounts cropCopyAvx2(
+    const float* __restrict x, const float* __restrict y, const float* __restrict z,
+    std::size_t n, const KeyPassParams& k, float* __restrict ox, float* __restrict oy,
+    float* __restrict oz) {
+  const __m256 maxf = _mm256_set1_ps(std::numeric_limits<float>::max());
+  const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  const __m256 nan = _mm256_set1_ps(std::numeric_limits<float>::quiet_NaN());
+  const __m256 b0[3] = {_mm256_set1_ps(k.bx0), _mm256_set1_ps(k.by0), _mm256_set1_ps(k.bz0)};
+  const __m256 b1[3] = {_mm256_set1_ps(k.bx1), _mm256_set1_ps(k.by1), _mm256_set1_ps(k.bz1)};
+  float* const out[3] = {ox, oy, oz};
+  std::size_t finite_count = 0, kept = 0;
+  const std::size_t n8 = n / 8 * 8;
+  for (std::size_t j = 0; j < n8; j += 8) {
+    const __m256 f[3] = {_mm256_loadu_ps(x + j), _mm256_loadu_ps(y + j), _mm256_loadu_ps(z + j)};
+    __m256 finite = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    __m256 in_box = finite;
+    for (int a = 0; a < 3; ++a) {
+      finite = _mm256_and_ps(finite, _mm256_cmp_ps(_mm256_and_ps(f[a], abs_mask), maxf, _CMP_LE_OQ));
+      in_box = _mm256_and_ps(in_box, _mm256_and_ps(_mm256_cmp_ps(f[a], b0[a], _CMP_GE_OQ),
+                                                   _mm256_cmp_ps(f[a], b1[a], _CMP_LE_OQ)));
+    }
+    const __m256 pass = _mm256_and_ps(
+        _mm256_and_ps(finite, in_box), _mm256_castsi256_ps(rangeMask(f[0], f[1], f[2], k)));
+    finite_count += static_cast<std::size_t>(__builtin_popcount(
+        static_cast<unsigned>(_mm256_movemask_ps(finite))));
+    kept += static_cast<std::size_t>(
+        __builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(pass))));
+    for (int a = 0; a < 3; ++a) _mm256_storeu_ps(out[a] + j, _mm256_blendv_ps(nan, f[a], pass));
+  }
+  const CropCounts rest = cropCopyLoop(x + n8, y + n8, z + n8, n - n8, k, ox + n8, oy + n8, oz + n8);
+  return {finite_count + rest.finite, kept + rest.kept};
+}
+
+using CropCopyFn = CropCounts (*)(const float*, const float*, const float*, std::size_t,
+                                  const KeyPassParams&, float*, float*, float*);
+CropCopyFn pickCropCopy() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt") ? cropCopyAvx2
+                                                                            : cropCopyLoop;
+}
+#else
+using CropCopyFn = CropCounts (*)(const float*, const float*, const float*, std::size_t,
+                                  const KeyPassParams&, float*, float*, float*);
+CropCopyFn pickCropCopy() { return cropCopyLoop; }
+#endif
+
+const CropCopyFn pickedCropCopy = pickCropCopy();
+
 // Per voxel: the sums of the points relative to the anchor, of the colours, and the count.
 struct VoxelSums {
   double sx = 0, sy = 0, sz = 0;
@@ -243,6 +319,31 @@ bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t 
   return voxelKeysLoop(x, y, z, n, k, keys);
 }
 
+CropCounts cropCopy(const float* x, const float* y, const float* z, std::size_t n,
+                    const KeyPassParams& k, float* ox, float* oy, float* oz) {
+  return pickedCropCopy(x, y, z, n, k, ox, oy, oz);
+}
+
+CropCounts cropCopyPlain(const float* x, const float* y, const float* z, std::size_t n,
+                         const KeyPassParams& k, float* ox, float* oy, float* oz) {
+  return cropCopyLoop(x, y, z, n, k, ox, oy, oz);
+}
+
+KeyPassParams rangeBoxBounds(const PreprocessParams* p, const Eigen::Vector3f& sensor_origin) {
+  KeyPassParams k{};
+  k.ox = sensor_origin.x(), k.oy = sensor_origin.y(), k.oz = sensor_origin.z();
+  const bool range = p && p->range_enabled, box = p && p->box_enabled;
+  const double inf = std::numeric_limits<double>::infinity();
+  const float inf_f = std::numeric_limits<float>::infinity();
+  k.rmin2 = range ? p->range_min_m * p->range_min_m : -inf;
+  k.rmax2 = range ? p->range_max_m * p->range_max_m : inf;
+  const Eigen::Vector3f lo = box ? p->box_min_m : Eigen::Vector3f::Constant(-inf_f);
+  const Eigen::Vector3f hi = box ? p->box_max_m : Eigen::Vector3f::Constant(inf_f);
+  k.bx0 = lo.x(), k.by0 = lo.y(), k.bz0 = lo.z();
+  k.bx1 = hi.x(), k.by1 = hi.y(), k.bz1 = hi.z();
+  return k;
+}
+
 namespace {
 
 // One pass of voxelize: the sums of every passing point's voxel, in point order.
@@ -251,18 +352,9 @@ class VoxelPass {
   VoxelPass(VoxelScratch& s, const PointCloud& in, const Eigen::Vector3d& ref, double voxel_m,
             const PreprocessParams* p)
       : s_(s), in_(in), ref_(ref), voxel_m_(voxel_m) {
+    k_ = rangeBoxBounds(p, in.sensor_origin);
     k_.ref_x = ref.x(), k_.ref_y = ref.y(), k_.ref_z = ref.z();
     k_.inv = 1.0 / voxel_m;
-    k_.ox = in.sensor_origin.x(), k_.oy = in.sensor_origin.y(), k_.oz = in.sensor_origin.z();
-    const bool range = p && p->range_enabled, box = p && p->box_enabled;
-    const double inf = std::numeric_limits<double>::infinity();
-    const float inf_f = std::numeric_limits<float>::infinity();
-    k_.rmin2 = range ? p->range_min_m * p->range_min_m : -inf;
-    k_.rmax2 = range ? p->range_max_m * p->range_max_m : inf;
-    const Eigen::Vector3f lo = box ? p->box_min_m : Eigen::Vector3f::Constant(-inf_f);
-    const Eigen::Vector3f hi = box ? p->box_max_m : Eigen::Vector3f::Constant(inf_f);
-    k_.bx0 = lo.x(), k_.by0 = lo.y(), k_.bz0 = lo.z();
-    k_.bx1 = hi.x(), k_.by1 = hi.y(), k_.bz1 = hi.z();
   }
 
   // Points [b, e) of one row (of an organized cloud: keys holds the row's voxel keys and ids
