@@ -45,6 +45,7 @@ void NavConfig::validate() const {
   step_edges.validate();
   route.validate();
   navigator.validate();
+  recovery.validate();
   loop.validate();
   perception.validate();
   if (ptg_ini.empty()) {

@@ -215,6 +215,9 @@ void NavigationLoop::navigateTo(const Eigen::Vector2d& goal_world) {
   replanning_stopped_ = false;
   best_route_m_ = std::numeric_limits<double>::infinity();
   last_progress_s_ = base_.timeS();
+  recoveries_ = 0;
+  recovering_ = false;
+  restartStallWatch();
   replan();
   if (!route_.found) navigator_->navigateTo(goal_world);
 }
@@ -263,8 +266,88 @@ bool NavigationLoop::navigating() const {
   return navigator_ && navigator_->state() == NavState::Navigating;
 }
 
+double NavigationLoop::routeHeadingError(const Pose2D& pose) const {
+  constexpr double kAhead_m = 1.0;
+  const Eigen::Vector2d xy(pose.x_m, pose.y_m);
+  Eigen::Vector2d aim = goal_world_;
+  if (route_.found && !route_.path_world.empty()) {
+    const auto& path = route_.path_world;
+    std::size_t nearest = 0;
+    for (std::size_t i = 1; i < path.size(); ++i) {
+      if ((path[i] - xy).squaredNorm() < (path[nearest] - xy).squaredNorm()) nearest = i;
+    }
+    aim = path.back();
+    for (std::size_t i = nearest; i < path.size(); ++i) {
+      if ((path[i] - xy).norm() >= kAhead_m) {
+        aim = path[i];
+        break;
+      }
+    }
+  }
+  const Eigen::Vector2d d = worldToRobot(pose, aim);
+  return std::atan2(d.y(), d.x());
+}
+
+void NavigationLoop::restartStallWatch() {
+  BaseState s;
+  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  stall_anchor_xy_ = {s.pose_world_robot.x_m, s.pose_world_robot.y_m};
+  stall_anchor_s_ = base_.timeS();
+}
+
+bool NavigationLoop::startRecoveryIfStalled() {
+  const RecoveryParams& rp = config_.recovery;
+  if (!rp.enabled) return false;
+  BaseState s;
+  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  const double now = base_.timeS();
+  const Eigen::Vector2d xy(s.pose_world_robot.x_m, s.pose_world_robot.y_m);
+  if ((xy - stall_anchor_xy_).norm() > rp.stall_radius_m) {
+    stall_anchor_xy_ = xy;
+    stall_anchor_s_ = now;
+    return false;
+  }
+  if (now - stall_anchor_s_ < rp.stall_time_s || recoveries_ >= rp.max_recoveries) return false;
+  // The navigator's own shape and obstacle points: the manoeuvre keeps the clearance it keeps.
+  double half_length_m = 0.0, half_width_m = 0.0;
+  for (const Eigen::Vector2d& v : navigator_->robotShape()) {
+    half_length_m = std::max(half_length_m, std::abs(v.x()));
+    half_width_m = std::max(half_width_m, std::abs(v.y()));
+  }
+  const RecoveryMotion m =
+      planRecovery(obstacles_.pointsInRobot(s.pose_world_robot), half_length_m, half_width_m,
+                   routeHeadingError(s.pose_world_robot), rp);
+  // Watch the next stretch of time whether or not a manoeuvre was found.
+  stall_anchor_s_ = now;
+  if (!m.feasible()) return false;
+  ++recoveries_;
+  recovering_ = true;
+  recovery_ = m;
+  recovery_end_s_ = now + m.duration_s;
+  return true;
+}
+
 NavState NavigationLoop::step() {
   if (!navigator_) throw std::logic_error("NavigationLoop::step before navigateTo");
+  if (recovering_) {
+    // Each command holds for a control period: stop before the feasible duration runs out.
+    if (base_.timeS() + config_.loop.control_period_s <= recovery_end_s_ + 1e-6) {
+      base_.sendVelocity(recovery_.command);
+      return navigator_->state();
+    }
+    recovering_ = false;
+    restartStallWatch();
+    // Start the navigator again (its motion state and no-progress clock start anew).
+    replan();
+    if (route_.found) {
+      navigator_->followWaypoints(route_.waypoints);
+    } else {
+      navigator_->navigateTo(goal_world_);
+    }
+  } else if (navigator_->state() == NavState::Navigating && startRecoveryIfStalled()) {
+    base_.sendVelocity(recovery_.command);
+    return navigator_->state();
+  }
   if (navigator_->state() == NavState::Navigating && !replanning_stopped_ &&
       base_.timeS() - last_plan_s_ >= config_.route.replan_period_s) {
     replan();

@@ -148,6 +148,7 @@ void summarize(ScenarioRun& run, const sim::WorldSpec& world, const NavConfig& c
   r.route = run.loop().route();
   r.failed_plans = run.loop().failedPlans();
   r.replanning_stopped = run.loop().replanningStopped();
+  r.recoveries = run.loop().recoveries();
 }
 
 }  // namespace
@@ -220,6 +221,7 @@ nlohmann::json summaryJson(const ScenarioResult& r) {
   j["collisions"] = r.collision_steps;
   j["route_plans_failed"] = r.failed_plans;
   j["route_replanning_stopped"] = r.replanning_stopped;
+  j["recoveries"] = r.recoveries;
   j["mean_frame_scoring_ms"] = r.mean_frame_ms;
   j["wall_time_s"] = r.wall_time_s;
   j["navlog"] = r.navlog_path.empty() ? "" : fs::path(r.navlog_path).filename().string();

@@ -19,6 +19,7 @@
 #include "upd/nav/navigator.h"
 #include "upd/nav/negative_obstacles.h"
 #include "upd/nav/obstacles.h"
+#include "upd/nav/recovery.h"
 #include "upd/nav/robot_base.h"
 #include "upd/nav/route_planner.h"
 #include "upd/sim/render.h"
@@ -84,6 +85,7 @@ struct NavConfig {
   maps::StepEdgeParams step_edges;
   RoutePlannerParams route;
   NavigatorParams navigator;
+  RecoveryParams recovery;
   LoopParams loop;
   PerceptionParams perception;
   std::string ptg_ini;        ///< absolute path of the MRPT navigator ini
@@ -113,6 +115,8 @@ void forEachNavSection(NavConfig& c, F&& f) {
     "MRPT's reactive navigator (its PTGs come from the file that `ptg_ini` names; "
     "`ptg_cache_dir` holds their tables).",
     c.navigator);
+  f("RecoveryParams", "What the loop does when the robot stalls (upd/nav/recovery.h).",
+    c.recovery);
   f("LoopParams", "The closed loop of `upd navigate`.", c.loop);
 }
 

@@ -19,7 +19,10 @@
 // not got shorter for that long: a robot circling a walled-in goal finds a new way in through
 // every stretch of wall it has not seen yet, and would otherwise search until the time limit. A
 // route that the map closed, replaced by another open way, counts as progress (the new way may
-// be longer: round a wall whose gap is away from the goal). The
+// be longer: round a wall whose gap is away from the goal). A robot that stays within
+// RecoveryParams::stall_radius_m for stall_time_s while navigating is stalled: the loop drives one
+// recovery manoeuvre (upd/nav/recovery.h) in place of the navigator, then restarts the navigator
+// on a fresh route. The
 // navigator is created by the first navigateTo(), so a loop that only maps never builds PTGs.
 #pragma once
 
@@ -29,6 +32,7 @@
 #include "upd/nav/navigator.h"
 #include "upd/nav/obstacles.h"
 #include "upd/nav/perception.h"
+#include "upd/nav/recovery.h"
 #include "upd/nav/robot_base.h"
 #include "upd/nav/route_planner.h"
 
@@ -80,6 +84,8 @@ class NavigationLoop {
   int failedPlans() const { return failed_plans_; }
   /// True once replanning stopped for lack of progress (see the header comment).
   bool replanningStopped() const { return replanning_stopped_; }
+  /// Recovery manoeuvres driven so far (see the header comment).
+  int recoveries() const { return recoveries_; }
   NavOutcome outcome() const;
   /// Ends the navigation (stops the robot) and closes the navlog.
   void finish();
@@ -116,8 +122,20 @@ class NavigationLoop {
   bool replanning_stopped_ = false;
   double best_route_m_ = 0.0;     ///< shortest route length so far [m]
   double last_progress_s_ = 0.0;  ///< when the route last got shorter [s]
+  Eigen::Vector2d stall_anchor_xy_ = Eigen::Vector2d::Zero();  ///< where the robot last stood [m]
+  double stall_anchor_s_ = 0.0;   ///< since when it has stayed near stall_anchor_xy_ [s]
+  int recoveries_ = 0;
+  bool recovering_ = false;
+  RecoveryMotion recovery_;
+  double recovery_end_s_ = 0.0;
 
   void replan();
+  /// The stall watch starts again from where the robot stands now.
+  void restartStallWatch();
+  /// True when the robot has stalled and a recovery manoeuvre was started.
+  bool startRecoveryIfStalled();
+  /// The route's heading about 1 m ahead of the robot, in the robot frame [rad].
+  double routeHeadingError(const Pose2D& pose_world_robot) const;
   void labelFrame(const core::PointCloud& cloud_world);
   /// Fuses the points (x, y, z) as NonTraversable evidence.
   void fuseNonTraversable(const std::vector<float>& x, const std::vector<float>& y,

@@ -65,6 +65,7 @@ struct ScenarioResult {
   Route route;                               ///< the last route the planner found
   int failed_plans = 0;                      ///< plans that found no route
   bool replanning_stopped = false;           ///< the loop stopped replanning for lack of progress
+  int recoveries = 0;                        ///< recovery manoeuvres of the stalled robot
   std::string navlog_path;                   ///< empty when no navlog was written
 };
 
