@@ -37,6 +37,23 @@ TEST(PointCloud, CountFiniteCountsPointsWithThreeFiniteCoordinates) {
   EXPECT_EQ(by_point, 4u);
 }
 
+TEST(PointCloud, ResizeKeepsThePointsAndGivesOrDropsTheColour) {
+  PointCloud c;
+  c.push_back(1.f, 2.f, 3.f, 10, 20, 30);
+  c.push_back(4.f, 5.f, 6.f, 40, 50, 60);
+  c.resize(3, true);
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_TRUE(c.hasColor());
+  EXPECT_EQ(c.point(1), Eigen::Vector3f(4.f, 5.f, 6.f));
+  EXPECT_EQ(c.g[1], 50);
+  EXPECT_EQ(c.width, 2u) << "the layout is the caller's";
+  c.resize(1, false);
+  EXPECT_EQ(c.size(), 1u);
+  EXPECT_FALSE(c.hasColor());
+  EXPECT_TRUE(c.r.empty() && c.g.empty() && c.b.empty());
+  EXPECT_EQ(c.point(0), Eigen::Vector3f(1.f, 2.f, 3.f));
+}
+
 TEST(Preprocess, VoxelGridKeepsTheCentroidOfEachVoxelInOrderOfFirstAppearance) {
   PointCloud c;
   // Voxel edge 1, anchored at the first point: two points in voxel (0, 0, 0), one in

@@ -34,8 +34,7 @@ void depthToCloud(const DepthImage& depth, const CameraIntrinsics& K, PointCloud
   }
   // Every pixel is written (a point or NaN), so the buffers are resized, not filled.
   const auto n = static_cast<std::size_t>(depth.width) * depth.height;
-  cloud.x.resize(n), cloud.y.resize(n), cloud.z.resize(n);
-  cloud.r.clear(), cloud.g.clear(), cloud.b.clear();
+  cloud.resize(n, false);
   cloud.width = depth.width, cloud.height = depth.height;
   cloud.sensor_origin.setZero();
   const float inv_fx = static_cast<float>(1.0 / K.fx), inv_fy = static_cast<float>(1.0 / K.fy);

@@ -291,8 +291,7 @@ std::size_t firstPassing(const PointCloud& in, const RangeBoxTest* test) {
 // The centroids of s.voxels[0, n) (anchored at ref) into out, in voxel order.
 void writeCentroids(const VoxelScratch& s, std::size_t n, const Eigen::Vector3d& ref,
                     bool colour, PointCloud& out) {
-  out.x.resize(n), out.y.resize(n), out.z.resize(n);
-  out.r.resize(colour ? n : 0), out.g.resize(colour ? n : 0), out.b.resize(colour ? n : 0);
+  out.resize(n, colour);
   out.width = n, out.height = 1;
   for (std::size_t v = 0; v < n; ++v) {
     const VoxelSums& a = s.voxels[v];

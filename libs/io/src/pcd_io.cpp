@@ -258,14 +258,7 @@ core::PointCloud cloudFromBlob(const std::string& path, const pcl::PCLPointCloud
     }
   }
   core::PointCloud cloud;
-  cloud.x.resize(n);
-  cloud.y.resize(n);
-  cloud.z.resize(n);
-  if (fc) {
-    cloud.r.resize(n);
-    cloud.g.resize(n);
-    cloud.b.resize(n);
-  }
+  cloud.resize(n, fc != nullptr);
   const std::uint8_t* data = blob.data.data();
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint8_t* p = data + i * blob.point_step;

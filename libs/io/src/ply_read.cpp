@@ -247,14 +247,7 @@ void appendVertex(const std::vector<double>& v, const PlyElement& e, const Verte
 }
 
 void prepareCloud(core::PointCloud& cloud, std::size_t n, bool color) {
-  cloud.x.resize(n);
-  cloud.y.resize(n);
-  cloud.z.resize(n);
-  if (color) {
-    cloud.r.resize(n);
-    cloud.g.resize(n);
-    cloud.b.resize(n);
-  }
+  cloud.resize(n, color);
   cloud.width = n;
   cloud.height = 1;
 }

@@ -148,10 +148,7 @@ core::PointCloud stereoToCloud(const cv::Mat& left_rect, const cv::Mat& right_re
       core::depthToCloud(disparityToDepth(disparity, calib, params), calib.leftIntrinsics());
   if (with_color &&
       (left_rect.type() == CV_8UC3 || left_rect.type() == CV_8UC1 || left_rect.type() == CV_8UC4)) {
-    const std::size_t n = cloud.size();
-    cloud.r.resize(n);
-    cloud.g.resize(n);
-    cloud.b.resize(n);
+    cloud.resize(cloud.size(), true);
     const int channels = left_rect.channels();
     for (int v = 0; v < left_rect.rows; ++v) {
       const auto* row = left_rect.ptr<uint8_t>(v);

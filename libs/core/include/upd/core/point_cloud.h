@@ -54,6 +54,16 @@ struct PointCloud {
     g.push_back(cg);
     b.push_back(cb);
   }
+  /// n points: x, y and z, and r, g and b when with_colour (no colour otherwise); the values of
+  /// the first min(n, size()) kept. The layout (width, height) is the caller's to set.
+  void resize(std::size_t n, bool with_colour) {
+    x.resize(n);
+    y.resize(n);
+    z.resize(n);
+    r.resize(with_colour ? n : 0);
+    g.resize(with_colour ? n : 0);
+    b.resize(with_colour ? n : 0);
+  }
   /// Makes the cloud an organized width x height image of NaN points (colour dropped).
   void resizeOrganized(std::size_t w, std::size_t h) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
