@@ -181,6 +181,28 @@ TEST(PcdIo, GarbageAndEmptyFilesFail) {
   EXPECT_NE(errorOf(e).find(e), std::string::npos);
 }
 
+// A header whose point count asks PCL for terabytes (what fuzz_pcd found: PCL's readHeader
+// allocates POINTS x the point's bytes before it reads the body) is refused before PCL reads it,
+// naming the count; a count the file can hold is read as before.
+TEST(PcdIo, PointCountTheFileCannotHoldFailsBeforePclAllocates) {
+  TempDir dir;
+  const std::string header_head =
+      "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n";
+  const std::string huge = dir.file("huge.pcd");
+  writeBytes(huge, header_head + "WIDTH 51539607552\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
+                                 "POINTS 51539607552\nDATA binary\n" + std::string(24, '\0'));
+  const std::string msg = errorOf(huge);
+  EXPECT_NE(msg.find(huge), std::string::npos) << msg;
+  EXPECT_NE(msg.find("POINTS 51539607552"), std::string::npos) << msg;
+
+  const std::string two = dir.file("two.pcd");
+  writeBytes(two, header_head + "WIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\n"
+                                "DATA ascii\n1 2 3\n4 5 6\n");
+  const core::PointCloud c = upd::io::readCloud(two);
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_EQ(c.z[1], 6.f);
+}
+
 TEST(PcdIo, AsciiPcdWithViewpointAndDoubleCoordinates) {
   TempDir dir;
   const std::string f = dir.file("ascii.pcd");

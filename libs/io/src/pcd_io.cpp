@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <ostream>
+#include <vector>
 
 namespace upd::io {
 
@@ -180,17 +181,72 @@ void requireValidAsciiBody(const std::string& path, const pcl::PCLPointCloud2& h
   }
 }
 
-/// A header cut off before its DATA line (PCL takes such a file as a cloud of no points, or reads
-/// the header's own lines as ascii data).
-void requireDataLine(const std::string& path) {
+// The unsigned integers after a header line's keyword (at most 64 of them); false when one is
+// not a number.
+bool headerNumbers(const std::string& line, std::size_t from, std::vector<std::uint64_t>& out) {
+  out.clear();
+  std::size_t pos = from;
+  while (out.size() < 64) {
+    pos = line.find_first_not_of(" \t\r", pos);
+    if (pos == std::string::npos) return true;
+    const std::size_t end = std::min(line.find_first_of(" \t\r", pos), line.size());
+    std::uint64_t v = 0;
+    const auto r = std::from_chars(line.data() + pos, line.data() + end, v);
+    if (r.ec != std::errc() || r.ptr != line.data() + end) return false;
+    out.push_back(v);
+    pos = end;
+  }
+  return true;
+}
+
+/// The header up to its DATA line, checked where PCL would act on it: a header cut off before its
+/// DATA line (PCL takes such a file as a cloud of no points, or reads the header's own lines as
+/// ascii data), and a point count whose bytes this file cannot hold (PCL's readHeader allocates
+/// POINTS x the point's bytes before it reads the body: a corrupt count asks for terabytes).
+void checkHeaderLines(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   std::size_t n = 0;
   constexpr std::size_t kMaxHeaderLines = 1000;  // a PCD header has about a dozen
+  std::vector<std::uint64_t> sizes, counts, values;
+  std::uint64_t points = 0, width = 0, height = 1;
   while (n < kMaxHeaderLines && std::getline(in, line)) {
     ++n;
     const std::size_t first = line.find_first_not_of(" \t");
-    if (first != std::string::npos && line.compare(first, 4, "DATA") == 0) return;
+    if (first == std::string::npos) continue;
+    const auto keyword = [&](const char* k) {
+      const std::size_t len = std::strlen(k);
+      return line.compare(first, len, k) == 0 &&
+             (first + len == line.size() || line[first + len] == ' ' || line[first + len] == '\t');
+    };
+    const auto numbers = [&](const char* k) { return headerNumbers(line, first + std::strlen(k), values); };
+    if (keyword("SIZE") && headerNumbers(line, first + 4, sizes)) continue;
+    if (keyword("COUNT") && headerNumbers(line, first + 5, counts)) continue;
+    if (keyword("POINTS") && numbers("POINTS") && values.size() == 1) points = values[0];
+    if (keyword("WIDTH") && numbers("WIDTH") && values.size() == 1) width = values[0];
+    if (keyword("HEIGHT") && numbers("HEIGHT") && values.size() == 1) height = values[0];
+    if (line.compare(first, 4, "DATA") != 0) continue;
+    // The bytes PCL would allocate: the larger of POINTS and WIDTH x HEIGHT, times the point's
+    // bytes (SIZE x COUNT per field), in long double so that no product wraps. A file holds at
+    // most its size in binary, and about 90 times it compressed (LZF's longest back-reference:
+    // 264 bytes from 3).
+    long double step = 0;
+    for (std::size_t f = 0; f < sizes.size(); ++f) {
+      step += static_cast<long double>(sizes[f]) * (f < counts.size() ? counts[f] : 1);
+    }
+    const long double claimed =
+        std::max<long double>(points, static_cast<long double>(width) * height) * step;
+    std::error_code ec;
+    const auto file_bytes = std::filesystem::file_size(path, ec);
+    const long double bound = 128.0L * (ec ? 0 : file_bytes) + 65536.0L;
+    if (claimed > bound) {
+      throw fileError(path, "corrupt PCD header: POINTS " + std::to_string(points) + " (WIDTH " +
+                                std::to_string(width) + " x HEIGHT " + std::to_string(height) +
+                                ") of " + std::to_string(static_cast<std::uint64_t>(step)) +
+                                " bytes each, more than a file of " +
+                                std::to_string(ec ? 0 : file_bytes) + " bytes can hold");
+    }
+    return;
   }
   if (n == 0) throw fileError(path, "empty file, not a PCD file (no header)");
   throw fileError(path, "truncated or invalid PCD header: no DATA line in its first " +
@@ -200,7 +256,7 @@ void requireDataLine(const std::string& path) {
 // Reads and checks the header, and checks the body against it before PCL parses the body (PCL
 // itself reads past a truncated one). Throws naming path.
 void checkPcdFile(const std::string& path, pcl::PCDReader& reader) {
-  requireDataLine(path);
+  checkHeaderLines(path);
   pcl::PCLPointCloud2 blob;
   Eigen::Vector4f origin = Eigen::Vector4f::Zero();
   Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
