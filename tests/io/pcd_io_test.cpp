@@ -195,6 +195,14 @@ TEST(PcdIo, PointCountTheFileCannotHoldFailsBeforePclAllocates) {
   EXPECT_NE(msg.find(huge), std::string::npos) << msg;
   EXPECT_NE(msg.find("POINTS 51539607552"), std::string::npos) << msg;
 
+  // A negative SIZE, which PCL sums as unsigned into 4 GB a point (the input fuzz_pcd found).
+  const std::string negative = dir.file("negative.pcd");
+  writeBytes(negative, "VERSION .7\nFIELDS x y z\nSIZE 4 -4 4\nTYPE F F F\nCOUNT 1 4 1\n"
+                       "WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
+  const std::string neg_msg = errorOf(negative);
+  EXPECT_NE(neg_msg.find(negative), std::string::npos) << neg_msg;
+  EXPECT_NE(neg_msg.find("SIZE 4 -4 4"), std::string::npos) << neg_msg;
+
   const std::string two = dir.file("two.pcd");
   writeBytes(two, header_head + "WIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\n"
                                 "DATA ascii\n1 2 3\n4 5 6\n");

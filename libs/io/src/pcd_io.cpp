@@ -220,8 +220,23 @@ void checkHeaderLines(const std::string& path) {
              (first + len == line.size() || line[first + len] == ' ' || line[first + len] == '\t');
     };
     const auto numbers = [&](const char* k) { return headerNumbers(line, first + std::strlen(k), values); };
-    if (keyword("SIZE") && headerNumbers(line, first + 4, sizes)) continue;
-    if (keyword("COUNT") && headerNumbers(line, first + 5, counts)) continue;
+    // Each field's SIZE is 1, 2, 4 or 8 bytes and its COUNT at least 1 (PCL reads them as ints
+    // and sums SIZE x COUNT as unsigned: a "-4" becomes 4 GB a point).
+    if (keyword("SIZE") || keyword("COUNT")) {
+      const bool size = keyword("SIZE");
+      std::vector<std::uint64_t>& list = size ? sizes : counts;
+      const bool ok = headerNumbers(line, first + (size ? 4 : 5), list) &&
+                      std::all_of(list.begin(), list.end(), [&](std::uint64_t v) {
+                        return size ? (v == 1 || v == 2 || v == 4 || v == 8)
+                                    : (v >= 1 && v <= 1u << 20);
+                      });
+      if (!ok) {
+        throw fileError(path, "corrupt PCD header: '" + line.substr(first, 80) + "' (" +
+                                  (size ? "a SIZE is 1, 2, 4 or 8 bytes" : "a COUNT is at least 1") +
+                                  ")");
+      }
+      continue;
+    }
     if (keyword("POINTS") && numbers("POINTS") && values.size() == 1) points = values[0];
     if (keyword("WIDTH") && numbers("WIDTH") && values.size() == 1) width = values[0];
     if (keyword("HEIGHT") && numbers("HEIGHT") && values.size() == 1) height = values[0];
