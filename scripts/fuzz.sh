@@ -5,8 +5,9 @@
 # arbitrary float clouds (pipeline). docs/RELIABILITY.md, "Fuzzing".
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     e.g. scripts/fuzz.sh 600 pcd ply
 # UPD_FUZZ_RUNS=N stops each target after N inputs as well (what comes first), and
-# UPD_FUZZ_SEED=S fixes libFuzzer's random seed: with both, a run is repeatable (what CI uses,
-# so that CI does not turn red on a finding of chance; longer runs hunt without them).
+# UPD_FUZZ_SEED=S fixes libFuzzer's random seed: with both, a run covers about the same inputs
+# each time (what CI uses; not exactly, as libFuzzer's coverage feedback varies, so CI can still
+# meet a new finding); longer runs hunt without them.
 # Seeds are made at run time: generated samples and scenes (fuzz_seeds), the shipped configs,
 # and the small clouds and rawlogs of ../shared/data (rawlogs decompressed, so the fuzzer
 # mutates the object stream and not the gzip layer). The corpus grows in build-fuzz/corpus/

@@ -4,7 +4,7 @@
 # In CI (CI=true), or with UPD_RELIABILITY=1, bounded reliability steps follow
 # (docs/RELIABILITY.md): the fuzzers of the cloud readers, the robot config and the core
 # pipeline and a rawlog object stream for at most UPD_FUZZ_SECONDS each (default 90; a fixed
-# seed and 2,000 inputs, so a run is repeatable), and under ASan + UBSan every test program
+# seed and 2,000 inputs: close to repeatable), and under ASan + UBSan every test program
 # (the navigation scenarios shortened, four long playbacks left out).
 # Longer and wider: scripts/fuzz.sh SECONDS [TARGET...] and scripts/sanitize.sh (every test).
 set -euo pipefail
