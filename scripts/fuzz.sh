@@ -27,7 +27,10 @@ SHARED="${UPD_SHARED_DATA_DIR:-$UPD_ROOT/../shared/data}"
 
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+# Line tables only (-g1): a finding still names file and line, and the build takes about a
+# third less time than with full debug information.
 cmake -S "$UPD_ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
       -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14 \
       -DUPD_FUZZ=ON -DUPD_SANITIZE=address,undefined -DUPD_BUILD_TESTS=OFF -DUPD_BUILD_BENCH=OFF \
       "${launcher[@]}" >/dev/null

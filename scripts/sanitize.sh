@@ -52,7 +52,10 @@ if [ "$scope" != all ]; then
   done
 fi
 
+# Line tables only (-g1): a finding still names file and line, and the build takes about a
+# third less time than with full debug information.
 cmake -S "$UPD_ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUPD_BUILD_BENCH=OFF \
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
       -DUPD_SANITIZE=address,undefined "${launcher[@]}" "${shared[@]}" >/dev/null
 if ((${#targets[@]})); then
   # An optional library's tests (learn, freenect, ros) exist only when it was configured.

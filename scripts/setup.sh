@@ -29,8 +29,10 @@ if ((${#missing[@]})); then
   echo "setup: installing ${missing[*]}"
   SUDO=""
   [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  install_start=$SECONDS
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  echo "setup: ${#missing[@]} packages installed in $((SECONDS - install_start)) s"
 fi
 
 cmake -S "$UPD_ROOT" -B "$UPD_BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null

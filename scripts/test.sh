@@ -8,13 +8,18 @@
 # (the navigation scenarios shortened, four long playbacks left out).
 # Longer and wider: scripts/fuzz.sh SECONDS [TARGET...] and scripts/sanitize.sh (every test).
 set -euo pipefail
+step_start=$SECONDS
+step_done() { echo "test: $1 took $((SECONDS - step_start)) s"; step_start=$SECONDS; }
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
+step_done "set-up and build"
 cd "$UPD_BUILD"
 ctest --output-on-failure -j"$(nproc)" "$@"
+step_done "the suite"
 if [ "${CI:-}" = true ] || [ "${UPD_RELIABILITY:-0}" = 1 ]; then
   # Repeatable: a fixed seed and 2,000 inputs per target (well within the time).
   UPD_FUZZ_SEED="${UPD_FUZZ_SEED:-1}" UPD_FUZZ_RUNS="${UPD_FUZZ_RUNS:-2000}" \
     "$UPD_ROOT/scripts/fuzz.sh" "${UPD_FUZZ_SECONDS:-90}" pcd ply xyz kitti_bin pipeline ini rawlog
+  step_done "fuzzing"
   # Every test program under ASan + UBSan + LeakSanitizer (apps/upd built instrumented), the
   # navigation scenarios shortened (NavScenarioStart.*) and four long runs of `upd` left out:
   # the 300 m and 10,000-frame playbacks, the ground-truth playback and the map merge (minutes
@@ -22,4 +27,5 @@ if [ "${CI:-}" = true ] || [ "${UPD_RELIABILITY:-0}" = 1 ]; then
   UPD_SANITIZE_SCOPE="core sim io maps mrpt_bridge nav gdal learn ros freenect apps" \
   UPD_SANITIZE_EXCLUDE="^LongRun\.|^PlaybackSoak\.|^Playback\.SimulatedRunAgreesWithGroundTruth$|^MapCommands\.MergeCropAndInfoOfSimulatedRuns$" \
     "$UPD_ROOT/scripts/sanitize.sh"
+  step_done "the sanitizer build and suite"
 fi
