@@ -256,7 +256,9 @@ std::vector<double> bruteMeans(const PointCloud& c, int k) {
 // dense (settled by the block of cells around a point's own, or by the wider block and the third
 // ring), the same with a wall of mixed density, 200 lone points scattered far apart (beyond the
 // rings: the k-d tree), 40 lone points (compared with every point), for several k, on one thread
-// and two, and a larger cloud after a smaller one and back.
+// and two, and a larger cloud after a smaller one and back. (The grid's cells are looked up in
+// its dense table, or by the hash where far lone points leave the box too sparse for one: with
+// the lone points, both, depending on k.)
 TEST(PreprocessReference, MeanNeighbourDistancesAreTheNearestCallAfterCall) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<float> u(0.f, 1.f);

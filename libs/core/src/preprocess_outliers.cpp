@@ -63,6 +63,22 @@ struct PointGrid {
   std::uint32_t find(std::int64_t cx, std::int64_t cy, std::int64_t cz) const {
     return cells.find(cx, cy, cz);
   }
+
+  // The cell ids over the occupied cells' box widened by kDenseMargin cells on every side, x
+  // fastest (kNoIndex where empty), and the shells' cell offsets in it, nearest first: a shell's
+  // cells by one load each instead of a hash look-up. Off (has_dense false) where the box would
+  // hold more than kDenseCellsPerPoint cells per point.
+  static constexpr int kDenseMargin = 3;
+  static constexpr std::size_t kDenseCellsPerPoint = 32;
+  bool has_dense = false;
+  std::vector<std::uint32_t> dense;
+  std::int64_t dense_lo[3] = {0, 0, 0};
+  std::int64_t dense_sy = 0, dense_sz = 0;  // strides of y and z
+  std::array<std::vector<std::int64_t>, 4> dense_offsets;  // by ring (0 .. 3)
+  std::size_t denseIndex(std::int32_t cx, std::int32_t cy, std::int32_t cz) const {
+    return static_cast<std::size_t>((cx - dense_lo[0]) + (cy - dense_lo[1]) * dense_sy +
+                                    (cz - dense_lo[2]) * dense_sz);
+  }
 };
 
 // Bins the finite points at edge h; false when a point lies beyond the keys' range.
@@ -206,6 +222,41 @@ const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
   return table[static_cast<std::size_t>(ring)];
 }
 
+// PointGrid's dense table of g's cells, when its box is small enough for n_points points.
+void buildDense(PointGrid& g, std::size_t n_points) {
+  g.has_dense = false;
+  const std::size_t n_cells = g.cells.size();
+  if (n_cells == 0) return;
+  std::int64_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) lo[a] = hi[a] = g.cells.xyz(0)[a];
+  for (std::size_t c = 1; c < n_cells; ++c) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min<std::int64_t>(lo[a], g.cells.xyz(c)[a]);
+      hi[a] = std::max<std::int64_t>(hi[a], g.cells.xyz(c)[a]);
+    }
+  }
+  double volume = 1;
+  std::int64_t dim[3];
+  for (int a = 0; a < 3; ++a) {
+    dim[a] = hi[a] - lo[a] + 1 + 2 * PointGrid::kDenseMargin;
+    volume *= static_cast<double>(dim[a]);
+  }
+  if (volume > static_cast<double>(PointGrid::kDenseCellsPerPoint * n_points + 4096)) return;
+  g.dense.assign(static_cast<std::size_t>(volume), detail::kNoIndex);
+  for (int a = 0; a < 3; ++a) g.dense_lo[a] = lo[a] - PointGrid::kDenseMargin;
+  g.dense_sy = dim[0], g.dense_sz = dim[0] * dim[1];
+  for (std::size_t c = 0; c < n_cells; ++c) {
+    const std::int32_t* xyz = g.cells.xyz(c);
+    g.dense[g.denseIndex(xyz[0], xyz[1], xyz[2])] = static_cast<std::uint32_t>(c);
+  }
+  for (int ring = 0; ring <= PointGrid::kDenseMargin; ++ring) {
+    std::vector<std::int64_t>& o = g.dense_offsets[static_cast<std::size_t>(ring)];
+    o.clear();
+    for (const auto& d : shellOffsets(ring)) o.push_back(d[0] + d[1] * g.dense_sy + d[2] * g.dense_sz);
+  }
+  g.has_dense = true;
+}
+
 // The cell edge: about (k + 1) / 2 points per occupied cell. On a surface the k + 1 nearest of a
 // point then lie within about 0.8 of a cell's edge, inside the 3 x 3 x 3 block around its cell
 // (~120 points on a voxelized Kinect frame) for all but a few per cent of the points, which look
@@ -303,6 +354,14 @@ class CellSearch {
   // out.
   void shell(int ring, std::vector<std::uint32_t>& out) const {
     out.clear();
+    if (g_->has_dense) {
+      const std::uint32_t* at = g_->dense.data() + g_->denseIndex(cx_, cy_, cz_);
+      for (const std::int64_t o : g_->dense_offsets[static_cast<std::size_t>(ring)]) {
+        const std::uint32_t c = at[o];
+        if (c != detail::kNoIndex) out.push_back(c);
+      }
+      return;
+    }
     // (Away from the keys' bounds, as nearly always, the keys are the cell's plus an offset,
     // with no range test.)
     const std::int32_t xyz[3] = {cx_, cy_, cz_};
@@ -449,6 +508,7 @@ __attribute__((noipa)) void meanNeighbourDistances(const PointCloud& in, int k,
     kdTreeMeanDistances(in, k, finite, mean_dist);
     return;
   }
+  buildDense(g, finite.size());
   rest.clear();  // grid positions of the points the rings did not settle
   gridMeanDistances(g, want, mean_dist, rest);
   // A few left (lone points, tiny clouds): compared with every point; many: the k-d tree.
