@@ -114,8 +114,8 @@ TEST(PreprocessKernels, SelectMeanIsTheMeanOfTheNearestWithTies) {
 
 // The voxel grid's key pass on AVX2 against the plain loop: the same key for every point (NaN,
 // infinite, on the range's and the box's bounds, beyond the keys' range), the same answer on
-// whether every passing point's voxel fits the key, at every length (the vector part and the
-// rest).
+// whether every passing point's voxel fits the key, the same count of finite points, at every
+// length (the vector part and the rest).
 TEST(PreprocessKernels, VoxelKeysAreThePlainLoopsKeys) {
   std::mt19937 rng(13);
   std::uniform_real_distribution<float> u(-6.f, 6.f);
@@ -146,9 +146,16 @@ TEST(PreprocessKernels, VoxelKeysAreThePlainLoopsKeys) {
       }
     }
     std::vector<std::uint64_t> got(n, 1), want(n, 2);
-    const bool ok = detail::voxelKeys(x.data(), y.data(), z.data(), n, k, got.data());
-    const bool ok_plain = detail::voxelKeysPlain(x.data(), y.data(), z.data(), n, k, want.data());
+    std::size_t finite = 3, finite_plain = 3, finite_want = 3;  // (the counts add to these)
+    for (std::size_t j = 0; j < n; ++j) {
+      finite_want += std::isfinite(x[j]) && std::isfinite(y[j]) && std::isfinite(z[j]) ? 1 : 0;
+    }
+    const bool ok = detail::voxelKeys(x.data(), y.data(), z.data(), n, k, got.data(), finite);
+    const bool ok_plain =
+        detail::voxelKeysPlain(x.data(), y.data(), z.data(), n, k, want.data(), finite_plain);
     ASSERT_EQ(ok, ok_plain) << "trial " << trial;
+    ASSERT_EQ(finite, finite_want) << "trial " << trial;
+    ASSERT_EQ(finite_plain, finite_want) << "trial " << trial;
     refused += ok ? 0 : 1;
     if (!ok) continue;  // (the caller throws: the keys are not used)
     for (std::size_t j = 0; j < n; ++j) {

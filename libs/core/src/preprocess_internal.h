@@ -38,11 +38,16 @@ class RangeBoxTest {
   double rmin2_, rmax2_;
 };
 
+/// What cropCopy and voxelize count: the finite points, and those of them that passed.
+struct CropCounts {
+  std::size_t finite = 0, kept = 0;
+};
+
 /// The voxel grid of the finite points of in that test keeps (every finite point when test is
 /// null) into out (unorganized; its buffers reused): one centroid per voxel, in order of first
-/// appearance, colour averaged. Returns the number of points that passed.
-std::size_t voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* test,
-                     PointCloud& out);
+/// appearance, colour averaged. Returns the number of finite points and of those that passed.
+CropCounts voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* test,
+                    PointCloud& out);
 
 /// No packed voxel key has its top bit: the key of a point that does not pass.
 constexpr std::uint64_t kNoKey = ~std::uint64_t(0);
@@ -58,22 +63,18 @@ struct KeyPassParams {
 };
 
 /// The voxel key of each of the n points (x, y, z) that passes (finite, kept by the range and
-/// box tests, each in RangeBoxTest's arithmetic) into keys, kNoKey for the others. Returns false
-/// when a passing point's voxel lies beyond the keys' range. On AVX2 by intrinsics, 8 points at
-/// a time; voxelKeysPlain is the compiler's vectorization of the plain loop, whatever the CPU.
+/// box tests, each in RangeBoxTest's arithmetic) into keys, kNoKey for the others; the number
+/// of finite points among them added to finite. Returns false when a passing point's voxel lies
+/// beyond the keys' range. On AVX2 by intrinsics, 8 points at a time; voxelKeysPlain is the
+/// compiler's vectorization of the plain loop, whatever the CPU.
 bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
-               const KeyPassParams& k, std::uint64_t* keys);
+               const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
 bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t n,
-                    const KeyPassParams& k, std::uint64_t* keys);
+                    const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
 
 /// KeyPassParams' sensor origin and range and box bounds from p (null: every test off; the
 /// key fields zero).
 KeyPassParams rangeBoxBounds(const PreprocessParams* p, const Eigen::Vector3f& sensor_origin);
-
-/// What cropCopy counted: the finite points, and those of them that passed.
-struct CropCounts {
-  std::size_t finite = 0, kept = 0;
-};
 
 /// The range and box cut of n points (x, y, z) into (ox, oy, oz): a point that passes (finite,
 /// kept by the range and box tests of k, each in RangeBoxTest's arithmetic) is copied, any
