@@ -16,18 +16,117 @@
 
 #include "preprocess_internal.h"
 
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace upd::core {
 
 namespace {
 
-// The cell (x, y, z) of point i in cells of edge 1 / inv_h anchored at point f0, as 64-bit
-// integers (detail::keyFits says whether they fit a key).
-inline void cellOf(const PointCloud& in, std::uint32_t i, std::uint32_t f0, double inv_h,
-                   std::int64_t (&c)[3]) {
-  c[0] = detail::floorToInt(static_cast<double>(in.x[i] - in.x[f0]) * inv_h);
-  c[1] = detail::floorToInt(static_cast<double>(in.y[i] - in.y[f0]) * inv_h);
-  c[2] = detail::floorToInt(static_cast<double>(in.z[i] - in.z[f0]) * inv_h);
+// floor(v) as a 32-bit integer, v clamped to +-2^30 first: detail::floorToInt's value wherever
+// a key fits (keyFits refuses the clamped ones), in arithmetic that vectorizes.
+inline std::int32_t floorClamped(double v) {
+  constexpr double kLimit = 1073741824.0;  // 2^30
+  v = v > -kLimit ? v : -kLimit;           // (NaN too)
+  v = v < kLimit ? v : kLimit;
+  const auto t = static_cast<std::int32_t>(v);
+  return t - (v < static_cast<double>(t) ? 1 : 0);
 }
+
+// The cell (cx, cy, cz)[f] of each point i = finite[f], f < n, in cells of edge 1 / inv_h
+// anchored at (ox, oy, oz) (a point of the cloud): (x[i] - ox) in float, times inv_h in double,
+// floored.
+UPD_VECTOR_CLONES
+void cellCoords(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                const std::uint32_t* __restrict finite, std::size_t n, float ox, float oy,
+                float oz, double inv_h, std::int32_t* __restrict cx, std::int32_t* __restrict cy,
+                std::int32_t* __restrict cz) {
+  for (std::size_t f = 0; f < n; ++f) {
+    const std::uint32_t i = finite[f];
+    cx[f] = floorClamped(static_cast<double>(x[i] - ox) * inv_h);
+    cy[f] = floorClamped(static_cast<double>(y[i] - oy) * inv_h);
+    cz[f] = floorClamped(static_cast<double>(z[i] - oz) * inv_h);
+  }
+}
+
+// cellCoords where finite[f] = f (every point finite, as the voxel grid's centroids): no
+// gathers.
+UPD_VECTOR_CLONES
+void cellCoordsDense(const float* __restrict x, const float* __restrict y,
+                     const float* __restrict z, std::size_t n, float ox, float oy, float oz,
+                     double inv_h, std::int32_t* __restrict cx, std::int32_t* __restrict cy,
+                     std::int32_t* __restrict cz) {
+  for (std::size_t i = 0; i < n; ++i) {
+    cx[i] = floorClamped(static_cast<double>(x[i] - ox) * inv_h);
+    cy[i] = floorClamped(static_cast<double>(y[i] - oy) * inv_h);
+    cz[i] = floorClamped(static_cast<double>(z[i] - oz) * inv_h);
+  }
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+// floorClamped((double(h) - r) * s) of the 4 lanes of h.
+__attribute__((target("avx2"))) inline __m128i floorClamped4(__m128 h, __m256d s) {
+  const __m256d lim = _mm256_set1_pd(1073741824.0), nlim = _mm256_set1_pd(-1073741824.0);
+  // (max(v, -lim): v where v > -lim, else -lim, NaN too; min(v, lim): v where v < lim.)
+  const __m256d v = _mm256_mul_pd(_mm256_cvtps_pd(h), s);
+  return _mm256_cvttpd_epi32(_mm256_floor_pd(_mm256_min_pd(_mm256_max_pd(v, nlim), lim)));
+}
+
+// cellCoordsDense by AVX2 intrinsics, 8 points at a time (the rest by the loop).
+__attribute__((target("avx2"))) void cellCoordsDenseAvx2(
+    const float* __restrict x, const float* __restrict y, const float* __restrict z,
+    std::size_t n, float ox, float oy, float oz, double inv_h, std::int32_t* __restrict cx,
+    std::int32_t* __restrict cy, std::int32_t* __restrict cz) {
+  const float* in[3] = {x, y, z};
+  const float o[3] = {ox, oy, oz};
+  std::int32_t* out[3] = {cx, cy, cz};
+  const __m256d s = _mm256_set1_pd(inv_h);
+  const std::size_t n8 = n / 8 * 8;
+  for (int a = 0; a < 3; ++a) {
+    const __m256 va = _mm256_set1_ps(o[a]);
+    for (std::size_t i = 0; i < n8; i += 8) {
+      const __m256 d = _mm256_sub_ps(_mm256_loadu_ps(in[a] + i), va);
+      const __m256i c = _mm256_set_m128i(floorClamped4(_mm256_extractf128_ps(d, 1), s),
+                                         floorClamped4(_mm256_castps256_ps128(d), s));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out[a] + i), c);
+    }
+  }
+  cellCoordsDense(x + n8, y + n8, z + n8, n - n8, ox, oy, oz, inv_h, cx + n8, cy + n8, cz + n8);
+}
+
+using CellCoordsDenseFn = void (*)(const float*, const float*, const float*, std::size_t, float,
+                                   float, float, double, std::int32_t*, std::int32_t*,
+                                   std::int32_t*);
+CellCoordsDenseFn pickCellCoordsDense() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") ? cellCoordsDenseAvx2 : cellCoordsDense;
+}
+#else
+using CellCoordsDenseFn = void (*)(const float*, const float*, const float*, std::size_t, float,
+                                   float, float, double, std::int32_t*, std::int32_t*,
+                                   std::int32_t*);
+CellCoordsDenseFn pickCellCoordsDense() { return cellCoordsDense; }
+#endif
+
+const CellCoordsDenseFn pickedCellCoordsDense = pickCellCoordsDense();
+
+// The per-point cell coordinates of a binning (the calling thread's buffers).
+struct CellCoords {
+  std::vector<std::int32_t> x, y, z;
+  void compute(const PointCloud& in, const std::vector<std::uint32_t>& finite, double inv_h) {
+    const std::size_t n = finite.size();
+    x.resize(n), y.resize(n), z.resize(n);
+    const std::uint32_t f0 = finite.front();
+    if (n == in.size()) {  // (finite is then 0, 1, ..., n - 1)
+      pickedCellCoordsDense(in.x.data(), in.y.data(), in.z.data(), n, in.x[f0], in.y[f0],
+                            in.z[f0], inv_h, x.data(), y.data(), z.data());
+    } else {
+      cellCoords(in.x.data(), in.y.data(), in.z.data(), finite.data(), n, in.x[f0], in.y[f0],
+                 in.z[f0], inv_h, x.data(), y.data(), z.data());
+    }
+  }
+};
 
 // Coordinates of the padding: their distances are huge and never kept.
 constexpr float kFarPoint = 1e18f;
@@ -46,6 +145,7 @@ struct PointGrid {
   std::vector<std::uint32_t> index;  // by cell: the cloud's index
   std::vector<std::uint32_t> cell_of;  // (buildGrid's buffers)
   detail::CellLists by_cell;
+  CellCoords coords;
 
   // Squared distance from (qx, qy, qz) to the box of cell c (0 inside).
   float boxDistance2(std::uint32_t c, float qx, float qy, float qz) const {
@@ -90,8 +190,9 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   g.cells.clear(finite.size() / 4 + 64);
   std::vector<std::uint32_t>& cell_of = g.cell_of;
   cell_of.resize(finite.size());
+  g.coords.compute(in, finite, g.inv_h);
   const auto coords = [&](std::size_t f, std::int64_t(&c)[3]) {
-    cellOf(in, finite[f], f0, g.inv_h, c);
+    c[0] = g.coords.x[f], c[1] = g.coords.y[f], c[2] = g.coords.z[f];
     return true;
   };
   if (!detail::binCells(0, finite.size(), coords, g.cells, cell_of.data())) return false;
@@ -262,7 +363,8 @@ void buildDense(PointGrid& g, std::size_t n_points) {
 // (~120 points on a voxelized Kinect frame) for all but a few per cent of the points, which look
 // at the 5 x 5 x 5 block. (With (k + 1) / 3 points more points need the wider block; with
 // k + 1 the blocks hold ~210 points: each 5-10 % more instructions on voxelized frames.)
-double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k) {
+double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k,
+                    CellCoords& coords) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (const std::uint32_t i : finite) {
@@ -273,12 +375,10 @@ double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& fini
   // First guess: the points filling the bounding box; then one correction from the measured
   // points per occupied cell, as for a surface (count ~ h^2).
   double h = std::cbrt(ext.prod() / static_cast<double>(finite.size()));
-  const std::uint32_t f0 = finite.front();
-  const double inv_h = 1.0 / h;
+  coords.compute(in, finite, 1.0 / h);
   detail::CellMap cells(finite.size() / 4 + 64);  // (counted only: no cell ids kept)
-  for (const std::uint32_t i : finite) {
-    std::int64_t c[3];
-    cellOf(in, i, f0, inv_h, c);
+  for (std::size_t f = 0; f < finite.size(); ++f) {
+    const std::int32_t c[3] = {coords.x[f], coords.y[f], coords.z[f]};
     if (!detail::keyFits(c[0], c[1], c[2])) return h;  // (buildGrid refuses it too: k-d tree)
     bool inserted = false;
     cells.findOrInsert(detail::packKey(c[0], c[1], c[2]), inserted);
@@ -504,7 +604,7 @@ __attribute__((noipa)) void meanNeighbourDistances(const PointCloud& in, int k,
   if (finite.empty()) return;
   const std::size_t want = static_cast<std::size_t>(k) + 1;  // the point itself comes first
   // (A k beyond NearestK's capacity, or a cloud beyond the keys' range: the k-d tree alone.)
-  if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k), g)) {
+  if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k, g.coords), g)) {
     kdTreeMeanDistances(in, k, finite, mean_dist);
     return;
   }
