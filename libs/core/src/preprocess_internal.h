@@ -111,6 +111,21 @@ std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, st
                               float qx, float qy, float qz, float t, float* cand);
 double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth);
 
+/// The outlier filter's grid cells: of each point i = finite[f], f < n, the cell
+/// (cx, cy, cz)[f] of edge 1 / inv_h anchored at (ox, oy, oz): floor(double(x[i] - ox) * inv_h),
+/// clamped to +-2^30 (beyond the keys' range either way). cellCoordsDense is the same for
+/// finite[f] = f, on AVX2 by intrinsics 8 points at a time; cellCoordsDensePlain its plain loop,
+/// whatever the CPU.
+void cellCoords(const float* x, const float* y, const float* z, const std::uint32_t* finite,
+                std::size_t n, float ox, float oy, float oz, double inv_h, std::int32_t* cx,
+                std::int32_t* cy, std::int32_t* cz);
+void cellCoordsDense(const float* x, const float* y, const float* z, std::size_t n, float ox,
+                     float oy, float oz, double inv_h, std::int32_t* cx, std::int32_t* cy,
+                     std::int32_t* cz);
+void cellCoordsDensePlain(const float* x, const float* y, const float* z, std::size_t n, float ox,
+                          float oy, float oz, double inv_h, std::int32_t* cx, std::int32_t* cy,
+                          std::int32_t* cz);
+
 /// Keeps the points of c where keep[i], in order, in place (an unorganized cloud).
 void compactInPlace(PointCloud& c, const std::vector<char>& keep);
 
