@@ -126,6 +126,9 @@ void cellCoordsDensePlain(const float* x, const float* y, const float* z, std::s
                           float oy, float oz, double inv_h, std::int32_t* cx, std::int32_t* cy,
                           std::int32_t* cz);
 
+/// The least and the greatest of v[0, n) into lo and hi (n > 0).
+void minMax(const std::int32_t* v, std::size_t n, std::int32_t& lo, std::int32_t& hi);
+
 /// Keeps the points of c where keep[i], in order, in place (an unorganized cloud).
 void compactInPlace(PointCloud& c, const std::vector<char>& keep);
 

@@ -332,6 +332,17 @@ double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth)
   return selectMeanScalar(cand, c, want, kth);
 }
 
+UPD_VECTOR_CLONES
+void minMax(const std::int32_t* __restrict v, std::size_t n, std::int32_t& lo, std::int32_t& hi) {
+  std::int32_t l = v[0], h = v[0];
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t x = v[i];
+    l = x < l ? x : l;  // (not std::min: GCC then keeps it scalar)
+    h = x > h ? x : h;
+  }
+  lo = l, hi = h;
+}
+
 void cellCoords(const float* x, const float* y, const float* z, const std::uint32_t* finite,
                 std::size_t n, float ox, float oy, float oz, double inv_h, std::int32_t* cx,
                 std::int32_t* cy, std::int32_t* cz) {

@@ -23,6 +23,7 @@ namespace {
 // The per-point cell coordinates of a binning (the calling thread's buffers).
 struct CellCoords {
   std::vector<std::int32_t> x, y, z;
+  std::vector<std::uint64_t> bits;  // (countCells' bitmap)
   void compute(const PointCloud& in, const std::vector<std::uint32_t>& finite, double inv_h) {
     const std::size_t n = finite.size();
     x.resize(n), y.resize(n), z.resize(n);
@@ -61,8 +62,8 @@ struct PointGrid {
     const float q[3] = {qx, qy, qz};
     float d2 = 0.f;
     for (int a = 0; a < 3; ++a) {
-      const auto lo = static_cast<float>(cells.xyz(c)[a] * h);
-      const auto hi = static_cast<float>((cells.xyz(c)[a] + 1) * h);
+      const auto lo = static_cast<float>(xyz(c)[a] * h);
+      const auto hi = static_cast<float>((xyz(c)[a] + 1) * h);
       const float d = q[a] < lo ? lo - q[a] : (q[a] > hi ? q[a] - hi : 0.f);
       d2 += d * d;
     }
@@ -88,7 +89,44 @@ struct PointGrid {
     return static_cast<std::size_t>((cx - dense_lo[0]) + (cy - dense_lo[1]) * dense_sy +
                                     (cz - dense_lo[2]) * dense_sz);
   }
+  // The cells' coordinates, 3 per cell in id order (the ids in order of first sight, as the
+  // hash's CellGrid numbers them).
+  std::vector<std::int32_t> cell_xyz;
+  std::size_t n_cells = 0;
+  const std::int32_t* xyz(std::size_t c) const { return &cell_xyz[3 * c]; }
 };
+
+// The box [lo, hi] (in cells) of a cloud's points: its cells' coordinates min and max.
+void coordBox(const CellCoords& c, std::int32_t (&lo)[3], std::int32_t (&hi)[3]) {
+  const std::vector<std::int32_t>* axis[3] = {&c.x, &c.y, &c.z};
+  for (int a = 0; a < 3; ++a) detail::minMax(axis[a]->data(), axis[a]->size(), lo[a], hi[a]);
+}
+
+// The cells' dense table (empty) and its shells' offsets over the box [lo, hi] widened by
+// kDenseMargin; false (has_dense off) where the box would hold more than kDenseCellsPerPoint
+// cells per point.
+const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring);
+bool makeDense(PointGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&hi)[3],
+               std::size_t n_points) {
+  g.has_dense = false;
+  double volume = 1;
+  std::int64_t dim[3];
+  for (int a = 0; a < 3; ++a) {
+    dim[a] = std::int64_t{hi[a]} - lo[a] + 1 + 2 * PointGrid::kDenseMargin;
+    volume *= static_cast<double>(dim[a]);
+  }
+  if (volume > static_cast<double>(PointGrid::kDenseCellsPerPoint * n_points + 4096)) return false;
+  g.dense.assign(static_cast<std::size_t>(volume), detail::kNoIndex);
+  for (int a = 0; a < 3; ++a) g.dense_lo[a] = std::int64_t{lo[a]} - PointGrid::kDenseMargin;
+  g.dense_sy = dim[0], g.dense_sz = dim[0] * dim[1];
+  for (int ring = 0; ring <= PointGrid::kDenseMargin; ++ring) {
+    std::vector<std::int64_t>& o = g.dense_offsets[static_cast<std::size_t>(ring)];
+    o.clear();
+    for (const auto& d : shellOffsets(ring)) o.push_back(d[0] + d[1] * g.dense_sy + d[2] * g.dense_sz);
+  }
+  g.has_dense = true;
+  return true;
+}
 
 // Bins the finite points at edge h; false when a point lies beyond the keys' range.
 bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, double h,
@@ -96,18 +134,35 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   g.h = h, g.inv_h = 1.0 / h;
   const std::uint32_t f0 = finite.front();
   g.ox = in.x[f0], g.oy = in.y[f0], g.oz = in.z[f0];
-  g.cells.clear(finite.size() / 4 + 64);
   std::vector<std::uint32_t>& cell_of = g.cell_of;
   cell_of.resize(finite.size());
   g.coords.compute(in, finite, g.inv_h);
-  const auto coords = [&](std::size_t f, std::int64_t(&c)[3]) {
-    c[0] = g.coords.x[f], c[1] = g.coords.y[f], c[2] = g.coords.z[f];
-    return true;
-  };
-  if (!detail::binCells(0, finite.size(), coords, g.cells, cell_of.data())) return false;
+  std::int32_t lo[3], hi[3];
+  coordBox(g.coords, lo, hi);
+  if (!detail::keyFits(lo[0], lo[1], lo[2]) || !detail::keyFits(hi[0], hi[1], hi[2])) return false;
+  if (makeDense(g, lo, hi, finite.size())) {  // (ids by the dense table: no hash)
+    g.cell_xyz.clear();
+    std::uint32_t n_cells = 0;
+    for (std::size_t f = 0; f < finite.size(); ++f) {
+      const std::int32_t cx = g.coords.x[f], cy = g.coords.y[f], cz = g.coords.z[f];
+      std::uint32_t& id = g.dense[g.denseIndex(cx, cy, cz)];
+      if (id == detail::kNoIndex) id = n_cells++, g.cell_xyz.insert(g.cell_xyz.end(), {cx, cy, cz});
+      cell_of[f] = id;
+    }
+    g.n_cells = n_cells;
+  } else {
+    g.cells.clear(finite.size() / 4 + 64);
+    const auto coords = [&](std::size_t f, std::int64_t(&c)[3]) {
+      c[0] = g.coords.x[f], c[1] = g.coords.y[f], c[2] = g.coords.z[f];
+      return true;
+    };
+    detail::binCells(0, finite.size(), coords, g.cells, cell_of.data());  // (every cell fits)
+    g.cell_xyz.assign(g.cells.coords().begin(), g.cells.coords().end());
+    g.n_cells = g.cells.size();
+  }
   detail::CellLists& by_cell = g.by_cell;
   detail::listByCell(
-      finite.size(), g.cells.size(), [&](std::size_t f) { return cell_of[f]; }, by_cell);
+      finite.size(), g.n_cells, [&](std::size_t f) { return cell_of[f]; }, by_cell);
   g.start.assign(by_cell.start.begin(), by_cell.start.end());
   // (kCopyLanes of slack: BlockPoints::fill copies 8 at a time.)
   const std::size_t rows = finite.size() + kCopyLanes;
@@ -232,39 +287,37 @@ const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
   return table[static_cast<std::size_t>(ring)];
 }
 
-// PointGrid's dense table of g's cells, when its box is small enough for n_points points.
-void buildDense(PointGrid& g, std::size_t n_points) {
-  g.has_dense = false;
-  const std::size_t n_cells = g.cells.size();
-  if (n_cells == 0) return;
-  std::int64_t lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) lo[a] = hi[a] = g.cells.xyz(0)[a];
-  for (std::size_t c = 1; c < n_cells; ++c) {
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min<std::int64_t>(lo[a], g.cells.xyz(c)[a]);
-      hi[a] = std::max<std::int64_t>(hi[a], g.cells.xyz(c)[a]);
-    }
-  }
-  double volume = 1;
+// The number of distinct cells of coords, whose box is [lo, hi]: by a bitmap over the box (it
+// holds about one cell per point at gridCellEdge's first guess), or a hash where that box is
+// large (a flat cloud).
+std::size_t countCells(CellCoords& coords, const std::int32_t (&lo)[3],
+                       const std::int32_t (&hi)[3]) {
+  const std::size_t n = coords.x.size();
   std::int64_t dim[3];
+  double volume = 1;
   for (int a = 0; a < 3; ++a) {
-    dim[a] = hi[a] - lo[a] + 1 + 2 * PointGrid::kDenseMargin;
+    dim[a] = std::int64_t{hi[a]} - lo[a] + 1;
     volume *= static_cast<double>(dim[a]);
   }
-  if (volume > static_cast<double>(PointGrid::kDenseCellsPerPoint * n_points + 4096)) return;
-  g.dense.assign(static_cast<std::size_t>(volume), detail::kNoIndex);
-  for (int a = 0; a < 3; ++a) g.dense_lo[a] = lo[a] - PointGrid::kDenseMargin;
-  g.dense_sy = dim[0], g.dense_sz = dim[0] * dim[1];
-  for (std::size_t c = 0; c < n_cells; ++c) {
-    const std::int32_t* xyz = g.cells.xyz(c);
-    g.dense[g.denseIndex(xyz[0], xyz[1], xyz[2])] = static_cast<std::uint32_t>(c);
+  std::size_t count = 0;
+  if (volume <= static_cast<double>(64 * n + 65536)) {
+    std::vector<std::uint64_t>& bits = coords.bits;
+    bits.assign(static_cast<std::size_t>(volume) / 64 + 1, 0);
+    for (std::size_t f = 0; f < n; ++f) {
+      const auto b = static_cast<std::size_t>((coords.x[f] - lo[0]) + (coords.y[f] - lo[1]) * dim[0] +
+                                              (coords.z[f] - lo[2]) * dim[0] * dim[1]);
+      const std::uint64_t bit = std::uint64_t{1} << (b % 64);
+      count += (bits[b / 64] & bit) == 0 ? 1 : 0;
+      bits[b / 64] |= bit;
+    }
+    return count;
   }
-  for (int ring = 0; ring <= PointGrid::kDenseMargin; ++ring) {
-    std::vector<std::int64_t>& o = g.dense_offsets[static_cast<std::size_t>(ring)];
-    o.clear();
-    for (const auto& d : shellOffsets(ring)) o.push_back(d[0] + d[1] * g.dense_sy + d[2] * g.dense_sz);
+  detail::CellMap cells(n / 4 + 64);
+  for (std::size_t f = 0; f < n; ++f) {
+    bool inserted = false;
+    cells.findOrInsert(detail::packKey(coords.x[f], coords.y[f], coords.z[f]), inserted);
   }
-  g.has_dense = true;
+  return cells.size();
 }
 
 // The cell edge: about (k + 1) / 2 points per occupied cell. On a surface the k + 1 nearest of a
@@ -285,14 +338,13 @@ double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& fini
   // points per occupied cell, as for a surface (count ~ h^2).
   double h = std::cbrt(ext.prod() / static_cast<double>(finite.size()));
   coords.compute(in, finite, 1.0 / h);
-  detail::CellMap cells(finite.size() / 4 + 64);  // (counted only: no cell ids kept)
-  for (std::size_t f = 0; f < finite.size(); ++f) {
-    const std::int32_t c[3] = {coords.x[f], coords.y[f], coords.z[f]};
-    if (!detail::keyFits(c[0], c[1], c[2])) return h;  // (buildGrid refuses it too: k-d tree)
-    bool inserted = false;
-    cells.findOrInsert(detail::packKey(c[0], c[1], c[2]), inserted);
+  std::int32_t c_lo[3], c_hi[3];
+  coordBox(coords, c_lo, c_hi);
+  if (!detail::keyFits(c_lo[0], c_lo[1], c_lo[2]) || !detail::keyFits(c_hi[0], c_hi[1], c_hi[2])) {
+    return h;  // (buildGrid refuses it too: k-d tree)
   }
-  const double per_cell = static_cast<double>(finite.size()) / static_cast<double>(cells.size());
+  const double per_cell =
+      static_cast<double>(finite.size()) / static_cast<double>(countCells(coords, c_lo, c_hi));
   const double target = static_cast<double>(k + 1) / 2.0;
   return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
 }
@@ -309,7 +361,7 @@ class CellSearch {
   }
 
   void startCell(std::size_t c) {
-    cx_ = g_->cells.xyz(c)[0], cy_ = g_->cells.xyz(c)[1], cz_ = g_->cells.xyz(c)[2];
+    cx_ = g_->xyz(c)[0], cy_ = g_->xyz(c)[1], cz_ = g_->xyz(c)[2];
     cells_.clear();
     built_ = -1;
     grow(1);
@@ -432,7 +484,7 @@ __attribute__((noipa)) void searchCells(CellSearch& search, const PointGrid& g,
 // (their grid positions).
 void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>& mean_dist,
                        std::vector<std::uint32_t>& rest) {
-  const std::size_t n_cells = g.start.size() - 1;
+  const std::size_t n_cells = g.n_cells;
   constexpr std::size_t kCellsPerShare = 16;
   const std::size_t n_shares = (n_cells + kCellsPerShare - 1) / kCellsPerShare;
 #pragma omp parallel
@@ -517,7 +569,6 @@ __attribute__((noipa)) void meanNeighbourDistances(const PointCloud& in, int k,
     kdTreeMeanDistances(in, k, finite, mean_dist);
     return;
   }
-  buildDense(g, finite.size());
   rest.clear();  // grid positions of the points the rings did not settle
   gridMeanDistances(g, want, mean_dist, rest);
   // A few left (lone points, tiny clouds): compared with every point; many: the k-d tree.
