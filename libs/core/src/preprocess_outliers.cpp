@@ -246,22 +246,6 @@ struct BlockPoints {
   }
 };
 
-// Distance from q (grid coordinates relative to the anchor) to the outside of the block of
-// cells within Chebyshev distance ring of its cell (cx, cy, cz): no point outside that block
-// is nearer.
-double blockMargin(const PointGrid& g, double qx, double qy, double qz, std::int32_t cx,
-                   std::int32_t cy, std::int32_t cz, int ring) {
-  double m = std::numeric_limits<double>::infinity();
-  const double q[3] = {qx, qy, qz};
-  const std::int32_t c[3] = {cx, cy, cz};
-  for (int a = 0; a < 3; ++a) {
-    const double lo = static_cast<double>(c[a] - ring) * g.h;
-    const double hi = static_cast<double>(c[a] + ring + 1) * g.h;
-    m = std::min({m, q[a] - lo, hi - q[a]});
-  }
-  return m;
-}
-
 // The cell offsets at Chebyshev distance ring (0 .. 3), sorted by their distance.
 const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
   static const auto table = [] {
@@ -362,6 +346,12 @@ class CellSearch {
 
   void startCell(std::size_t c) {
     cx_ = g_->xyz(c)[0], cy_ = g_->xyz(c)[1], cz_ = g_->xyz(c)[2];
+    for (int ring = 1; ring <= 3; ++ring) {
+      for (int a = 0; a < 3; ++a) {
+        lo_[ring][a] = static_cast<double>(g_->xyz(c)[a] - ring) * g_->h;
+        hi_[ring][a] = static_cast<double>(g_->xyz(c)[a] + ring + 1) * g_->h;
+      }
+    }
     cells_.clear();
     built_ = -1;
     grow(1);
@@ -374,7 +364,7 @@ class CellSearch {
     for (int ring = 1; ring <= 2; ++ring) {
       if (built_ < ring) grow(ring);
       const BlockPoints& b = block_[ring];
-      const double m = blockMargin(*g_, qx, qy, qz, cx_, cy_, cz_, ring);
+      const double m = margin(qx, qy, qz, ring);
       const auto m2 = static_cast<float>(m * m * (1 - 1e-6));
       // The previous point's k-th distance, a little widened, mostly bounds this one's: fewer
       // candidates to select from. Where it does not, the block's margin.
@@ -403,7 +393,7 @@ class CellSearch {
                  d2_.data());
       for (std::size_t j = 0; j < n; ++j) best_.offer(d2_[j]);
     }
-    const double m = blockMargin(*g_, qx, qy, qz, cx_, cy_, cz_, 3);
+    const double m = margin(qx, qy, qz, 3);
     if (best_.full() && static_cast<double>(best_.worst()) <= m * m) {
       return best_.meanWithoutFirst();
     }
@@ -411,6 +401,14 @@ class CellSearch {
   }
 
  private:
+  // Distance from q (grid coordinates relative to the anchor) to the outside of the block of
+  // cells within Chebyshev distance ring of the current cell: no point outside that block is
+  // nearer.
+  double margin(double qx, double qy, double qz, int ring) const {
+    const double* lo = lo_[ring];
+    const double* hi = hi_[ring];
+    return std::min({qx - lo[0], hi[0] - qx, qy - lo[1], hi[1] - qy, qz - lo[2], hi[2] - qz});
+  }
   // The occupied cells at Chebyshev distance ring from the current cell, nearest first, into
   // out.
   void shell(int ring, std::vector<std::uint32_t>& out) const {
@@ -453,6 +451,7 @@ class CellSearch {
   NearestK best_{1};
   std::int32_t cx_ = 0, cy_ = 0, cz_ = 0;
   int built_ = -1;  // the rings gathered for the current cell
+  double lo_[4][3] = {}, hi_[4][3] = {};  // the current cell's blocks' bounds by ring (1 .. 3)
   std::vector<std::uint32_t> cells_, around_, ring3_;
   BlockPoints block_[3];
   std::vector<float> bd2_, cand_, d2_;
@@ -502,6 +501,22 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
   }
 }
 
+// d2[0, n) offered to best. (Once it is full, a run of 16 with none below its worst, the common
+// case, is passed over by one test: the worst only falls, so their offers would be refused.)
+void offerAll(const float* d2, std::size_t n, NearestK& best) {
+  std::size_t j = 0;
+  for (; j < n && !best.full(); ++j) best.offer(d2[j]);
+  constexpr std::size_t kRun = 16;
+  for (; j + kRun <= n; j += kRun) {
+    const float w = best.worst();
+    int below = 0;
+    for (std::size_t t = 0; t < kRun; ++t) below |= d2[j + t] < w ? 1 : 0;
+    if (below == 0) continue;
+    for (std::size_t t = 0; t < kRun; ++t) best.offer(d2[j + t]);
+  }
+  for (; j < n; ++j) best.offer(d2[j]);
+}
+
 // The mean distances of the few grid points at positions todo, each compared with every point
 // of the grid (cheaper than building a k-d tree for a few dozen).
 void allPairsMeanDistances(const PointGrid& g, std::size_t want,
@@ -516,7 +531,7 @@ void allPairsMeanDistances(const PointGrid& g, std::size_t want,
       const std::uint32_t q = todo[static_cast<std::size_t>(r)];
       distances2(g.x.data(), g.y.data(), g.z.data(), n, g.x[q], g.y[q], g.z[q], d2.data());
       best.clear();
-      for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
+      offerAll(d2.data(), n, best);
       if (best.size() >= 2) mean_dist[g.index[q]] = best.meanWithoutFirst();
     }
   }
