@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "fast_cell_map.h"
 #include "preprocess_internal.h"
 #include "upd/core/vector_clones.h"
 
@@ -359,6 +360,53 @@ void cellCoordsDensePlain(const float* x, const float* y, const float* z, std::s
                           float oy, float oz, double inv_h, std::int32_t* cx, std::int32_t* cy,
                           std::int32_t* cz) {
   cellCoordsDenseLoop(x, y, z, n, ox, oy, oz, inv_h, cx, cy, cz);
+}
+
+void CellCoords::compute(const PointCloud& in, const std::vector<std::uint32_t>& finite,
+                         double inv_h) {
+  const std::size_t n = finite.size();
+  x.resize(n), y.resize(n), z.resize(n);
+  const std::uint32_t f0 = finite.front();
+  if (n == in.size()) {  // (finite is then 0, 1, ..., n - 1)
+    cellCoordsDense(in.x.data(), in.y.data(), in.z.data(), n, in.x[f0], in.y[f0], in.z[f0], inv_h,
+                    x.data(), y.data(), z.data());
+  } else {
+    cellCoords(in.x.data(), in.y.data(), in.z.data(), finite.data(), n, in.x[f0], in.y[f0],
+               in.z[f0], inv_h, x.data(), y.data(), z.data());
+  }
+}
+
+void CellCoords::box(std::int32_t (&lo)[3], std::int32_t (&hi)[3]) const {
+  const std::vector<std::int32_t>* axis[3] = {&x, &y, &z};
+  for (int a = 0; a < 3; ++a) minMax(axis[a]->data(), axis[a]->size(), lo[a], hi[a]);
+}
+
+std::size_t CellCoords::countCells(const std::int32_t (&lo)[3], const std::int32_t (&hi)[3]) {
+  const std::size_t n = x.size();
+  std::int64_t dim[3];
+  double volume = 1;
+  for (int a = 0; a < 3; ++a) {
+    dim[a] = std::int64_t{hi[a]} - lo[a] + 1;
+    volume *= static_cast<double>(dim[a]);
+  }
+  if (volume <= static_cast<double>(64 * n + 65536)) {
+    bits.assign(static_cast<std::size_t>(volume) / 64 + 1, 0);
+    std::size_t count = 0;
+    for (std::size_t f = 0; f < n; ++f) {
+      const auto b = static_cast<std::size_t>((x[f] - lo[0]) + (y[f] - lo[1]) * dim[0] +
+                                              (z[f] - lo[2]) * dim[0] * dim[1]);
+      const std::uint64_t bit = std::uint64_t{1} << (b % 64);
+      count += (bits[b / 64] & bit) == 0 ? 1 : 0;
+      bits[b / 64] |= bit;
+    }
+    return count;
+  }
+  CellMap cells(n / 4 + 64);
+  for (std::size_t f = 0; f < n; ++f) {
+    bool inserted = false;
+    cells.findOrInsert(packKey(x[f], y[f], z[f]), inserted);
+  }
+  return cells.size();
 }
 
 }  // namespace upd::core::detail

@@ -20,24 +20,6 @@ namespace upd::core {
 
 namespace {
 
-// The per-point cell coordinates of a binning (the calling thread's buffers).
-struct CellCoords {
-  std::vector<std::int32_t> x, y, z;
-  std::vector<std::uint64_t> bits;  // (countCells' bitmap)
-  void compute(const PointCloud& in, const std::vector<std::uint32_t>& finite, double inv_h) {
-    const std::size_t n = finite.size();
-    x.resize(n), y.resize(n), z.resize(n);
-    const std::uint32_t f0 = finite.front();
-    if (n == in.size()) {  // (finite is then 0, 1, ..., n - 1)
-      detail::cellCoordsDense(in.x.data(), in.y.data(), in.z.data(), n, in.x[f0], in.y[f0],
-                              in.z[f0], inv_h, x.data(), y.data(), z.data());
-    } else {
-      detail::cellCoords(in.x.data(), in.y.data(), in.z.data(), finite.data(), n, in.x[f0],
-                         in.y[f0], in.z[f0], inv_h, x.data(), y.data(), z.data());
-    }
-  }
-};
-
 // Coordinates of the padding: their distances are huge and never kept.
 constexpr float kFarPoint = 1e18f;
 // The slack of the rows for copyRunByEights.
@@ -55,7 +37,7 @@ struct PointGrid {
   std::vector<std::uint32_t> index;  // by cell: the cloud's index
   std::vector<std::uint32_t> cell_of;  // (buildGrid's buffers)
   detail::CellLists by_cell;
-  CellCoords coords;
+  detail::CellCoords coords;
 
   // Squared distance from (qx, qy, qz) to the box of cell c (0 inside).
   float boxDistance2(std::uint32_t c, float qx, float qy, float qz) const {
@@ -96,12 +78,6 @@ struct PointGrid {
   const std::int32_t* xyz(std::size_t c) const { return &cell_xyz[3 * c]; }
 };
 
-// The box [lo, hi] (in cells) of a cloud's points: its cells' coordinates min and max.
-void coordBox(const CellCoords& c, std::int32_t (&lo)[3], std::int32_t (&hi)[3]) {
-  const std::vector<std::int32_t>* axis[3] = {&c.x, &c.y, &c.z};
-  for (int a = 0; a < 3; ++a) detail::minMax(axis[a]->data(), axis[a]->size(), lo[a], hi[a]);
-}
-
 // The cells' dense table (empty) and its shells' offsets over the box [lo, hi] widened by
 // kDenseMargin; false (has_dense off) where the box would hold more than kDenseCellsPerPoint
 // cells per point.
@@ -138,7 +114,7 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   cell_of.resize(finite.size());
   g.coords.compute(in, finite, g.inv_h);
   std::int32_t lo[3], hi[3];
-  coordBox(g.coords, lo, hi);
+  g.coords.box(lo, hi);
   if (!detail::keyFits(lo[0], lo[1], lo[2]) || !detail::keyFits(hi[0], hi[1], hi[2])) return false;
   if (makeDense(g, lo, hi, finite.size())) {  // (ids by the dense table: no hash)
     g.cell_xyz.clear();
@@ -271,46 +247,13 @@ const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
   return table[static_cast<std::size_t>(ring)];
 }
 
-// The number of distinct cells of coords, whose box is [lo, hi]: by a bitmap over the box (it
-// holds about one cell per point at gridCellEdge's first guess), or a hash where that box is
-// large (a flat cloud).
-std::size_t countCells(CellCoords& coords, const std::int32_t (&lo)[3],
-                       const std::int32_t (&hi)[3]) {
-  const std::size_t n = coords.x.size();
-  std::int64_t dim[3];
-  double volume = 1;
-  for (int a = 0; a < 3; ++a) {
-    dim[a] = std::int64_t{hi[a]} - lo[a] + 1;
-    volume *= static_cast<double>(dim[a]);
-  }
-  std::size_t count = 0;
-  if (volume <= static_cast<double>(64 * n + 65536)) {
-    std::vector<std::uint64_t>& bits = coords.bits;
-    bits.assign(static_cast<std::size_t>(volume) / 64 + 1, 0);
-    for (std::size_t f = 0; f < n; ++f) {
-      const auto b = static_cast<std::size_t>((coords.x[f] - lo[0]) + (coords.y[f] - lo[1]) * dim[0] +
-                                              (coords.z[f] - lo[2]) * dim[0] * dim[1]);
-      const std::uint64_t bit = std::uint64_t{1} << (b % 64);
-      count += (bits[b / 64] & bit) == 0 ? 1 : 0;
-      bits[b / 64] |= bit;
-    }
-    return count;
-  }
-  detail::CellMap cells(n / 4 + 64);
-  for (std::size_t f = 0; f < n; ++f) {
-    bool inserted = false;
-    cells.findOrInsert(detail::packKey(coords.x[f], coords.y[f], coords.z[f]), inserted);
-  }
-  return cells.size();
-}
-
 // The cell edge: about (k + 1) / 2 points per occupied cell. On a surface the k + 1 nearest of a
 // point then lie within about 0.8 of a cell's edge, inside the 3 x 3 x 3 block around its cell
 // (~120 points on a voxelized Kinect frame) for all but a few per cent of the points, which look
 // at the 5 x 5 x 5 block. (With (k + 1) / 3 points more points need the wider block; with
 // k + 1 the blocks hold ~210 points: each 5-10 % more instructions on voxelized frames.)
 double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k,
-                    CellCoords& coords) {
+                    detail::CellCoords& coords) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (const std::uint32_t i : finite) {
@@ -323,12 +266,12 @@ double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& fini
   double h = std::cbrt(ext.prod() / static_cast<double>(finite.size()));
   coords.compute(in, finite, 1.0 / h);
   std::int32_t c_lo[3], c_hi[3];
-  coordBox(coords, c_lo, c_hi);
+  coords.box(c_lo, c_hi);
   if (!detail::keyFits(c_lo[0], c_lo[1], c_lo[2]) || !detail::keyFits(c_hi[0], c_hi[1], c_hi[2])) {
     return h;  // (buildGrid refuses it too: k-d tree)
   }
   const double per_cell =
-      static_cast<double>(finite.size()) / static_cast<double>(countCells(coords, c_lo, c_hi));
+      static_cast<double>(finite.size()) / static_cast<double>(coords.countCells(c_lo, c_hi));
   const double target = static_cast<double>(k + 1) / 2.0;
   return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
 }
