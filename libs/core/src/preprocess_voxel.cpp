@@ -183,11 +183,19 @@ __attribute__((target("avx2,popcnt"))) bool voxelKeysAvx2(const float* __restric
     finite_count += static_cast<std::size_t>(
         __builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(fin))));
     __m256 ok = _mm256_and_ps(fin, _mm256_castsi256_ps(rangeMask(f[0], f[1], f[2], k)));
-    __m256i fits = _mm256_set1_epi32(-1), u[3];
-    const double ref[3] = {k.ref_x, k.ref_y, k.ref_z};
     for (int a = 0; a < 3; ++a) {
       ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(f[a], b0[a], _CMP_GE_OQ),
                                            _mm256_cmp_ps(f[a], b1[a], _CMP_LE_OQ)));
+    }
+    if (_mm256_testz_ps(ok, ok)) {  // (none passes, as in the NaN holes and beyond the range)
+      const __m256i none = _mm256_set1_epi64x(-1);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(keys + j), none);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(keys + j + 4), none);
+      continue;
+    }
+    __m256i fits = _mm256_set1_epi32(-1), u[3];
+    const double ref[3] = {k.ref_x, k.ref_y, k.ref_z};
+    for (int a = 0; a < 3; ++a) {
       const __m256i c = cellCoords(f[a], ref[a], k.inv);
       fits = _mm256_and_si256(fits, _mm256_and_si256(_mm256_cmpgt_epi32(c, lo), _mm256_cmpgt_epi32(hi, c)));
       u[a] = _mm256_add_epi32(c, hi);
@@ -320,8 +328,10 @@ void writeCentroids(const VoxelScratch& s, std::size_t n, const Eigen::Vector3d&
     out.y[v] = static_cast<float>(c.y());
     out.z[v] = static_cast<float>(c.z());
     if (colour) {
+      // (lround's value: the quotient lies at least 1 / (2 n) from a half, far beyond its
+      // rounding, and is not negative.)
       const auto avg = [&](std::uint32_t sum) {
-        return static_cast<std::uint8_t>(std::lround(static_cast<double>(sum) / a.n));
+        return static_cast<std::uint8_t>(static_cast<double>(sum) / a.n + 0.5);
       };
       out.r[v] = avg(a.r), out.g[v] = avg(a.g), out.b[v] = avg(a.b);
     }
