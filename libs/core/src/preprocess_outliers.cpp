@@ -1,5 +1,6 @@
 // The statistical outlier filter's neighbour search, meanNeighbourDistances: the mean distance
-// of every point to its k nearest, by a grid of cells (CellGrid) where that settles them, by
+// of every point to its k nearest, by a grid of cells (PointGrid: its cells found in a dense
+// table over their box, or by the hash where that box is sparse) where that settles them, by
 // comparing with every point for the few left, and by the k-d tree when many are left.
 #include <Eigen/Core>
 #include <algorithm>
