@@ -3,7 +3,8 @@
 // points within the bound, in point order; selectMean gives
 // the mean of the square roots of the want smallest and the want-th, with ties, few candidates
 // and many, whatever the guess of the want-th it is given; the voxel grid's key pass gives the
-// plain loop's keys; the sensor-rate range cut keeps what RangeBoxTest keeps. Fixed seeds.
+// plain loop's keys; the sensor-rate range cut keeps what RangeBoxTest keeps; the outlier
+// filter's grid cells are the floors of the plain arithmetic. Fixed seeds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -114,8 +115,8 @@ TEST(PreprocessKernels, SelectMeanIsTheMeanOfTheNearestWithTies) {
 
 // The voxel grid's key pass on AVX2 against the plain loop: the same key for every point (NaN,
 // infinite, on the range's and the box's bounds, beyond the keys' range), the same answer on
-// whether every passing point's voxel fits the key, at every length (the vector part and the
-// rest).
+// whether every passing point's voxel fits the key, the same count of finite points, at every
+// length (the vector part and the rest).
 TEST(PreprocessKernels, VoxelKeysAreThePlainLoopsKeys) {
   std::mt19937 rng(13);
   std::uniform_real_distribution<float> u(-6.f, 6.f);
@@ -146,9 +147,16 @@ TEST(PreprocessKernels, VoxelKeysAreThePlainLoopsKeys) {
       }
     }
     std::vector<std::uint64_t> got(n, 1), want(n, 2);
-    const bool ok = detail::voxelKeys(x.data(), y.data(), z.data(), n, k, got.data());
-    const bool ok_plain = detail::voxelKeysPlain(x.data(), y.data(), z.data(), n, k, want.data());
+    std::size_t finite = 3, finite_plain = 3, finite_want = 3;  // (the counts add to these)
+    for (std::size_t j = 0; j < n; ++j) {
+      finite_want += std::isfinite(x[j]) && std::isfinite(y[j]) && std::isfinite(z[j]) ? 1 : 0;
+    }
+    const bool ok = detail::voxelKeys(x.data(), y.data(), z.data(), n, k, got.data(), finite);
+    const bool ok_plain =
+        detail::voxelKeysPlain(x.data(), y.data(), z.data(), n, k, want.data(), finite_plain);
     ASSERT_EQ(ok, ok_plain) << "trial " << trial;
+    ASSERT_EQ(finite, finite_want) << "trial " << trial;
+    ASSERT_EQ(finite_plain, finite_want) << "trial " << trial;
     refused += ok ? 0 : 1;
     if (!ok) continue;  // (the caller throws: the keys are not used)
     for (std::size_t j = 0; j < n; ++j) {
@@ -223,6 +231,59 @@ TEST(PreprocessKernels, CropCopyKeepsWhatRangeBoxTestKeeps) {
   }
   EXPECT_GT(kept_total, 1000u);
   EXPECT_GT(cut_total, 1000u);
+}
+
+// The outlier filter's grid cells, on AVX2 and by the plain loops (dense and through the list of
+// finite points), against floor(double(x - o) * inv_h) in plain arithmetic: points on cell
+// faces, NaN and far points (clamped, beyond the keys' range either way), every length up to a
+// few vectors.
+TEST(PreprocessKernels, CellCoordsAreTheFloorsOfThePlainArithmetic) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> u(-3.f, 3.f);
+  constexpr double kLimit = 1073741824.0;  // 2^30
+  const auto expected = [&](float v, float o, double inv_h) {
+    const double w = static_cast<double>(v - o) * inv_h;
+    if (std::isnan(w)) return static_cast<std::int32_t>(-kLimit);
+    return static_cast<std::int32_t>(std::floor(std::clamp(w, -kLimit, kLimit)));
+  };
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::size_t n = static_cast<std::size_t>(trial % 45);
+    const double inv_h = trial % 2 ? 1.0 / 0.06 : 1.0 / 0.0173;
+    const float o[3] = {u(rng), u(rng), u(rng)};
+    std::vector<float> p[3];
+    for (auto& a : p) a.resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      for (int a = 0; a < 3; ++a) p[a][j] = u(rng);
+      switch ((j + static_cast<std::size_t>(trial)) % 9) {
+        case 0: p[1][j] = std::numeric_limits<float>::quiet_NaN(); break;
+        case 1: p[0][j] = 3e12f; break;    // (clamped to 2^30)
+        case 2: p[2][j] = -3e12f; break;
+        case 3: p[0][j] = static_cast<float>(o[0] + 5 / inv_h); break;  // near a cell face
+        default: break;
+      }
+    }
+    std::vector<std::uint32_t> all(n);
+    for (std::size_t j = 0; j < n; ++j) all[j] = static_cast<std::uint32_t>(j);
+    std::vector<std::int32_t> got[3][3];  // by version and axis
+    for (auto& v : got) {
+      for (auto& a : v) a.assign(n, 7);
+    }
+    detail::cellCoordsDense(p[0].data(), p[1].data(), p[2].data(), n, o[0], o[1], o[2], inv_h,
+                            got[0][0].data(), got[0][1].data(), got[0][2].data());
+    detail::cellCoordsDensePlain(p[0].data(), p[1].data(), p[2].data(), n, o[0], o[1], o[2],
+                                 inv_h, got[1][0].data(), got[1][1].data(), got[1][2].data());
+    detail::cellCoords(p[0].data(), p[1].data(), p[2].data(), all.data(), n, o[0], o[1], o[2],
+                       inv_h, got[2][0].data(), got[2][1].data(), got[2][2].data());
+    for (std::size_t j = 0; j < n; ++j) {
+      for (int a = 0; a < 3; ++a) {
+        const std::int32_t want = expected(p[a][j], o[a], inv_h);
+        for (int v = 0; v < 3; ++v) {
+          ASSERT_EQ(got[v][a][j], want) << "trial " << trial << ", point " << j << ", axis " << a
+                                        << ", version " << v;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace

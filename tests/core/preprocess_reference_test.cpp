@@ -236,12 +236,15 @@ TEST(PreprocessReference, RandomCloudsKeepTheReferencesPointsAndCentroids) {
 // in double (the k-d tree computes in float from its own origin: on a cloud spanning hundreds of
 // metres it is off by 1e-4 relative).
 std::vector<double> bruteMeans(const PointCloud& c, int k) {
-  std::vector<double> m(c.size(), std::numeric_limits<double>::quiet_NaN()), d(c.size());
+  std::vector<double> m(c.size(), std::numeric_limits<double>::quiet_NaN()), d;
+  const std::size_t finite = c.countFinite();
   for (std::size_t i = 0; i < c.size(); ++i) {
+    if (!c.isFinite(i)) continue;  // (NaN: not scored)
+    d.clear();
     for (std::size_t j = 0; j < c.size(); ++j) {
-      d[j] = (c.point(i).cast<double>() - c.point(j).cast<double>()).norm();
+      if (c.isFinite(j)) d.push_back((c.point(i).cast<double>() - c.point(j).cast<double>()).norm());
     }
-    const auto kk = static_cast<std::size_t>(std::min<std::size_t>(k, c.size() - 1));
+    const auto kk = static_cast<std::size_t>(std::min<std::size_t>(k, finite - 1));
     if (kk == 0) continue;
     std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(kk), d.end());
     double sum = 0;
@@ -255,8 +258,11 @@ std::vector<double> bruteMeans(const PointCloud& c, int k) {
 // same buffer (the search keeps its buffers from call to call): a surface with a strip a tenth as
 // dense (settled by the block of cells around a point's own, or by the wider block and the third
 // ring), the same with a wall of mixed density, 200 lone points scattered far apart (beyond the
-// rings: the k-d tree), 40 lone points (compared with every point), for several k, on one thread
-// and two, and a larger cloud after a smaller one and back.
+// rings: the k-d tree), 40 lone points (compared with every point), a cloud with NaN points
+// among the others (NaN for them, the others' neighbours among the finite points), for several
+// k, on one thread and two, and a larger cloud after a smaller one and back. (The grid's cells are looked up in
+// its dense table, or by the hash where far lone points leave the box too sparse for one: with
+// the lone points, both, depending on k.)
 TEST(PreprocessReference, MeanNeighbourDistancesAreTheNearestCallAfterCall) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<float> u(0.f, 1.f);
@@ -271,7 +277,9 @@ TEST(PreprocessReference, MeanNeighbourDistancesAreTheNearestCallAfterCall) {
   PointCloud many_lone = surface, few_lone = surface;
   for (int i = 0; i < 200; ++i) many_lone.push_back(10.f + 3.f * i, -5.f - 2.f * i, 4.f);
   for (int i = 0; i < 40; ++i) few_lone.push_back(-10.f - 3.f * i, 7.f, -3.f + 0.5f * i);
-  const std::vector<const PointCloud*> clouds = {&surface, &mixed, &many_lone, &few_lone};
+  PointCloud holes = mixed;  // (the non-finite points are left out of the grid)
+  for (std::size_t i = 3; i < holes.size(); i += 7) holes.x[i] = std::numeric_limits<float>::quiet_NaN();
+  const std::vector<const PointCloud*> clouds = {&surface, &mixed, &many_lone, &few_lone, &holes};
   const std::vector<int> ks = {4, 16, 40};
   std::vector<std::vector<double>> want;  // per cloud and k
   for (const PointCloud* c : clouds) {
@@ -280,7 +288,7 @@ TEST(PreprocessReference, MeanNeighbourDistancesAreTheNearestCallAfterCall) {
   std::vector<double> got;
   for (const int threads : {1, 2}) {
     setThreads(threads);
-    for (const std::size_t ci : {0u, 1u, 2u, 3u, 0u, 1u}) {
+    for (const std::size_t ci : {0u, 1u, 2u, 3u, 4u, 0u, 1u}) {
       for (std::size_t ki = 0; ki < ks.size(); ++ki) {
         SCOPED_TRACE(std::to_string(threads) + " thread(s), cloud " + std::to_string(ci) +
                      ", k " + std::to_string(ks[ki]));
@@ -288,6 +296,10 @@ TEST(PreprocessReference, MeanNeighbourDistancesAreTheNearestCallAfterCall) {
         const std::vector<double>& w = want[ci * ks.size() + ki];
         ASSERT_EQ(got.size(), w.size());
         for (std::size_t i = 0; i < w.size(); ++i) {
+          if (std::isnan(w[i])) {
+            ASSERT_TRUE(std::isnan(got[i])) << "point " << i;
+            continue;
+          }
           ASSERT_NEAR(got[i], w[i], 1e-5 * w[i]) << "point " << i;  // (float rounding)
         }
       }

@@ -86,6 +86,25 @@ class CellMap {
     }
   }
 
+  /// clear(expected) for a map that holds exactly the keys[0, n) (the caller's list of what it
+  /// inserted): where the table keeps its size and those keys fill less than a quarter of it,
+  /// only their probe runs are emptied instead of the whole table.
+  void clearHeld(std::size_t expected, const std::uint64_t* keys, std::size_t n) {
+    if (table_.size() != capacityFor(expected) || n != size_ || 4 * n > table_.size()) {
+      clear(expected);
+      return;
+    }
+    // (Every occupied slot lies in the run from its key's home slot on: emptying the runs from
+    // every key's home slot empties the table.)
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t slot = hash(keys[i]); table_[slot].value != kNoIndex;
+           slot = (slot + 1) & mask_) {
+        table_[slot] = Entry{};
+      }
+    }
+    size_ = 0;
+  }
+
   /// The index stored for key, or kNoIndex.
   std::uint32_t find(std::uint64_t key) const {
     std::size_t slot = hash(key);

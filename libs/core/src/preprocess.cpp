@@ -174,12 +174,12 @@ namespace {
 // steps one after the other (cropRange, voxelDownsample, removeStatisticalOutliers).
 void preprocessVoxelized(const PointCloud& in, const PreprocessParams& p, PointCloud& out,
                          PreprocessStats& st) {
-  const std::size_t finite = in.countFinite();
   st.points_in = in.size();
-  st.non_finite = in.size() - finite;
   const RangeBoxTest test(p, in.sensor_origin);
-  const std::size_t passed = detail::voxelize(in, p.voxel_m, test.enabled() ? &test : nullptr, out);
-  st.range_removed = finite - passed;
+  const detail::CropCounts c =
+      detail::voxelize(in, p.voxel_m, test.enabled() ? &test : nullptr, out);
+  st.non_finite = in.size() - c.finite;
+  st.range_removed = c.finite - c.kept;
   st.after_voxel = out.size();
   if (p.outlier_enabled && !out.empty()) {
     detail::compactInPlace(out, outlierKeepMask(out, p.outlier_k, p.outlier_std_mul));

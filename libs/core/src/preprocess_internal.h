@@ -38,11 +38,16 @@ class RangeBoxTest {
   double rmin2_, rmax2_;
 };
 
+/// What cropCopy and voxelize count: the finite points, and those of them that passed.
+struct CropCounts {
+  std::size_t finite = 0, kept = 0;
+};
+
 /// The voxel grid of the finite points of in that test keeps (every finite point when test is
 /// null) into out (unorganized; its buffers reused): one centroid per voxel, in order of first
-/// appearance, colour averaged. Returns the number of points that passed.
-std::size_t voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* test,
-                     PointCloud& out);
+/// appearance, colour averaged. Returns the number of finite points and of those that passed.
+CropCounts voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* test,
+                    PointCloud& out);
 
 /// No packed voxel key has its top bit: the key of a point that does not pass.
 constexpr std::uint64_t kNoKey = ~std::uint64_t(0);
@@ -58,22 +63,18 @@ struct KeyPassParams {
 };
 
 /// The voxel key of each of the n points (x, y, z) that passes (finite, kept by the range and
-/// box tests, each in RangeBoxTest's arithmetic) into keys, kNoKey for the others. Returns false
-/// when a passing point's voxel lies beyond the keys' range. On AVX2 by intrinsics, 8 points at
-/// a time; voxelKeysPlain is the compiler's vectorization of the plain loop, whatever the CPU.
+/// box tests, each in RangeBoxTest's arithmetic) into keys, kNoKey for the others; the number
+/// of finite points among them added to finite. Returns false when a passing point's voxel lies
+/// beyond the keys' range. On AVX2 by intrinsics, 8 points at a time; voxelKeysPlain is the
+/// compiler's vectorization of the plain loop, whatever the CPU.
 bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
-               const KeyPassParams& k, std::uint64_t* keys);
+               const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
 bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t n,
-                    const KeyPassParams& k, std::uint64_t* keys);
+                    const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
 
 /// KeyPassParams' sensor origin and range and box bounds from p (null: every test off; the
 /// key fields zero).
 KeyPassParams rangeBoxBounds(const PreprocessParams* p, const Eigen::Vector3f& sensor_origin);
-
-/// What cropCopy counted: the finite points, and those of them that passed.
-struct CropCounts {
-  std::size_t finite = 0, kept = 0;
-};
 
 /// The range and box cut of n points (x, y, z) into (ox, oy, oz): a point that passes (finite,
 /// kept by the range and box tests of k, each in RangeBoxTest's arithmetic) is copied, any
@@ -109,6 +110,39 @@ double selectMean(float* cand, std::size_t c, std::size_t want, float& kth);
 std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, std::size_t n,
                               float qx, float qy, float qz, float t, float* cand);
 double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth);
+
+/// The outlier filter's grid cells: of each point i = finite[f], f < n, the cell
+/// (cx, cy, cz)[f] of edge 1 / inv_h anchored at (ox, oy, oz): floor(double(x[i] - ox) * inv_h),
+/// clamped to +-2^30 (beyond the keys' range either way). cellCoordsDense is the same for
+/// finite[f] = f, on AVX2 by intrinsics 8 points at a time; cellCoordsDensePlain its plain loop,
+/// whatever the CPU.
+void cellCoords(const float* x, const float* y, const float* z, const std::uint32_t* finite,
+                std::size_t n, float ox, float oy, float oz, double inv_h, std::int32_t* cx,
+                std::int32_t* cy, std::int32_t* cz);
+void cellCoordsDense(const float* x, const float* y, const float* z, std::size_t n, float ox,
+                     float oy, float oz, double inv_h, std::int32_t* cx, std::int32_t* cy,
+                     std::int32_t* cz);
+void cellCoordsDensePlain(const float* x, const float* y, const float* z, std::size_t n, float ox,
+                          float oy, float oz, double inv_h, std::int32_t* cx, std::int32_t* cy,
+                          std::int32_t* cz);
+
+/// The least and the greatest of v[0, n) into lo and hi (n > 0).
+void minMax(const std::int32_t* v, std::size_t n, std::int32_t& lo, std::int32_t& hi);
+
+/// The outlier filter's grid cells of a cloud's finite points (the calling thread's buffers).
+struct CellCoords {
+  std::vector<std::int32_t> x, y, z;  ///< by finite point
+  std::vector<std::uint64_t> bits;    ///< (countCells' bitmap)
+
+  /// The cells of the points finite (not empty) of in at edge 1 / inv_h, anchored at the first.
+  void compute(const PointCloud& in, const std::vector<std::uint32_t>& finite, double inv_h);
+  /// Their box [lo, hi] (in cells).
+  void box(std::int32_t (&lo)[3], std::int32_t (&hi)[3]) const;
+  /// The number of distinct cells, the box being [lo, hi] and fitting the keys: by a bitmap
+  /// over the box (gridCellEdge's first guess has about one cell of the box per point), by a
+  /// hash where the box is too large for one.
+  std::size_t countCells(const std::int32_t (&lo)[3], const std::int32_t (&hi)[3]);
+};
 
 /// Keeps the points of c where keep[i], in order, in place (an unorganized cloud).
 void compactInPlace(PointCloud& c, const std::vector<char>& keep);

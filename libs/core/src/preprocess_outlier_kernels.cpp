@@ -1,13 +1,15 @@
-// The outlier filter's two inner steps, gatherWithin and selectMean (preprocess_internal.h), in
-// a version for AVX2 by intrinsics and a plain one, the one for the running CPU chosen once when
-// the library loads.
+// The outlier filter's inner steps, gatherWithin, selectMean and the cells of its grid
+// (cellCoords, preprocess_internal.h), in a version for AVX2 by intrinsics and a plain one, the
+// one for the running CPU chosen once when the library loads.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 
+#include "fast_cell_map.h"
 #include "preprocess_internal.h"
+#include "upd/core/vector_clones.h"
 
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
@@ -222,6 +224,95 @@ SelectMeanFn pickSelectMean() { return selectMeanScalar; }
 
 const SelectMeanFn pickedSelectMean = pickSelectMean();
 
+// floor(v) as a 32-bit integer, v clamped to +-2^30 first: detail::floorToInt's value wherever
+// a key fits (keyFits refuses the clamped ones), in arithmetic that vectorizes.
+inline std::int32_t floorClamped(double v) {
+  constexpr double kLimit = 1073741824.0;  // 2^30
+  v = v > -kLimit ? v : -kLimit;           // (NaN too)
+  v = v < kLimit ? v : kLimit;
+  const auto t = static_cast<std::int32_t>(v);
+  return t - (v < static_cast<double>(t) ? 1 : 0);
+}
+
+// The cell (cx, cy, cz)[f] of each point i = finite[f], f < n, in cells of edge 1 / inv_h
+// anchored at (ox, oy, oz) (a point of the cloud): (x[i] - ox) in float, times inv_h in double,
+// floored.
+UPD_VECTOR_CLONES
+void cellCoordsLoop(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                const std::uint32_t* __restrict finite, std::size_t n, float ox, float oy,
+                float oz, double inv_h, std::int32_t* __restrict cx, std::int32_t* __restrict cy,
+                std::int32_t* __restrict cz) {
+  for (std::size_t f = 0; f < n; ++f) {
+    const std::uint32_t i = finite[f];
+    cx[f] = floorClamped(static_cast<double>(x[i] - ox) * inv_h);
+    cy[f] = floorClamped(static_cast<double>(y[i] - oy) * inv_h);
+    cz[f] = floorClamped(static_cast<double>(z[i] - oz) * inv_h);
+  }
+}
+
+// cellCoordsLoop where finite[f] = f (every point finite, as the voxel grid's centroids): no
+// gathers.
+UPD_VECTOR_CLONES
+void cellCoordsDenseLoop(const float* __restrict x, const float* __restrict y,
+                         const float* __restrict z, std::size_t n, float ox, float oy, float oz,
+                         double inv_h, std::int32_t* __restrict cx, std::int32_t* __restrict cy,
+                         std::int32_t* __restrict cz) {
+  for (std::size_t i = 0; i < n; ++i) {
+    cx[i] = floorClamped(static_cast<double>(x[i] - ox) * inv_h);
+    cy[i] = floorClamped(static_cast<double>(y[i] - oy) * inv_h);
+    cz[i] = floorClamped(static_cast<double>(z[i] - oz) * inv_h);
+  }
+}
+
+#if defined(__GNUC__) && defined(__x86_64__)
+// floorClamped((double(h) - r) * s) of the 4 lanes of h.
+__attribute__((target("avx2"))) inline __m128i floorClamped4(__m128 h, __m256d s) {
+  const __m256d lim = _mm256_set1_pd(1073741824.0), nlim = _mm256_set1_pd(-1073741824.0);
+  // (max(v, -lim): v where v > -lim, else -lim, NaN too; min(v, lim): v where v < lim.)
+  const __m256d v = _mm256_mul_pd(_mm256_cvtps_pd(h), s);
+  return _mm256_cvttpd_epi32(_mm256_floor_pd(_mm256_min_pd(_mm256_max_pd(v, nlim), lim)));
+}
+
+// cellCoordsDense by AVX2 intrinsics, 8 points at a time (the rest by the loop).
+__attribute__((target("avx2"))) void cellCoordsDenseAvx2(
+    const float* __restrict x, const float* __restrict y, const float* __restrict z,
+    std::size_t n, float ox, float oy, float oz, double inv_h, std::int32_t* __restrict cx,
+    std::int32_t* __restrict cy, std::int32_t* __restrict cz) {
+  const float* in[3] = {x, y, z};
+  const float o[3] = {ox, oy, oz};
+  std::int32_t* out[3] = {cx, cy, cz};
+  const __m256d s = _mm256_set1_pd(inv_h);
+  const std::size_t n8 = n / 8 * 8;
+  for (int a = 0; a < 3; ++a) {
+    const __m256 va = _mm256_set1_ps(o[a]);
+    for (std::size_t i = 0; i < n8; i += 8) {
+      const __m256 d = _mm256_sub_ps(_mm256_loadu_ps(in[a] + i), va);
+      const __m256i c = _mm256_set_m128i(floorClamped4(_mm256_extractf128_ps(d, 1), s),
+                                         floorClamped4(_mm256_castps256_ps128(d), s));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out[a] + i), c);
+    }
+  }
+  cellCoordsDenseLoop(x + n8, y + n8, z + n8, n - n8, ox, oy, oz, inv_h, cx + n8, cy + n8,
+                      cz + n8);
+}
+
+using CellCoordsDenseFn = void (*)(const float*, const float*, const float*, std::size_t, float,
+                                   float, float, double, std::int32_t*, std::int32_t*,
+                                   std::int32_t*);
+CellCoordsDenseFn pickCellCoordsDense() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") ? cellCoordsDenseAvx2 : cellCoordsDenseLoop;
+}
+#else
+using CellCoordsDenseFn = void (*)(const float*, const float*, const float*, std::size_t, float,
+                                   float, float, double, std::int32_t*, std::int32_t*,
+                                   std::int32_t*);
+CellCoordsDenseFn pickCellCoordsDense() { return cellCoordsDenseLoop; }
+#endif
+
+const CellCoordsDenseFn pickedCellCoordsDense = pickCellCoordsDense();
+
+
 }  // namespace
 
 std::size_t gatherWithin(const float* x, const float* y, const float* z, std::size_t n, float qx,
@@ -240,6 +331,82 @@ std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, st
 
 double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth) {
   return selectMeanScalar(cand, c, want, kth);
+}
+
+UPD_VECTOR_CLONES
+void minMax(const std::int32_t* __restrict v, std::size_t n, std::int32_t& lo, std::int32_t& hi) {
+  std::int32_t l = v[0], h = v[0];
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::int32_t x = v[i];
+    l = x < l ? x : l;  // (not std::min: GCC then keeps it scalar)
+    h = x > h ? x : h;
+  }
+  lo = l, hi = h;
+}
+
+void cellCoords(const float* x, const float* y, const float* z, const std::uint32_t* finite,
+                std::size_t n, float ox, float oy, float oz, double inv_h, std::int32_t* cx,
+                std::int32_t* cy, std::int32_t* cz) {
+  cellCoordsLoop(x, y, z, finite, n, ox, oy, oz, inv_h, cx, cy, cz);
+}
+
+void cellCoordsDense(const float* x, const float* y, const float* z, std::size_t n, float ox,
+                     float oy, float oz, double inv_h, std::int32_t* cx, std::int32_t* cy,
+                     std::int32_t* cz) {
+  pickedCellCoordsDense(x, y, z, n, ox, oy, oz, inv_h, cx, cy, cz);
+}
+
+void cellCoordsDensePlain(const float* x, const float* y, const float* z, std::size_t n, float ox,
+                          float oy, float oz, double inv_h, std::int32_t* cx, std::int32_t* cy,
+                          std::int32_t* cz) {
+  cellCoordsDenseLoop(x, y, z, n, ox, oy, oz, inv_h, cx, cy, cz);
+}
+
+void CellCoords::compute(const PointCloud& in, const std::vector<std::uint32_t>& finite,
+                         double inv_h) {
+  const std::size_t n = finite.size();
+  x.resize(n), y.resize(n), z.resize(n);
+  const std::uint32_t f0 = finite.front();
+  if (n == in.size()) {  // (finite is then 0, 1, ..., n - 1)
+    cellCoordsDense(in.x.data(), in.y.data(), in.z.data(), n, in.x[f0], in.y[f0], in.z[f0], inv_h,
+                    x.data(), y.data(), z.data());
+  } else {
+    cellCoords(in.x.data(), in.y.data(), in.z.data(), finite.data(), n, in.x[f0], in.y[f0],
+               in.z[f0], inv_h, x.data(), y.data(), z.data());
+  }
+}
+
+void CellCoords::box(std::int32_t (&lo)[3], std::int32_t (&hi)[3]) const {
+  const std::vector<std::int32_t>* axis[3] = {&x, &y, &z};
+  for (int a = 0; a < 3; ++a) minMax(axis[a]->data(), axis[a]->size(), lo[a], hi[a]);
+}
+
+std::size_t CellCoords::countCells(const std::int32_t (&lo)[3], const std::int32_t (&hi)[3]) {
+  const std::size_t n = x.size();
+  std::int64_t dim[3];
+  double volume = 1;
+  for (int a = 0; a < 3; ++a) {
+    dim[a] = std::int64_t{hi[a]} - lo[a] + 1;
+    volume *= static_cast<double>(dim[a]);
+  }
+  if (volume <= static_cast<double>(64 * n + 65536)) {
+    bits.assign(static_cast<std::size_t>(volume) / 64 + 1, 0);
+    std::size_t count = 0;
+    for (std::size_t f = 0; f < n; ++f) {
+      const auto b = static_cast<std::size_t>((x[f] - lo[0]) + (y[f] - lo[1]) * dim[0] +
+                                              (z[f] - lo[2]) * dim[0] * dim[1]);
+      const std::uint64_t bit = std::uint64_t{1} << (b % 64);
+      count += (bits[b / 64] & bit) == 0 ? 1 : 0;
+      bits[b / 64] |= bit;
+    }
+    return count;
+  }
+  CellMap cells(n / 4 + 64);
+  for (std::size_t f = 0; f < n; ++f) {
+    bool inserted = false;
+    cells.findOrInsert(packKey(x[f], y[f], z[f]), inserted);
+  }
+  return cells.size();
 }
 
 }  // namespace upd::core::detail

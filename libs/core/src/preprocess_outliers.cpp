@@ -1,5 +1,6 @@
 // The statistical outlier filter's neighbour search, meanNeighbourDistances: the mean distance
-// of every point to its k nearest, by a grid of cells (CellGrid) where that settles them, by
+// of every point to its k nearest, by a grid of cells (PointGrid: its cells found in a dense
+// table over their box, or by the hash where that box is sparse) where that settles them, by
 // comparing with every point for the few left, and by the k-d tree when many are left.
 #include <Eigen/Core>
 #include <algorithm>
@@ -20,15 +21,6 @@ namespace upd::core {
 
 namespace {
 
-// The cell (x, y, z) of point i in cells of edge 1 / inv_h anchored at point f0, as 64-bit
-// integers (detail::keyFits says whether they fit a key).
-inline void cellOf(const PointCloud& in, std::uint32_t i, std::uint32_t f0, double inv_h,
-                   std::int64_t (&c)[3]) {
-  c[0] = detail::floorToInt(static_cast<double>(in.x[i] - in.x[f0]) * inv_h);
-  c[1] = detail::floorToInt(static_cast<double>(in.y[i] - in.y[f0]) * inv_h);
-  c[2] = detail::floorToInt(static_cast<double>(in.z[i] - in.z[f0]) * inv_h);
-}
-
 // Coordinates of the padding: their distances are huge and never kept.
 constexpr float kFarPoint = 1e18f;
 // The slack of the rows for copyRunByEights.
@@ -46,14 +38,15 @@ struct PointGrid {
   std::vector<std::uint32_t> index;  // by cell: the cloud's index
   std::vector<std::uint32_t> cell_of;  // (buildGrid's buffers)
   detail::CellLists by_cell;
+  detail::CellCoords coords;
 
   // Squared distance from (qx, qy, qz) to the box of cell c (0 inside).
   float boxDistance2(std::uint32_t c, float qx, float qy, float qz) const {
     const float q[3] = {qx, qy, qz};
     float d2 = 0.f;
     for (int a = 0; a < 3; ++a) {
-      const auto lo = static_cast<float>(cells.xyz(c)[a] * h);
-      const auto hi = static_cast<float>((cells.xyz(c)[a] + 1) * h);
+      const auto lo = static_cast<float>(xyz(c)[a] * h);
+      const auto hi = static_cast<float>((xyz(c)[a] + 1) * h);
       const float d = q[a] < lo ? lo - q[a] : (q[a] > hi ? q[a] - hi : 0.f);
       d2 += d * d;
     }
@@ -63,7 +56,54 @@ struct PointGrid {
   std::uint32_t find(std::int64_t cx, std::int64_t cy, std::int64_t cz) const {
     return cells.find(cx, cy, cz);
   }
+
+  // The cell ids over the occupied cells' box widened by kDenseMargin cells on every side, x
+  // fastest (kNoIndex where empty), and the shells' cell offsets in it, nearest first: a shell's
+  // cells by one load each instead of a hash look-up. Off (has_dense false) where the box would
+  // hold more than kDenseCellsPerPoint cells per point.
+  static constexpr int kDenseMargin = 3;
+  static constexpr std::size_t kDenseCellsPerPoint = 32;
+  bool has_dense = false;
+  std::vector<std::uint32_t> dense;
+  std::int64_t dense_lo[3] = {0, 0, 0};
+  std::int64_t dense_sy = 0, dense_sz = 0;  // strides of y and z
+  std::array<std::vector<std::int64_t>, 4> dense_offsets;  // by ring (0 .. 3)
+  std::size_t denseIndex(std::int32_t cx, std::int32_t cy, std::int32_t cz) const {
+    return static_cast<std::size_t>((cx - dense_lo[0]) + (cy - dense_lo[1]) * dense_sy +
+                                    (cz - dense_lo[2]) * dense_sz);
+  }
+  // The cells' coordinates, 3 per cell in id order (the ids in order of first sight, as the
+  // hash's CellGrid numbers them).
+  std::vector<std::int32_t> cell_xyz;
+  std::size_t n_cells = 0;
+  const std::int32_t* xyz(std::size_t c) const { return &cell_xyz[3 * c]; }
 };
+
+// The cells' dense table (empty) and its shells' offsets over the box [lo, hi] widened by
+// kDenseMargin; false (has_dense off) where the box would hold more than kDenseCellsPerPoint
+// cells per point.
+const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring);
+bool makeDense(PointGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&hi)[3],
+               std::size_t n_points) {
+  g.has_dense = false;
+  double volume = 1;
+  std::int64_t dim[3];
+  for (int a = 0; a < 3; ++a) {
+    dim[a] = std::int64_t{hi[a]} - lo[a] + 1 + 2 * PointGrid::kDenseMargin;
+    volume *= static_cast<double>(dim[a]);
+  }
+  if (volume > static_cast<double>(PointGrid::kDenseCellsPerPoint * n_points + 4096)) return false;
+  g.dense.assign(static_cast<std::size_t>(volume), detail::kNoIndex);
+  for (int a = 0; a < 3; ++a) g.dense_lo[a] = std::int64_t{lo[a]} - PointGrid::kDenseMargin;
+  g.dense_sy = dim[0], g.dense_sz = dim[0] * dim[1];
+  for (int ring = 0; ring <= PointGrid::kDenseMargin; ++ring) {
+    std::vector<std::int64_t>& o = g.dense_offsets[static_cast<std::size_t>(ring)];
+    o.clear();
+    for (const auto& d : shellOffsets(ring)) o.push_back(d[0] + d[1] * g.dense_sy + d[2] * g.dense_sz);
+  }
+  g.has_dense = true;
+  return true;
+}
 
 // Bins the finite points at edge h; false when a point lies beyond the keys' range.
 bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, double h,
@@ -71,17 +111,35 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   g.h = h, g.inv_h = 1.0 / h;
   const std::uint32_t f0 = finite.front();
   g.ox = in.x[f0], g.oy = in.y[f0], g.oz = in.z[f0];
-  g.cells.clear(finite.size() / 4 + 64);
   std::vector<std::uint32_t>& cell_of = g.cell_of;
   cell_of.resize(finite.size());
-  const auto coords = [&](std::size_t f, std::int64_t(&c)[3]) {
-    cellOf(in, finite[f], f0, g.inv_h, c);
-    return true;
-  };
-  if (!detail::binCells(0, finite.size(), coords, g.cells, cell_of.data())) return false;
+  g.coords.compute(in, finite, g.inv_h);
+  std::int32_t lo[3], hi[3];
+  g.coords.box(lo, hi);
+  if (!detail::keyFits(lo[0], lo[1], lo[2]) || !detail::keyFits(hi[0], hi[1], hi[2])) return false;
+  if (makeDense(g, lo, hi, finite.size())) {  // (ids by the dense table: no hash)
+    g.cell_xyz.clear();
+    std::uint32_t n_cells = 0;
+    for (std::size_t f = 0; f < finite.size(); ++f) {
+      const std::int32_t cx = g.coords.x[f], cy = g.coords.y[f], cz = g.coords.z[f];
+      std::uint32_t& id = g.dense[g.denseIndex(cx, cy, cz)];
+      if (id == detail::kNoIndex) id = n_cells++, g.cell_xyz.insert(g.cell_xyz.end(), {cx, cy, cz});
+      cell_of[f] = id;
+    }
+    g.n_cells = n_cells;
+  } else {
+    g.cells.clear(finite.size() / 4 + 64);
+    const auto coords = [&](std::size_t f, std::int64_t(&c)[3]) {
+      c[0] = g.coords.x[f], c[1] = g.coords.y[f], c[2] = g.coords.z[f];
+      return true;
+    };
+    detail::binCells(0, finite.size(), coords, g.cells, cell_of.data());  // (every cell fits)
+    g.cell_xyz.assign(g.cells.coords().begin(), g.cells.coords().end());
+    g.n_cells = g.cells.size();
+  }
   detail::CellLists& by_cell = g.by_cell;
   detail::listByCell(
-      finite.size(), g.cells.size(), [&](std::size_t f) { return cell_of[f]; }, by_cell);
+      finite.size(), g.n_cells, [&](std::size_t f) { return cell_of[f]; }, by_cell);
   g.start.assign(by_cell.start.begin(), by_cell.start.end());
   // (kCopyLanes of slack: BlockPoints::fill copies 8 at a time.)
   const std::size_t rows = finite.size() + kCopyLanes;
@@ -165,22 +223,6 @@ struct BlockPoints {
   }
 };
 
-// Distance from q (grid coordinates relative to the anchor) to the outside of the block of
-// cells within Chebyshev distance ring of its cell (cx, cy, cz): no point outside that block
-// is nearer.
-double blockMargin(const PointGrid& g, double qx, double qy, double qz, std::int32_t cx,
-                   std::int32_t cy, std::int32_t cz, int ring) {
-  double m = std::numeric_limits<double>::infinity();
-  const double q[3] = {qx, qy, qz};
-  const std::int32_t c[3] = {cx, cy, cz};
-  for (int a = 0; a < 3; ++a) {
-    const double lo = static_cast<double>(c[a] - ring) * g.h;
-    const double hi = static_cast<double>(c[a] + ring + 1) * g.h;
-    m = std::min({m, q[a] - lo, hi - q[a]});
-  }
-  return m;
-}
-
 // The cell offsets at Chebyshev distance ring (0 .. 3), sorted by their distance.
 const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
   static const auto table = [] {
@@ -211,7 +253,8 @@ const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
 // (~120 points on a voxelized Kinect frame) for all but a few per cent of the points, which look
 // at the 5 x 5 x 5 block. (With (k + 1) / 3 points more points need the wider block; with
 // k + 1 the blocks hold ~210 points: each 5-10 % more instructions on voxelized frames.)
-double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k) {
+double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k,
+                    detail::CellCoords& coords) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (const std::uint32_t i : finite) {
@@ -222,17 +265,14 @@ double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& fini
   // First guess: the points filling the bounding box; then one correction from the measured
   // points per occupied cell, as for a surface (count ~ h^2).
   double h = std::cbrt(ext.prod() / static_cast<double>(finite.size()));
-  const std::uint32_t f0 = finite.front();
-  const double inv_h = 1.0 / h;
-  detail::CellMap cells(finite.size() / 4 + 64);  // (counted only: no cell ids kept)
-  for (const std::uint32_t i : finite) {
-    std::int64_t c[3];
-    cellOf(in, i, f0, inv_h, c);
-    if (!detail::keyFits(c[0], c[1], c[2])) return h;  // (buildGrid refuses it too: k-d tree)
-    bool inserted = false;
-    cells.findOrInsert(detail::packKey(c[0], c[1], c[2]), inserted);
+  coords.compute(in, finite, 1.0 / h);
+  std::int32_t c_lo[3], c_hi[3];
+  coords.box(c_lo, c_hi);
+  if (!detail::keyFits(c_lo[0], c_lo[1], c_lo[2]) || !detail::keyFits(c_hi[0], c_hi[1], c_hi[2])) {
+    return h;  // (buildGrid refuses it too: k-d tree)
   }
-  const double per_cell = static_cast<double>(finite.size()) / static_cast<double>(cells.size());
+  const double per_cell =
+      static_cast<double>(finite.size()) / static_cast<double>(coords.countCells(c_lo, c_hi));
   const double target = static_cast<double>(k + 1) / 2.0;
   return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
 }
@@ -249,7 +289,13 @@ class CellSearch {
   }
 
   void startCell(std::size_t c) {
-    cx_ = g_->cells.xyz(c)[0], cy_ = g_->cells.xyz(c)[1], cz_ = g_->cells.xyz(c)[2];
+    cx_ = g_->xyz(c)[0], cy_ = g_->xyz(c)[1], cz_ = g_->xyz(c)[2];
+    for (int ring = 1; ring <= 3; ++ring) {
+      for (int a = 0; a < 3; ++a) {
+        lo_[ring][a] = static_cast<double>(g_->xyz(c)[a] - ring) * g_->h;
+        hi_[ring][a] = static_cast<double>(g_->xyz(c)[a] + ring + 1) * g_->h;
+      }
+    }
     cells_.clear();
     built_ = -1;
     grow(1);
@@ -262,7 +308,7 @@ class CellSearch {
     for (int ring = 1; ring <= 2; ++ring) {
       if (built_ < ring) grow(ring);
       const BlockPoints& b = block_[ring];
-      const double m = blockMargin(*g_, qx, qy, qz, cx_, cy_, cz_, ring);
+      const double m = margin(qx, qy, qz, ring);
       const auto m2 = static_cast<float>(m * m * (1 - 1e-6));
       // The previous point's k-th distance, a little widened, mostly bounds this one's: fewer
       // candidates to select from. Where it does not, the block's margin.
@@ -291,7 +337,7 @@ class CellSearch {
                  d2_.data());
       for (std::size_t j = 0; j < n; ++j) best_.offer(d2_[j]);
     }
-    const double m = blockMargin(*g_, qx, qy, qz, cx_, cy_, cz_, 3);
+    const double m = margin(qx, qy, qz, 3);
     if (best_.full() && static_cast<double>(best_.worst()) <= m * m) {
       return best_.meanWithoutFirst();
     }
@@ -299,10 +345,26 @@ class CellSearch {
   }
 
  private:
+  // Distance from q (grid coordinates relative to the anchor) to the outside of the block of
+  // cells within Chebyshev distance ring of the current cell: no point outside that block is
+  // nearer.
+  double margin(double qx, double qy, double qz, int ring) const {
+    const double* lo = lo_[ring];
+    const double* hi = hi_[ring];
+    return std::min({qx - lo[0], hi[0] - qx, qy - lo[1], hi[1] - qy, qz - lo[2], hi[2] - qz});
+  }
   // The occupied cells at Chebyshev distance ring from the current cell, nearest first, into
   // out.
   void shell(int ring, std::vector<std::uint32_t>& out) const {
     out.clear();
+    if (g_->has_dense) {
+      const std::uint32_t* at = g_->dense.data() + g_->denseIndex(cx_, cy_, cz_);
+      for (const std::int64_t o : g_->dense_offsets[static_cast<std::size_t>(ring)]) {
+        const std::uint32_t c = at[o];
+        if (c != detail::kNoIndex) out.push_back(c);
+      }
+      return;
+    }
     // (Away from the keys' bounds, as nearly always, the keys are the cell's plus an offset,
     // with no range test.)
     const std::int32_t xyz[3] = {cx_, cy_, cz_};
@@ -333,6 +395,7 @@ class CellSearch {
   NearestK best_{1};
   std::int32_t cx_ = 0, cy_ = 0, cz_ = 0;
   int built_ = -1;  // the rings gathered for the current cell
+  double lo_[4][3] = {}, hi_[4][3] = {};  // the current cell's blocks' bounds by ring (1 .. 3)
   std::vector<std::uint32_t> cells_, around_, ring3_;
   BlockPoints block_[3];
   std::vector<float> bd2_, cand_, d2_;
@@ -364,7 +427,7 @@ __attribute__((noipa)) void searchCells(CellSearch& search, const PointGrid& g,
 // (their grid positions).
 void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>& mean_dist,
                        std::vector<std::uint32_t>& rest) {
-  const std::size_t n_cells = g.start.size() - 1;
+  const std::size_t n_cells = g.n_cells;
   constexpr std::size_t kCellsPerShare = 16;
   const std::size_t n_shares = (n_cells + kCellsPerShare - 1) / kCellsPerShare;
 #pragma omp parallel
@@ -382,6 +445,22 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
   }
 }
 
+// d2[0, n) offered to best. (Once it is full, a run of 16 with none below its worst, the common
+// case, is passed over by one test: the worst only falls, so their offers would be refused.)
+void offerAll(const float* d2, std::size_t n, NearestK& best) {
+  std::size_t j = 0;
+  for (; j < n && !best.full(); ++j) best.offer(d2[j]);
+  constexpr std::size_t kRun = 16;
+  for (; j + kRun <= n; j += kRun) {
+    const float w = best.worst();
+    int below = 0;
+    for (std::size_t t = 0; t < kRun; ++t) below |= d2[j + t] < w ? 1 : 0;
+    if (below == 0) continue;
+    for (std::size_t t = 0; t < kRun; ++t) best.offer(d2[j + t]);
+  }
+  for (; j < n; ++j) best.offer(d2[j]);
+}
+
 // The mean distances of the few grid points at positions todo, each compared with every point
 // of the grid (cheaper than building a k-d tree for a few dozen).
 void allPairsMeanDistances(const PointGrid& g, std::size_t want,
@@ -396,7 +475,7 @@ void allPairsMeanDistances(const PointGrid& g, std::size_t want,
       const std::uint32_t q = todo[static_cast<std::size_t>(r)];
       distances2(g.x.data(), g.y.data(), g.z.data(), n, g.x[q], g.y[q], g.z[q], d2.data());
       best.clear();
-      for (std::size_t j = 0; j < n; ++j) best.offer(d2[j]);
+      offerAll(d2.data(), n, best);
       if (best.size() >= 2) mean_dist[g.index[q]] = best.meanWithoutFirst();
     }
   }
@@ -445,7 +524,7 @@ __attribute__((noipa)) void meanNeighbourDistances(const PointCloud& in, int k,
   if (finite.empty()) return;
   const std::size_t want = static_cast<std::size_t>(k) + 1;  // the point itself comes first
   // (A k beyond NearestK's capacity, or a cloud beyond the keys' range: the k-d tree alone.)
-  if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k), g)) {
+  if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k, g.coords), g)) {
     kdTreeMeanDistances(in, k, finite, mean_dist);
     return;
   }

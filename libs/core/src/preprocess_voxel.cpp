@@ -50,12 +50,16 @@ inline bool passes(float fx, float fy, float fz, const KeyPassParams& k) {
 // voxelKeys (preprocess_internal.h), branch-free, so that it vectorizes.
 UPD_VECTOR_CLONES
 bool voxelKeysLoop(const float* __restrict x, const float* __restrict y, const float* __restrict z,
-               std::size_t n, const KeyPassParams& k, std::uint64_t* __restrict keys) {
+               std::size_t n, const KeyPassParams& k, std::uint64_t* __restrict keys,
+               std::size_t& finite) {
   constexpr std::int32_t kBias = static_cast<std::int32_t>(kKeyBias);
+  constexpr float kMaxF = std::numeric_limits<float>::max();
   std::uint32_t bad = 0;
+  std::size_t finite_count = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const float fx = x[j], fy = y[j], fz = z[j];
     const bool pass = passes(fx, fy, fz, k);
+    finite_count += (std::abs(fx) <= kMaxF) & (std::abs(fy) <= kMaxF) & (std::abs(fz) <= kMaxF);
     const std::int32_t cx = floorClamped((static_cast<double>(fx) - k.ref_x) * k.inv);
     const std::int32_t cy = floorClamped((static_cast<double>(fy) - k.ref_y) * k.inv);
     const std::int32_t cz = floorClamped((static_cast<double>(fz) - k.ref_z) * k.inv);
@@ -67,6 +71,7 @@ bool voxelKeysLoop(const float* __restrict x, const float* __restrict y, const f
                               (static_cast<std::uint64_t>(static_cast<std::uint32_t>(cz + kBias)) << 42);
     keys[j] = pass ? key : kNoKey;
   }
+  finite += finite_count;
   return bad == 0;
 }
 
@@ -154,11 +159,12 @@ __attribute__((target("avx2"))) inline __m256i packKeys(__m128i ux, __m128i uy, 
 
 // voxelKeys by AVX2 intrinsics, 8 points at a time (the rest by the loop): the same operations
 // in double and float as voxelKeysLoop, so the same keys.
-__attribute__((target("avx2"))) bool voxelKeysAvx2(const float* __restrict x,
-                                                   const float* __restrict y,
-                                                   const float* __restrict z, std::size_t n,
-                                                   const KeyPassParams& k,
-                                                   std::uint64_t* __restrict keys) {
+__attribute__((target("avx2,popcnt"))) bool voxelKeysAvx2(const float* __restrict x,
+                                                          const float* __restrict y,
+                                                          const float* __restrict z, std::size_t n,
+                                                          const KeyPassParams& k,
+                                                          std::uint64_t* __restrict keys,
+                                                          std::size_t& finite) {
   const __m256 maxf = _mm256_set1_ps(std::numeric_limits<float>::max());
   const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
   const __m256 b0[3] = {_mm256_set1_ps(k.bx0), _mm256_set1_ps(k.by0), _mm256_set1_ps(k.bz0)};
@@ -166,16 +172,30 @@ __attribute__((target("avx2"))) bool voxelKeysAvx2(const float* __restrict x,
   const __m256i lo = _mm256_set1_epi32(-static_cast<std::int32_t>(kKeyBias) - 1);
   const __m256i hi = _mm256_set1_epi32(static_cast<std::int32_t>(kKeyBias));
   __m256i bad = _mm256_setzero_si256();
+  std::size_t finite_count = 0;
   const std::size_t n8 = n / 8 * 8;
   for (std::size_t j = 0; j < n8; j += 8) {
     const __m256 f[3] = {_mm256_loadu_ps(x + j), _mm256_loadu_ps(y + j), _mm256_loadu_ps(z + j)};
-    __m256 ok = _mm256_castsi256_ps(rangeMask(f[0], f[1], f[2], k));
+    __m256 fin = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    for (int a = 0; a < 3; ++a) {
+      fin = _mm256_and_ps(fin, _mm256_cmp_ps(_mm256_and_ps(f[a], abs_mask), maxf, _CMP_LE_OQ));
+    }
+    finite_count += static_cast<std::size_t>(
+        __builtin_popcount(static_cast<unsigned>(_mm256_movemask_ps(fin))));
+    __m256 ok = _mm256_and_ps(fin, _mm256_castsi256_ps(rangeMask(f[0], f[1], f[2], k)));
+    for (int a = 0; a < 3; ++a) {
+      ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(f[a], b0[a], _CMP_GE_OQ),
+                                           _mm256_cmp_ps(f[a], b1[a], _CMP_LE_OQ)));
+    }
+    if (_mm256_testz_ps(ok, ok)) {  // (none passes, as in the NaN holes and beyond the range)
+      const __m256i none = _mm256_set1_epi64x(-1);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(keys + j), none);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(keys + j + 4), none);
+      continue;
+    }
     __m256i fits = _mm256_set1_epi32(-1), u[3];
     const double ref[3] = {k.ref_x, k.ref_y, k.ref_z};
     for (int a = 0; a < 3; ++a) {
-      ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_and_ps(f[a], abs_mask), maxf, _CMP_LE_OQ));
-      ok = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(f[a], b0[a], _CMP_GE_OQ),
-                                           _mm256_cmp_ps(f[a], b1[a], _CMP_LE_OQ)));
       const __m256i c = cellCoords(f[a], ref[a], k.inv);
       fits = _mm256_and_si256(fits, _mm256_and_si256(_mm256_cmpgt_epi32(c, lo), _mm256_cmpgt_epi32(hi, c)));
       u[a] = _mm256_add_epi32(c, hi);
@@ -188,19 +208,21 @@ __attribute__((target("avx2"))) bool voxelKeysAvx2(const float* __restrict x,
                                    lanes4(pass, h)));
     }
   }
-  const bool rest = voxelKeysLoop(x + n8, y + n8, z + n8, n - n8, k, keys + n8);
+  finite += finite_count;
+  const bool rest = voxelKeysLoop(x + n8, y + n8, z + n8, n - n8, k, keys + n8, finite);
   return rest && _mm256_testz_si256(bad, bad);
 }
 
 using VoxelKeysFn = bool (*)(const float*, const float*, const float*, std::size_t,
-                             const KeyPassParams&, std::uint64_t*);
+                             const KeyPassParams&, std::uint64_t*, std::size_t&);
 VoxelKeysFn pickVoxelKeys() {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? voxelKeysAvx2 : voxelKeysLoop;
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt") ? voxelKeysAvx2
+                                                                            : voxelKeysLoop;
 }
 #else
 using VoxelKeysFn = bool (*)(const float*, const float*, const float*, std::size_t,
-                             const KeyPassParams&, std::uint64_t*);
+                             const KeyPassParams&, std::uint64_t*, std::size_t&);
 VoxelKeysFn pickVoxelKeys() { return voxelKeysLoop; }
 #endif
 
@@ -257,10 +279,11 @@ CropCopyFn pickCropCopy() { return cropCopyLoop; }
 
 const CropCopyFn pickedCropCopy = pickCropCopy();
 
-// Per voxel: the sums of the points relative to the anchor, of the colours, and the count.
+// Per voxel: the sums of the points relative to the anchor, of the colours (exact: below 2^32
+// for any voxel of fewer than 2^24 points), and the count.
 struct VoxelSums {
   double sx = 0, sy = 0, sz = 0;
-  double r = 0, g = 0, b = 0;
+  std::uint32_t r = 0, g = 0, b = 0;
   std::uint32_t n = 0;
 };
 
@@ -268,6 +291,8 @@ struct VoxelSums {
 struct VoxelScratch {
   CellMap map;
   std::vector<VoxelSums> voxels;
+  std::vector<std::uint64_t> voxel_keys;  // the keys the map holds, by voxel id
+  std::size_t held = 0;                   // (their number)
   std::vector<std::uint64_t> row_key[2];  // the voxel key and id of each column, last two rows
   std::vector<std::uint32_t> row_id[2];
   std::vector<std::uint64_t> keys;  // the keys of the points of one row (unorganized: a chunk)
@@ -280,10 +305,13 @@ struct VoxelScratch {
       "cut-off");
 }
 
-// The first point of in that passes (finite, kept by test), or in.size().
-std::size_t firstPassing(const PointCloud& in, const RangeBoxTest* test) {
+// The first point of in that passes (finite, kept by test), or in.size(); the finite points
+// before it added to finite.
+std::size_t firstPassing(const PointCloud& in, const RangeBoxTest* test, std::size_t& finite) {
   for (std::size_t i = 0; i < in.size(); ++i) {
-    if (in.isFinite(i) && (test == nullptr || test->keeps(in.point(i)))) return i;
+    if (!in.isFinite(i)) continue;
+    if (test == nullptr || test->keeps(in.point(i))) return i;
+    ++finite;
   }
   return in.size();
 }
@@ -300,7 +328,11 @@ void writeCentroids(const VoxelScratch& s, std::size_t n, const Eigen::Vector3d&
     out.y[v] = static_cast<float>(c.y());
     out.z[v] = static_cast<float>(c.z());
     if (colour) {
-      const auto avg = [&](double sum) { return static_cast<std::uint8_t>(std::lround(sum / a.n)); };
+      // (lround's value: the quotient lies at least 1 / (2 n) from a half, far beyond its
+      // rounding, and is not negative.)
+      const auto avg = [&](std::uint32_t sum) {
+        return static_cast<std::uint8_t>(static_cast<double>(sum) / a.n + 0.5);
+      };
       out.r[v] = avg(a.r), out.g[v] = avg(a.g), out.b[v] = avg(a.b);
     }
   }
@@ -309,13 +341,13 @@ void writeCentroids(const VoxelScratch& s, std::size_t n, const Eigen::Vector3d&
 }  // namespace
 
 bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
-               const KeyPassParams& k, std::uint64_t* keys) {
-  return pickedVoxelKeys(x, y, z, n, k, keys);
+               const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite) {
+  return pickedVoxelKeys(x, y, z, n, k, keys, finite);
 }
 
 bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t n,
-                    const KeyPassParams& k, std::uint64_t* keys) {
-  return voxelKeysLoop(x, y, z, n, k, keys);
+                    const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite) {
+  return voxelKeysLoop(x, y, z, n, k, keys, finite);
 }
 
 CropCounts cropCopy(const float* x, const float* y, const float* z, std::size_t n,
@@ -363,7 +395,7 @@ class VoxelPass {
     const std::size_t n = e - b;
     if (s_.keys.size() < n) s_.keys.resize(n);
     if (!keys) keys = s_.keys.data();
-    if (!voxelKeys(&in_.x[b], &in_.y[b], &in_.z[b], n, k_, keys)) throwSpan(voxel_m_);
+    if (!voxelKeys(&in_.x[b], &in_.y[b], &in_.z[b], n, k_, keys, finite_)) throwSpan(voxel_m_);
     const bool colour = in_.hasColor();
     const float *x = &in_.x[b], *y = &in_.y[b], *z = &in_.z[b];
     const std::uint8_t* rgb[3] = {colour ? &in_.r[b] : nullptr, colour ? &in_.g[b] : nullptr,
@@ -403,6 +435,7 @@ class VoxelPass {
     }
   }
   std::size_t passed() const { return passed_; }
+  std::size_t finite() const { return finite_; }
   std::size_t voxels() const { return n_voxels_; }
 
  private:
@@ -410,8 +443,12 @@ class VoxelPass {
     bool inserted = false;
     const std::uint32_t id = s_.map.findOrInsert(key, inserted);
     if (inserted) {
-      if (s_.voxels.size() <= n_voxels_) s_.voxels.resize(2 * n_voxels_ + 64);
+      if (s_.voxels.size() <= n_voxels_) {
+        s_.voxels.resize(2 * n_voxels_ + 64), s_.voxel_keys.resize(2 * n_voxels_ + 64);
+      }
+      s_.voxel_keys[n_voxels_] = key;
       s_.voxels[n_voxels_++] = VoxelSums{};
+      s_.held = n_voxels_;
     }
     return id;
   }
@@ -423,23 +460,27 @@ class VoxelPass {
   KeyPassParams k_;
   std::uint64_t last_key_ = kNoKey;
   std::uint32_t last_id_ = 0;
-  std::size_t passed_ = 0, n_voxels_ = 0;
+  std::size_t passed_ = 0, finite_ = 0, n_voxels_ = 0;
 };
 
-}  // namespace
-
-std::size_t voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* test,
-                     PointCloud& out) {
-  thread_local VoxelScratch s;
+// voxelize with the calling thread's scratch s (a function of its own, kept from inlining and
+// from specializing on its argument: GCC computes a thread_local's address again, by a call
+// into the dynamic linker, at each use in a function that names it).
+__attribute__((noipa)) CropCounts voxelizeWith(VoxelScratch& s, const PointCloud& in,
+                                               double voxel_m, const RangeBoxTest* test,
+                                               PointCloud& out) {
   out.sensor_origin = in.sensor_origin;
-  const std::size_t first = firstPassing(in, test);
+  std::size_t finite_before = 0;
+  const std::size_t first = firstPassing(in, test, finite_before);
   if (first == in.size()) {
     writeCentroids(s, 0, Eigen::Vector3d::Zero(), false, out);
-    return 0;
+    return {finite_before, 0};
   }
   // Keys and centroids relative to the first point: exact far from the origin.
   const Eigen::Vector3d ref = in.point(first).cast<double>();
-  s.map.clear(in.size() / 4 + 16);
+  // (Only the slots of the last call's keys are emptied, not the whole table.)
+  s.map.clearHeld(in.size() / 4 + 16, s.voxel_keys.data(), s.held);
+  s.held = 0;
   VoxelPass pass(s, in, ref, voxel_m, test ? &test->params() : nullptr);
   if (!in.isOrganized()) {
     constexpr std::size_t kChunk = 4096;  // (the keys of a chunk stay in the cache)
@@ -461,7 +502,15 @@ std::size_t voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* t
     }
   }
   writeCentroids(s, pass.voxels(), ref, in.hasColor(), out);
-  return pass.passed();
+  return {finite_before + pass.finite(), pass.passed()};
+}
+
+}  // namespace
+
+CropCounts voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* test,
+                    PointCloud& out) {
+  thread_local VoxelScratch s;
+  return voxelizeWith(s, in, voxel_m, test, out);
 }
 
 void compactInPlace(PointCloud& c, const std::vector<char>& keep) {
