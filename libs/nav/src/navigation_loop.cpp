@@ -295,6 +295,32 @@ void NavigationLoop::restartStallWatch() {
   stall_anchor_s_ = base_.timeS();
 }
 
+namespace {
+
+// Centres of the cells within reach_m of the robot that the map has not observed (cells outside
+// the grid's window included), in the robot frame.
+std::vector<Eigen::Vector2d> unknownCellsInRobot(const maps::TraversabilityGrid& grid,
+                                                 const Pose2D& pose_world_robot, double reach_m) {
+  const double cs = grid.cellSize();
+  const Eigen::Vector2d centre(pose_world_robot.x_m, pose_world_robot.y_m);
+  // World cell indices: the centre of cell (i, j) is ((i + 0.5) cs, (j + 0.5) cs).
+  const auto index = [&](double v_m) { return static_cast<std::int64_t>(std::floor(v_m / cs)); };
+  std::vector<Eigen::Vector2d> out;
+  for (std::int64_t j = index(centre.y() - reach_m); j <= index(centre.y() + reach_m); ++j) {
+    for (std::int64_t i = index(centre.x() - reach_m); i <= index(centre.x() + reach_m); ++i) {
+      const Eigen::Vector2d c((static_cast<double>(i) + 0.5) * cs,
+                              (static_cast<double>(j) + 0.5) * cs);
+      if ((c - centre).norm() > reach_m) continue;
+      const maps::GridCell* cell = grid.cellAt(c.x(), c.y());
+      if (cell != nullptr && maps::isKnown(*cell, grid.params())) continue;
+      out.push_back(worldToRobot(pose_world_robot, c));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 bool NavigationLoop::startRecoveryIfStalled() {
   const RecoveryParams& rp = config_.recovery;
   if (!rp.enabled) return false;
@@ -314,9 +340,15 @@ bool NavigationLoop::startRecoveryIfStalled() {
     half_length_m = std::max(half_length_m, std::abs(v.x()));
     half_width_m = std::max(half_width_m, std::abs(v.y()));
   }
+  std::vector<Eigen::Vector2d> unobserved_robot;
+  if (!rp.into_unobserved) {
+    unobserved_robot = unknownCellsInRobot(
+        grid_, s.pose_world_robot,
+        recoveryReach(half_length_m, half_width_m, rp, grid_.cellSize()));
+  }
   const RecoveryMotion m =
-      planRecovery(obstacles_.pointsInRobot(s.pose_world_robot), half_length_m, half_width_m,
-                   routeHeadingError(s.pose_world_robot), rp);
+      planRecovery(obstacles_.pointsInRobot(s.pose_world_robot), unobserved_robot, half_length_m,
+                   half_width_m, routeHeadingError(s.pose_world_robot), rp);
   // Watch the next stretch of time whether or not a manoeuvre was found.
   stall_anchor_s_ = now;
   if (!m.feasible()) return false;
