@@ -26,7 +26,7 @@ struct DeadEndRun {
 // The robot at the origin facing +x in a dead end (walls 5 cm beyond the navigator's shape on
 // each side, one ahead), the goal beyond the end wall; no camera frame, so the map has observed
 // nothing. The navigator cannot get past the walls: the robot stalls.
-DeadEndRun runDeadEnd(bool into_unobserved) {
+DeadEndRun runDeadEnd(bool into_unobserved, double end_wall_x_m = 0.5) {
   NavConfig config = loadNavConfig(kConfig + "/dune-kinect.ini", kConfig + "/dune-nav.ini");
   config.recovery.into_unobserved = into_unobserved;
   config.recovery.stall_time_s = 2.0;
@@ -37,13 +37,13 @@ DeadEndRun runDeadEnd(bool into_unobserved) {
   SimulatedDiffDrive base(Pose2D{0.0, 0.0, 0.0}, config.base);
   NavigationLoop loop(base, config, core::ObstacleDetector::Upd);
   std::vector<Eigen::Vector2d> walls = rectangleFence({-4.0, -4.0}, {4.0, 4.0}, 0.05);
-  for (double x = -0.2; x <= 0.6; x += 0.05) {
+  for (double x = -0.2; x <= end_wall_x_m + 0.1; x += 0.05) {
     walls.emplace_back(x, 0.33);
     walls.emplace_back(x, -0.33);
   }
-  for (double y = -0.33; y <= 0.33; y += 0.05) walls.emplace_back(0.5, y);
+  for (double y = -0.33; y <= 0.33; y += 0.05) walls.emplace_back(end_wall_x_m, y);
   loop.setFixedObstacles(walls);
-  loop.navigateTo({2.0, 0.0});
+  loop.navigateTo({end_wall_x_m + 1.5, 0.0});
   DeadEndRun run;
   for (int k = 0; k < 300; ++k) {
     mrpt::Clock::setSimulatedTime(mrpt::Clock::fromDouble(1.0e9 + base.timeS()));
@@ -66,6 +66,14 @@ TEST(NavRecoveryLoop, NoReverseOntoGroundTheMapHasNotSeen) {
   const DeadEndRun reckless = runDeadEnd(true);
   EXPECT_GE(reckless.recoveries, 1);
   EXPECT_LT(reckless.min_x_m, blind.min_x_m - 0.1);
+}
+
+// Ground the robot has driven on held it: a recovery may drive there again though the camera
+// never saw it. In a dead end 2 m long the robot drives in, stalls at the end and backs out
+// along its own tracks.
+TEST(NavRecoveryLoop, DrivenGroundCountsAsObserved) {
+  const DeadEndRun run = runDeadEnd(false, 2.0);
+  EXPECT_GE(run.recoveries, 1);
 }
 
 }  // namespace

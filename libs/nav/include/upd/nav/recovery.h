@@ -10,7 +10,8 @@
 // map's unknown cells are checked like obstacle points. A forward-looking camera may never have
 // seen the ground behind the robot, and in the field a ditch or a rock there is as likely as
 // anywhere else; a reverse onto it would be the one motion of the robot that no sensor checked.
-// Unknown cells under the robot's shape are left out: the robot stands on that ground.
+// Unknown cells under the robot's shape are left out: the robot stands on that ground (and the
+// loop leaves out every cell the shape has covered on the way: the robot stood there too).
 #pragma once
 
 #include "upd/nav/robot_base.h"
