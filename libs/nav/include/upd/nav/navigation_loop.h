@@ -21,9 +21,9 @@
 // route that the map closed, replaced by another open way, counts as progress (the new way may
 // be longer: round a wall whose gap is away from the goal). A robot that stays within
 // RecoveryParams::stall_radius_m for stall_time_s while navigating is stalled: the loop drives one
-// recovery manoeuvre (upd/nav/recovery.h) in place of the navigator, then restarts the navigator
-// on a fresh route. The
-// navigator is created by the first navigateTo(), so a loop that only maps never builds PTGs.
+// recovery manoeuvre (upd/nav/recovery.h) in place of the navigator, on ground the map has
+// observed or the navigator's polygon has covered, then restarts the navigator on a fresh route.
+// The navigator is created by the first navigateTo(), so a loop that only maps never builds PTGs.
 #pragma once
 
 #include "upd/maps/grid_fusion.h"
