@@ -1,5 +1,6 @@
 // Recovery of a stalled robot: the manoeuvre never brings an obstacle point into the robot's
-// shape (nor deeper into it), turns towards the route when there is room and reverses otherwise.
+// shape (nor deeper into it), nor ground the map has not observed, turns towards the route when
+// there is room and reverses otherwise.
 #include "upd/nav/recovery.h"
 
 #include <gtest/gtest.h>
@@ -120,6 +121,66 @@ TEST(RecoveryTest, ChosenManoeuvreNeverEntersAnObstacle) {
     EXPECT_GE(clearanceAlong(pts, m), -0.013) << "trial " << trial;
   }
   EXPECT_GT(feasible, 20);
+}
+
+// Centres of 10 cm cells over [x0, x1] x [y0, y1] (robot frame): ground the map has not observed.
+std::vector<Eigen::Vector2d> cellCentres(double x0, double x1, double y0, double y1) {
+  std::vector<Eigen::Vector2d> out;
+  for (double y = y0 + 0.05; y < y1; y += 0.1) {
+    for (double x = x0 + 0.05; x < x1; x += 0.1) out.emplace_back(x, y);
+  }
+  return out;
+}
+
+// The ground behind the robot has never been observed (a forward-looking camera): no reverse
+// drives onto it, however open it may be.
+TEST(RecoveryTest, NoReverseOntoUnobservedGround) {
+  const RecoveryParams p;  // into_unobserved = false
+  const auto behind = cellCentres(-1.5, -0.4, -1.5, 1.5);
+  EXPECT_FALSE(planRecovery({}, behind, kHalfLength, kHalfWidth, 0.1, p).feasible());
+  // Observed and free: the full reverse.
+  const RecoveryMotion open = planRecovery({}, {}, kHalfLength, kHalfWidth, 0.1, p);
+  ASSERT_TRUE(open.feasible());
+  EXPECT_LT(open.command.v_mps, 0.0);
+  EXPECT_NEAR(-open.command.v_mps * open.duration_s, p.reverse_distance_m, 1e-6);
+  // Unobserved from 0.2 m behind the shape on (cell centres 0.25 m behind): a shorter reverse.
+  const auto far_behind = cellCentres(-1.5, -0.6, -1.5, 1.5);
+  const RecoveryMotion shorter = planRecovery({}, far_behind, kHalfLength, kHalfWidth, 0.1, p);
+  ASSERT_TRUE(shorter.feasible());
+  EXPECT_LT(shorter.command.v_mps, 0.0);
+  EXPECT_GE(-shorter.command.v_mps * shorter.duration_s, p.min_reverse_m);
+  EXPECT_LT(-shorter.command.v_mps * shorter.duration_s, 0.3);
+  EXPECT_GE(clearanceAlong(far_behind, shorter), -1e-3);
+  // into_unobserved: unknown ground counts as free, the full reverse again.
+  RecoveryParams into = p;
+  into.into_unobserved = true;
+  const RecoveryMotion blind = planRecovery({}, behind, kHalfLength, kHalfWidth, 0.1, into);
+  ASSERT_TRUE(blind.feasible());
+  EXPECT_NEAR(-blind.command.v_mps * blind.duration_s, p.reverse_distance_m, 1e-6);
+}
+
+// A turn in place sweeps the corners over the ground around the robot: unobserved ground there
+// stops it too. The ground under the robot's shape is not in the way (the robot stands on it).
+TEST(RecoveryTest, TurnsStayOnObservedGround) {
+  const RecoveryParams p;
+  std::vector<Eigen::Vector2d> unknown_around;
+  for (const auto& c : cellCentres(-1.5, 1.5, -1.5, 1.5)) {
+    if (rectangleSignedDistance(c, kHalfLength, kHalfWidth) > 0.0) unknown_around.push_back(c);
+  }
+  EXPECT_FALSE(planRecovery({}, unknown_around, kHalfLength, kHalfWidth, 1.0, p).feasible());
+  const auto under = cellCentres(-0.4, 0.4, -0.2, 0.2);
+  const RecoveryMotion turn = planRecovery({}, under, kHalfLength, kHalfWidth, 1.0, p);
+  ASSERT_TRUE(turn.feasible());
+  EXPECT_DOUBLE_EQ(turn.command.v_mps, 0.0);
+  EXPECT_NEAR(turn.command.w_radps * turn.duration_s, 1.0, 1e-6);
+  RecoveryParams into = p;
+  into.into_unobserved = true;
+  EXPECT_TRUE(planRecovery({}, unknown_around, kHalfLength, kHalfWidth, 1.0, into).feasible());
+}
+
+TEST(RecoveryTest, ReachCoversTheShapeAndTheReverse) {
+  const RecoveryParams p;
+  EXPECT_NEAR(recoveryReach(0.3, 0.4, p, 0.1), 0.5 + p.reverse_distance_m + 0.1, 1e-12);
 }
 
 TEST(RecoveryTest, ParamsValidate) {

@@ -295,11 +295,66 @@ void NavigationLoop::restartStallWatch() {
   stall_anchor_s_ = base_.timeS();
 }
 
+namespace {
+
+std::uint64_t cellKey(std::int64_t i, std::int64_t j) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(i)) << 32) |
+         static_cast<std::uint32_t>(j);
+}
+
+// Centres of the cells within reach_m of the robot that the map has not observed and the robot
+// has not driven on (cells outside the grid's window included), in the robot frame.
+std::vector<Eigen::Vector2d> unknownCellsInRobot(const maps::TraversabilityGrid& grid,
+                                                 const std::unordered_set<std::uint64_t>& driven,
+                                                 const Pose2D& pose_world_robot, double reach_m) {
+  const double cs = grid.cellSize();
+  const Eigen::Vector2d centre(pose_world_robot.x_m, pose_world_robot.y_m);
+  // World cell indices: the centre of cell (i, j) is ((i + 0.5) cs, (j + 0.5) cs).
+  const auto index = [&](double v_m) { return static_cast<std::int64_t>(std::floor(v_m / cs)); };
+  std::vector<Eigen::Vector2d> out;
+  for (std::int64_t j = index(centre.y() - reach_m); j <= index(centre.y() + reach_m); ++j) {
+    for (std::int64_t i = index(centre.x() - reach_m); i <= index(centre.x() + reach_m); ++i) {
+      const Eigen::Vector2d c((static_cast<double>(i) + 0.5) * cs,
+                              (static_cast<double>(j) + 0.5) * cs);
+      if ((c - centre).norm() > reach_m || driven.count(cellKey(i, j)) > 0) continue;
+      const maps::GridCell* cell = grid.cellAt(c.x(), c.y());
+      if (cell != nullptr && maps::isKnown(*cell, grid.params())) continue;
+      out.push_back(worldToRobot(pose_world_robot, c));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void NavigationLoop::markDrivenCells(const Pose2D& pose, double half_length_m,
+                                     double half_width_m) {
+  const double cs = grid_.cellSize();
+  const double r = std::hypot(half_length_m, half_width_m);
+  const auto index = [&](double v_m) { return static_cast<std::int64_t>(std::floor(v_m / cs)); };
+  for (std::int64_t j = index(pose.y_m - r); j <= index(pose.y_m + r); ++j) {
+    for (std::int64_t i = index(pose.x_m - r); i <= index(pose.x_m + r); ++i) {
+      const Eigen::Vector2d c((static_cast<double>(i) + 0.5) * cs,
+                              (static_cast<double>(j) + 0.5) * cs);
+      if (rectangleSignedDistance(worldToRobot(pose, c), half_length_m, half_width_m) <= 0.0) {
+        driven_cells_.insert(cellKey(i, j));
+      }
+    }
+  }
+}
+
 bool NavigationLoop::startRecoveryIfStalled() {
   const RecoveryParams& rp = config_.recovery;
   if (!rp.enabled) return false;
   BaseState s;
   if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  // The navigator's own shape and obstacle points: the manoeuvre keeps the clearance it keeps.
+  double half_length_m = 0.0, half_width_m = 0.0;
+  for (const Eigen::Vector2d& v : navigator_->robotShape()) {
+    half_length_m = std::max(half_length_m, std::abs(v.x()));
+    half_width_m = std::max(half_width_m, std::abs(v.y()));
+  }
+  if (!rp.into_unobserved) markDrivenCells(s.pose_world_robot, half_length_m, half_width_m);
   const double now = base_.timeS();
   const Eigen::Vector2d xy(s.pose_world_robot.x_m, s.pose_world_robot.y_m);
   if ((xy - stall_anchor_xy_).norm() > rp.stall_radius_m) {
@@ -308,15 +363,15 @@ bool NavigationLoop::startRecoveryIfStalled() {
     return false;
   }
   if (now - stall_anchor_s_ < rp.stall_time_s || recoveries_ >= rp.max_recoveries) return false;
-  // The navigator's own shape and obstacle points: the manoeuvre keeps the clearance it keeps.
-  double half_length_m = 0.0, half_width_m = 0.0;
-  for (const Eigen::Vector2d& v : navigator_->robotShape()) {
-    half_length_m = std::max(half_length_m, std::abs(v.x()));
-    half_width_m = std::max(half_width_m, std::abs(v.y()));
+  std::vector<Eigen::Vector2d> unobserved_robot;
+  if (!rp.into_unobserved) {
+    unobserved_robot = unknownCellsInRobot(
+        grid_, driven_cells_, s.pose_world_robot,
+        recoveryReach(half_length_m, half_width_m, rp, grid_.cellSize()));
   }
   const RecoveryMotion m =
-      planRecovery(obstacles_.pointsInRobot(s.pose_world_robot), half_length_m, half_width_m,
-                   routeHeadingError(s.pose_world_robot), rp);
+      planRecovery(obstacles_.pointsInRobot(s.pose_world_robot), unobserved_robot, half_length_m,
+                   half_width_m, routeHeadingError(s.pose_world_robot), rp);
   // Watch the next stretch of time whether or not a manoeuvre was found.
   stall_anchor_s_ = now;
   if (!m.feasible()) return false;

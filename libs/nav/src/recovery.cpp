@@ -82,6 +82,24 @@ double feasibleDuration(const std::vector<Eigen::Vector2d>& points_robot, double
 RecoveryMotion planRecovery(const std::vector<Eigen::Vector2d>& points_robot, double half_length_m,
                             double half_width_m, double heading_error_rad,
                             const RecoveryParams& params) {
+  return planRecovery(points_robot, {}, half_length_m, half_width_m, heading_error_rad, params);
+}
+
+double recoveryReach(double half_length_m, double half_width_m, const RecoveryParams& params,
+                     double cell_size_m) {
+  return std::hypot(half_length_m, half_width_m) + params.reverse_distance_m + cell_size_m;
+}
+
+RecoveryMotion planRecovery(const std::vector<Eigen::Vector2d>& obstacles_robot,
+                            const std::vector<Eigen::Vector2d>& unobserved_robot,
+                            double half_length_m, double half_width_m, double heading_error_rad,
+                            const RecoveryParams& params) {
+  std::vector<Eigen::Vector2d> points_robot = obstacles_robot;
+  if (!params.into_unobserved) {
+    for (const Eigen::Vector2d& p : unobserved_robot) {
+      if (rectangleSignedDistance(p, half_length_m, half_width_m) > 0.0) points_robot.push_back(p);
+    }
+  }
   const double turn_sign = heading_error_rad >= 0 ? 1.0 : -1.0;
   const double wanted_turn = std::min(std::abs(heading_error_rad), params.max_turn_rad);
   if (wanted_turn >= params.min_turn_rad) {

@@ -21,9 +21,9 @@
 // route that the map closed, replaced by another open way, counts as progress (the new way may
 // be longer: round a wall whose gap is away from the goal). A robot that stays within
 // RecoveryParams::stall_radius_m for stall_time_s while navigating is stalled: the loop drives one
-// recovery manoeuvre (upd/nav/recovery.h) in place of the navigator, then restarts the navigator
-// on a fresh route. The
-// navigator is created by the first navigateTo(), so a loop that only maps never builds PTGs.
+// recovery manoeuvre (upd/nav/recovery.h) in place of the navigator, on ground the map has
+// observed or the navigator's polygon has covered, then restarts the navigator on a fresh route.
+// The navigator is created by the first navigateTo(), so a loop that only maps never builds PTGs.
 #pragma once
 
 #include "upd/maps/grid_fusion.h"
@@ -38,9 +38,11 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 namespace upd::nav {
@@ -128,12 +130,17 @@ class NavigationLoop {
   bool recovering_ = false;
   RecoveryMotion recovery_;
   double recovery_end_s_ = 0.0;
+  /// Grid cells (world indices, packed) whose centres the navigator's polygon has covered: the
+  /// robot stood there, so a recovery may drive there even when the camera never saw them.
+  std::unordered_set<std::uint64_t> driven_cells_;
 
   void replan();
   /// The stall watch starts again from where the robot stands now.
   void restartStallWatch();
   /// True when the robot has stalled and a recovery manoeuvre was started.
   bool startRecoveryIfStalled();
+  /// Adds the cells under the polygon (half sizes) at the pose to driven_cells_.
+  void markDrivenCells(const Pose2D& pose_world_robot, double half_length_m, double half_width_m);
   /// The route's heading about 1 m ahead of the robot, in the robot frame [rad].
   double routeHeadingError(const Pose2D& pose_world_robot) const;
   void labelFrame(const core::PointCloud& cloud_world);

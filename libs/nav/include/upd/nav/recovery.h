@@ -6,6 +6,12 @@
 // then drives one short manoeuvre itself, checked against the same obstacle points and robot
 // shape the navigator uses: a turn in place towards the route, else a reverse (arcing towards the
 // route, straight, or arcing away), after which the navigator starts again on the route.
+// Turns and reverses alike stay on observed ground: unless into_unobserved, the centres of the
+// map's unknown cells are checked like obstacle points. A forward-looking camera may never have
+// seen the ground behind the robot, and in the field a ditch or a rock there is as likely as
+// anywhere else; a reverse onto it would be the one motion of the robot that no sensor checked.
+// Unknown cells under the robot's shape are left out: the robot stands on that ground (and the
+// loop leaves out every cell the shape has covered on the way: the robot stood there too).
 #pragma once
 
 #include "upd/nav/robot_base.h"
@@ -29,6 +35,7 @@ struct RecoveryParams {
   double reverse_turn_radps = 0.35;  ///< turn rate of the reversing arcs [rad/s]
   double reverse_distance_m = 0.4;   ///< reverse at most this far [m]
   double min_reverse_m = 0.1;        ///< a shorter feasible reverse is not worth it [m]
+  bool into_unobserved = false;      ///< may drive onto ground the map has not observed
 
   void validate() const;
   template <class V>
@@ -44,6 +51,9 @@ struct RecoveryParams {
     v("reverse_turn_radps", reverse_turn_radps, "turn rate of the reversing arcs [rad/s]");
     v("reverse_distance_m", reverse_distance_m, "a reverse drives at most this far [m]");
     v("min_reverse_m", min_reverse_m, "a reverse shorter than this is not tried [m]");
+    v("into_unobserved", into_unobserved,
+      "a manoeuvre may drive onto ground the map has not observed (false: unknown cells count "
+      "as obstacles)");
   }
 };
 
@@ -71,8 +81,21 @@ double feasibleDuration(const std::vector<Eigen::Vector2d>& points_robot, double
 /// route heading heading_error_rad away (robot frame, counter-clockwise positive): a turn in
 /// place towards it when at least min_turn_rad of it is feasible, else the longest of the
 /// reversing arcs (towards the route, straight, away) when at least min_reverse_m, else none.
+/// unobserved_robot: centres of the map's unknown cells near the robot (robot frame); unless
+/// params.into_unobserved they are obstacle points too, except those inside the shape at the
+/// start (the robot stands on that ground).
+RecoveryMotion planRecovery(const std::vector<Eigen::Vector2d>& points_robot,
+                            const std::vector<Eigen::Vector2d>& unobserved_robot,
+                            double half_length_m, double half_width_m, double heading_error_rad,
+                            const RecoveryParams& params);
+/// The same with no unknown ground around the robot.
 RecoveryMotion planRecovery(const std::vector<Eigen::Vector2d>& points_robot, double half_length_m,
                             double half_width_m, double heading_error_rad,
                             const RecoveryParams& params);
+
+/// How far from the robot's centre an unknown cell can matter to a manoeuvre: the shape's
+/// half-diagonal plus the reverse distance plus cell_size_m [m].
+double recoveryReach(double half_length_m, double half_width_m, const RecoveryParams& params,
+                     double cell_size_m);
 
 }  // namespace upd::nav
