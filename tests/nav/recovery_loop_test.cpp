@@ -25,10 +25,13 @@ struct DeadEndRun {
 
 // The robot at the origin facing +x in a dead end (walls 5 cm beyond the navigator's shape on
 // each side, one ahead), the goal beyond the end wall; no camera frame, so the map has observed
-// nothing. The navigator cannot get past the walls: the robot stalls.
-DeadEndRun runDeadEnd(bool into_unobserved, double end_wall_x_m = 0.5) {
+// nothing. The navigator cannot get past the walls: the robot stalls. unobserved_behind_m: the
+// obstacle source's unobserved ground behind the robot (0: none, MRPT's backward PTG free).
+DeadEndRun runDeadEnd(bool into_unobserved, double end_wall_x_m = 0.5,
+                      double unobserved_behind_m = 0.0) {
   NavConfig config = loadNavConfig(kConfig + "/dune-kinect.ini", kConfig + "/dune-nav.ini");
   config.recovery.into_unobserved = into_unobserved;
+  config.obstacles.unobserved_behind_m = unobserved_behind_m;
   config.recovery.stall_time_s = 2.0;
   config.navigator.no_progress_timeout_s = 20.0;
   const mrpt::Clock::Source previous = mrpt::Clock::getActiveClock();
@@ -70,10 +73,17 @@ TEST(NavRecoveryLoop, NoReverseOntoGroundTheMapHasNotSeen) {
 
 // Ground the robot has driven on held it: a recovery may drive there again though the camera
 // never saw it. In a dead end 2 m long the robot drives in, stalls at the end and backs out
-// along its own tracks.
+// along its own tracks, with or without the unobserved ground behind it as obstacles.
 TEST(NavRecoveryLoop, DrivenGroundCountsAsObserved) {
-  const DeadEndRun run = runDeadEnd(false, 2.0);
-  EXPECT_GE(run.recoveries, 1);
+  EXPECT_GE(runDeadEnd(false, 2.0).recoveries, 1);
+  EXPECT_GE(runDeadEnd(false, 2.0, 1.0).recoveries, 1);
+}
+
+// MRPT's own backward PTG: in the short dead end it backs the robot out over ground no frame
+// observed; with ObstacleParams::unobserved_behind_m that ground is an obstacle and it does not.
+TEST(NavRecoveryLoop, NavigatorDoesNotReverseOntoUnobservedGroundBehind) {
+  EXPECT_LT(runDeadEnd(false, 0.5, 0.0).min_x_m, -0.3);
+  EXPECT_GT(runDeadEnd(false, 0.5, 1.0).min_x_m, -0.05);
 }
 
 }  // namespace

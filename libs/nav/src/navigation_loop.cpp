@@ -343,18 +343,36 @@ void NavigationLoop::markDrivenCells(const Pose2D& pose, double half_length_m,
   }
 }
 
+Eigen::Vector2d NavigationLoop::polygonHalfSizes() const {
+  Eigen::Vector2d half = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector2d& v : navigator_->robotShape()) half = half.cwiseMax(v.cwiseAbs());
+  return half;
+}
+
+void NavigationLoop::updateDrivenAndUnobserved() {
+  const double behind_m = config_.obstacles.unobserved_behind_m;
+  if (behind_m <= 0.0 && (!config_.recovery.enabled || config_.recovery.into_unobserved)) return;
+  BaseState s;
+  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  const Eigen::Vector2d half = polygonHalfSizes();
+  markDrivenCells(s.pose_world_robot, half.x(), half.y());
+  if (behind_m <= 0.0) return;
+  std::vector<Eigen::Vector2d> behind_world;
+  for (const Eigen::Vector2d& p : unknownCellsInRobot(grid_, driven_cells_, s.pose_world_robot,
+                                                      half.x() + behind_m)) {
+    if (p.x() < -half.x() - grid_.cellSize()) behind_world.push_back(robotToWorld(s.pose_world_robot, p));
+  }
+  obstacles_.setUnobservedBehind(std::move(behind_world));
+}
+
 bool NavigationLoop::startRecoveryIfStalled() {
   const RecoveryParams& rp = config_.recovery;
   if (!rp.enabled) return false;
   BaseState s;
   if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
   // The navigator's own shape and obstacle points: the manoeuvre keeps the clearance it keeps.
-  double half_length_m = 0.0, half_width_m = 0.0;
-  for (const Eigen::Vector2d& v : navigator_->robotShape()) {
-    half_length_m = std::max(half_length_m, std::abs(v.x()));
-    half_width_m = std::max(half_width_m, std::abs(v.y()));
-  }
-  if (!rp.into_unobserved) markDrivenCells(s.pose_world_robot, half_length_m, half_width_m);
+  const Eigen::Vector2d half = polygonHalfSizes();
+  const double half_length_m = half.x(), half_width_m = half.y();
   const double now = base_.timeS();
   const Eigen::Vector2d xy(s.pose_world_robot.x_m, s.pose_world_robot.y_m);
   if ((xy - stall_anchor_xy_).norm() > rp.stall_radius_m) {
@@ -407,6 +425,7 @@ NavState NavigationLoop::step() {
       base_.timeS() - last_plan_s_ >= config_.route.replan_period_s) {
     replan();
   }
+  updateDrivenAndUnobserved();
   return navigator_->step();
 }
 

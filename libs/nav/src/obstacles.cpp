@@ -20,6 +20,8 @@ void ObstacleParams::validate() const {
                      "must be > 0");
   core::requireParam(std::isfinite(point_height_m), "ObstacleParams", "point_height_m", point_height_m,
                "must be finite");
+  core::requireParam(std::isfinite(unobserved_behind_m) && unobserved_behind_m >= 0,
+                     "ObstacleParams", "unobserved_behind_m", unobserved_behind_m, "must be >= 0");
 }
 
 Eigen::Vector2d worldToRobot(const Pose2D& pose_world_robot, const Eigen::Vector2d& p_world) {
@@ -66,6 +68,10 @@ void ObstacleSource::setFixedObstacles(std::vector<Eigen::Vector2d> points_world
   fixed_world_ = std::move(points_world);
 }
 
+void ObstacleSource::setUnobservedBehind(std::vector<Eigen::Vector2d> points_world) {
+  unobserved_world_ = std::move(points_world);
+}
+
 namespace {
 
 std::uint64_t squareKey(std::int64_t ix, std::int64_t iy) {
@@ -100,6 +106,7 @@ std::vector<Eigen::Vector2d> ObstacleSource::pointsInRobot(const Pose2D& pose_wo
     for (const auto& p : frame_world_) add(p);
   }
   for (const auto& p : fixed_world_) add(p);
+  for (const auto& p : unobserved_world_) add(p);
   return out;
 }
 

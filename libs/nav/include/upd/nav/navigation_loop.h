@@ -141,6 +141,11 @@ class NavigationLoop {
   bool startRecoveryIfStalled();
   /// Adds the cells under the polygon (half sizes) at the pose to driven_cells_.
   void markDrivenCells(const Pose2D& pose_world_robot, double half_length_m, double half_width_m);
+  /// Half length and half width of the navigator's polygon [m].
+  Eigen::Vector2d polygonHalfSizes() const;
+  /// Marks the ground under the robot as driven and hands the obstacle source the unobserved
+  /// ground behind it (ObstacleParams::unobserved_behind_m).
+  void updateDrivenAndUnobserved();
   /// The route's heading about 1 m ahead of the robot, in the robot frame [rad].
   double routeHeadingError(const Pose2D& pose_world_robot) const;
   void labelFrame(const core::PointCloud& cloud_world);

@@ -16,7 +16,14 @@
 //  - the current frame: every NonTraversable point of the latest scored frame within range_m,
 //    so an obstacle acts at once even before the map has fused it (or when the map disagrees);
 //  - fixed obstacles: points the caller knows a priori, such as the fence around the mission
-//    area (the simulated worlds are bounded; the robot must not leave them).
+//    area (the simulated worlds are bounded; the robot must not leave them);
+//  - unobserved ground behind the robot (unobserved_behind_m > 0): the centres of the map's
+//    cells more than a cell behind the polygon's rear edge, within unobserved_behind_m of it,
+//    that no frame has observed and the robot has not driven on (set by the loop every step).
+//    MRPT's navigator has a backward PTG and the camera looks forward: without these its
+//    reverses cross ground no sensor checked. (Nearer cells would put obstacle points in the
+//    PTGs' first collision-grid cells and stop every motion.) Off by default: on the generated
+//    worlds it costs goals (docs/NAVIGATION.md, "Driving a real robot").
 // The other sources' points are thinned to one per decimation_m x decimation_m cell (in the
 // world frame, so the result does not flicker as the robot turns). Every point carries
 // z = point_height_m, which must fall in the navigator's [min_obstacles_height,
@@ -46,6 +53,7 @@ struct ObstacleParams {
   bool use_current_frame = true;  ///< take NonTraversable points of the latest frame
   double decimation_m = 0.05;     ///< at most one point per square of this side [m]
   double point_height_m = 0.2;    ///< z of every obstacle point in the robot frame [m]
+  double unobserved_behind_m = 0.0;  ///< unobserved ground this close behind the robot is an obstacle [m]
 
   void validate() const;
   template <class V>
@@ -63,6 +71,10 @@ struct ObstacleParams {
     v("decimation_m", decimation_m, "keep at most one obstacle point per square of this side [m]");
     v("point_height_m", point_height_m,
       "z of the obstacle points (inside the navigator's obstacle height band) [m]");
+    v("unobserved_behind_m", unobserved_behind_m,
+      "map cells behind the robot's rear edge within this distance that no frame observed and the "
+      "robot did not drive on are obstacles (the navigator may not reverse onto unseen ground); "
+      "0: none [m]");
   }
 };
 
@@ -88,6 +100,8 @@ class ObstacleSource {
   void setFrameObstacles(std::vector<Eigen::Vector2d> points_world);
   /// Replaces the fixed obstacles (world frame, xy).
   void setFixedObstacles(std::vector<Eigen::Vector2d> points_world);
+  /// Replaces the unobserved ground behind the robot (world frame, xy).
+  void setUnobservedBehind(std::vector<Eigen::Vector2d> points_world);
 
   /// Every source within range_m of the robot, thinned, in the robot frame (x forward, y left).
   std::vector<Eigen::Vector2d> pointsInRobot(const Pose2D& pose_world_robot) const;
@@ -101,6 +115,7 @@ class ObstacleSource {
   const maps::TraversabilityGrid* grid_ = nullptr;
   std::vector<Eigen::Vector2d> frame_world_;
   std::vector<Eigen::Vector2d> fixed_world_;
+  std::vector<Eigen::Vector2d> unobserved_world_;
 };
 
 }  // namespace upd::nav
