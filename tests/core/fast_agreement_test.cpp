@@ -65,6 +65,33 @@ TEST(FastNormals, GridEqualsTheExactPath) {
   }
 }
 
+// The grid normals find a point's 27 cells by a dense table over the cells' box, or by a hash
+// where that box is mostly empty: a far lone point switches to the hash and changes no other
+// point's normal, bit for bit (the same cells, candidates and sums).
+TEST(FastNormals, GridCellTableAndHashGiveTheSameNormals) {
+  for (const NormalWeighting weighting : {NormalWeighting::Uniform, NormalWeighting::Gaussian}) {
+    PointCloud c = test::makeRandomCloud(3000, 11, 1.f);
+    c.x[17] = std::numeric_limits<float>::quiet_NaN();
+    c.sensor_origin = Eigen::Vector3f(0, 0, 3);
+    NormalParams p;
+    p.radius_m = 0.12;
+    p.weighting = weighting;
+    const Normals dense = computeNormalsGrid(c, p, Eigen::Vector3f::UnitZ());
+    PointCloud far = c;
+    far.push_back(900.f, -700.f, 800.f);
+    const Normals hashed = computeNormalsGrid(far, p, Eigen::Vector3f::UnitZ());
+    EXPECT_EQ(hashed.invalid, dense.invalid + 1);
+    EXPECT_FALSE(hashed.isValid(c.size()));
+    EXPECT_GT(c.size() - dense.invalid, 2500u);
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      ASSERT_EQ(hashed.isValid(i), dense.isValid(i)) << "point " << i;
+      if (!dense.isValid(i)) continue;
+      ASSERT_EQ(hashed.normal(i), dense.normal(i)) << "point " << i;
+      ASSERT_EQ(hashed.curvature[i], dense.curvature[i]) << "point " << i;
+    }
+  }
+}
+
 TEST(FastNormals, OrganizedScansFindTheExactNeighbourhoods) {
   const RenderedScene rs = kinectFrame();
   const PointCloud& c = rs.scene.cloud;

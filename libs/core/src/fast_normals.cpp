@@ -138,32 +138,102 @@ using detail::Moments;
 
 // The finite points binned into cells of edge radius_m (the neighbours of a point lie in the 27
 // cells around its own), grouped by cell and kept relative to the first finite point, as
-// coordinate arrays.
+// coordinate arrays. The cells are numbered in order of first sight and found by a dense table
+// of ids over their box widened by one cell (one load per neighbour cell at an offset fixed per
+// grid); where that box would hold more than kDenseCellsPerPoint cells per point (far lone
+// points) by the hash grid, with the same ids.
 struct RadiusGrid {
-  detail::CellGrid grid;
-  detail::CellLists points;   // cloud indices by cell
+  static constexpr std::size_t kDenseCellsPerPoint = 32;
+  detail::CellGrid grid;       // ids by hash, where the dense table is off
+  std::vector<std::int32_t> xyz;  // 3 per cell, in id order
+  std::size_t n_cells = 0;
+  bool has_dense = false;
+  std::vector<std::uint32_t> dense;  // cell ids over the widened box, x fastest
+  std::int64_t lo[3] = {0, 0, 0}, sy = 0, sz = 0;
+  std::array<std::int64_t, 27> dense_offsets{};  // the 27 cells around one, d = dx + 3 dy + 9 dz
+  detail::CellLists points;    // cloud indices by cell
   std::vector<float> x, y, z;  // by cell: relative to the first finite point (then kFar slack)
+
+  std::size_t denseIndex(const std::int32_t* c) const {
+    return static_cast<std::size_t>((c[0] - lo[0]) + (c[1] - lo[1]) * sy + (c[2] - lo[2]) * sz);
+  }
 };
+
+// The dense table over the box [lo, hi] widened by one cell, or false where it would hold more
+// than kDenseCellsPerPoint cells per point.
+bool makeDense(RadiusGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&hi)[3],
+               std::size_t n_points) {
+  std::int64_t dim[3];
+  double volume = 1;
+  for (int a = 0; a < 3; ++a) {
+    dim[a] = std::int64_t{hi[a]} - lo[a] + 3;
+    volume *= static_cast<double>(dim[a]);
+  }
+  if (volume > static_cast<double>(RadiusGrid::kDenseCellsPerPoint * n_points + 4096)) {
+    return false;
+  }
+  g.dense.assign(static_cast<std::size_t>(volume), kNoIndex);
+  for (int a = 0; a < 3; ++a) g.lo[a] = std::int64_t{lo[a]} - 1;
+  g.sy = dim[0], g.sz = dim[0] * dim[1];
+  for (int d = 0; d < 27; ++d) {
+    g.dense_offsets[static_cast<std::size_t>(d)] =
+        (d % 3 - 1) + ((d / 3) % 3 - 1) * g.sy + (d / 9 - 1) * g.sz;
+  }
+  return true;
+}
 
 void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, RadiusGrid& g) {
   const std::size_t N = cloud.size();
   const Eigen::Vector3d ref = cloud.point(first).cast<double>();
   const double inv = 1.0 / radius_m;
-  g.grid = detail::CellGrid(N / 8 + 64);
+  // Every finite point's cell and the cells' box.
+  std::vector<std::int32_t> cell_xyz(3 * N);
   std::vector<std::uint32_t> cell_of(N, kNoIndex);
-  const auto coords = [&](std::size_t i, std::int64_t(&c)[3]) {
-    if (!cloud.isFinite(i)) return false;
-    const Eigen::Vector3d p = (cloud.point(i).cast<double>() - ref) * inv;
-    c[0] = detail::floorToInt(p.x()), c[1] = detail::floorToInt(p.y());
-    c[2] = detail::floorToInt(p.z());
-    return true;
-  };
-  if (!detail::binCells(first, N, coords, g.grid, cell_of.data())) {
-    throw std::invalid_argument("NormalParams.radius_m = " + std::to_string(radius_m) +
-                                ": the cloud spans more than 2^20 radii along an axis");
+  std::int32_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::numeric_limits<std::int32_t>::max();
+    hi[a] = std::numeric_limits<std::int32_t>::min();
   }
+  std::size_t n_finite = 0;
+  for (std::size_t i = first; i < N; ++i) {
+    if (!cloud.isFinite(i)) continue;
+    const Eigen::Vector3d p = (cloud.point(i).cast<double>() - ref) * inv;
+    const std::int64_t c[3] = {detail::floorToInt(p.x()), detail::floorToInt(p.y()),
+                               detail::floorToInt(p.z())};
+    if (!detail::keyFits(c[0], c[1], c[2])) {
+      throw std::invalid_argument("NormalParams.radius_m = " + std::to_string(radius_m) +
+                                  ": the cloud spans more than 2^20 radii along an axis");
+    }
+    std::int32_t* o = &cell_xyz[3 * i];
+    for (int a = 0; a < 3; ++a) {
+      o[a] = static_cast<std::int32_t>(c[a]);
+      lo[a] = std::min(lo[a], o[a]), hi[a] = std::max(hi[a], o[a]);
+    }
+    cell_of[i] = 0;  // (finite: numbered below)
+    ++n_finite;
+  }
+  g.xyz.resize(3 * n_finite);
+  g.n_cells = 0;
+  g.has_dense = makeDense(g, lo, hi, n_finite);
+  if (!g.has_dense) g.grid = detail::CellGrid(N / 8 + 64);
+  for (std::size_t i = first; i < N; ++i) {
+    if (cell_of[i] == kNoIndex) continue;
+    const std::int32_t* c = &cell_xyz[3 * i];
+    if (g.has_dense) {
+      std::uint32_t& id = g.dense[g.denseIndex(c)];
+      if (id == kNoIndex) {
+        id = static_cast<std::uint32_t>(g.n_cells);
+        std::memcpy(&g.xyz[3 * g.n_cells++], c, 3 * sizeof(std::int32_t));
+      }
+      cell_of[i] = id;
+    } else {
+      cell_of[i] = g.grid.insert(c[0], c[1], c[2]);
+    }
+  }
+  if (!g.has_dense) g.xyz = g.grid.coords(), g.n_cells = g.grid.size();
+  g.xyz.resize(3 * g.n_cells);
   detail::listByCell(
-      N, g.grid.size(), [&](std::size_t i) { return cell_of[i]; }, g.points);
+      N, g.n_cells, [&](std::size_t i) { return cell_of[i]; }, g.points);
   const std::size_t n = g.points.order.size();
   // (Slack for gatherAround's copies, 8 at a time; the candidate rows have kScanLanes = 8 more.)
   g.x.assign(n + 8, kFar), g.y.assign(n + 8, kFar), g.z.assign(n + 8, kFar);
@@ -174,16 +244,18 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   }
 }
 
-// The candidates of the points of cell c (the points of the 27 cells around it), as coordinate
-// rows for gatedMoments, padded with kFar; returns their number. The rows are resized, never
-// shrunk (no allocation once they have the room).
-std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<float>& cx,
-                            std::vector<float>& cy, std::vector<float>& cz) {
-  std::array<std::uint32_t, 27> around{};
+// The ids of the occupied cells among the 27 around cell c, in the order d = dx + 3 dy + 9 dz.
+int cellsAround(const RadiusGrid& g, std::size_t c, std::array<std::uint32_t, 27>& around) {
   int n_around = 0;
-  std::size_t total = 0;
-  const std::int32_t* xyz = g.grid.xyz(c);
-  const std::vector<std::uint32_t>& start = g.points.start;
+  const std::int32_t* xyz = &g.xyz[3 * c];
+  if (g.has_dense) {
+    const std::uint32_t* at = g.dense.data() + g.denseIndex(xyz);
+    for (int d = 0; d < 27; ++d) {
+      const std::uint32_t id = at[g.dense_offsets[static_cast<std::size_t>(d)]];
+      if (id != kNoIndex) around[static_cast<std::size_t>(n_around++)] = id;
+    }
+    return n_around;
+  }
   // (Away from the keys' bounds, as nearly always, the neighbours' keys are the cell's plus
   // an offset, with no range test.)
   static const std::array<std::uint64_t, 27> offsets = [] {
@@ -195,11 +267,26 @@ std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<floa
   const std::uint64_t key = inner ? detail::packKey(xyz[0], xyz[1], xyz[2]) : 0;
   for (int d = 0; d < 27; ++d) {
     const std::uint32_t id =
-        inner ? g.grid.findKey(key + offsets[d])
+        inner ? g.grid.findKey(key + offsets[static_cast<std::size_t>(d)])
               : g.grid.find(xyz[0] + d % 3 - 1, xyz[1] + (d / 3) % 3 - 1, xyz[2] + d / 9 - 1);
-    if (id == kNoIndex) continue;
-    around[n_around++] = id;
-    total += start[id + 1] - start[id];
+    if (id != kNoIndex) around[static_cast<std::size_t>(n_around++)] = id;
+  }
+  return n_around;
+}
+
+// The candidates of the points of cell c (the points of the 27 cells around it), as coordinate
+// rows for gatedMoments, padded with kFar; returns their number. The rows are resized, never
+// shrunk (no allocation once they have the room).
+std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<float>& cx,
+                            std::vector<float>& cy, std::vector<float>& cz) {
+  std::array<std::uint32_t, 27> around{};
+  const int n_around = cellsAround(g, c, around);
+  const std::uint32_t* start = g.points.start.data();
+  std::array<std::uint32_t, 27> begin{}, end{};
+  std::size_t total = 0;
+  for (int a = 0; a < n_around; ++a) {
+    begin[a] = start[around[a]], end[a] = start[around[a] + 1];
+    total += end[a] - begin[a];
   }
   if (cx.size() < total + kScanLanes) {
     cx.resize(total + kScanLanes), cy.resize(total + kScanLanes), cz.resize(total + kScanLanes);
@@ -207,9 +294,9 @@ std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<floa
   float *ox = cx.data(), *oy = cy.data(), *oz = cz.data();
   std::size_t m = 0;
   for (int a = 0; a < n_around; ++a) {
-    const std::uint32_t b = start[around[a]], e = start[around[a] + 1];
-    detail::copyRunByEights(g.x.data(), g.y.data(), g.z.data(), b, e, ox + m, oy + m, oz + m);
-    m += e - b;
+    detail::copyRunByEights(g.x.data(), g.y.data(), g.z.data(), begin[a], end[a], ox + m,
+                            oy + m, oz + m);
+    m += end[a] - begin[a];
   }
   for (int l = 0; l < kScanLanes; ++l) ox[m + l] = oy[m + l] = oz[m + l] = kFar;
   return static_cast<std::ptrdiff_t>(total);
@@ -296,7 +383,7 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
   const float inv_2s2 = 1.f / (2.f * sigma * sigma);
   std::size_t invalid = N - g.points.order.size();
   const NormalOrienter orient(cloud.sensor_origin, up, params.vertical_band_rad);
-  const auto n_cells = static_cast<std::ptrdiff_t>(g.grid.size());
+  const auto n_cells = static_cast<std::ptrdiff_t>(g.n_cells);
 #pragma omp parallel reduction(+ : invalid)
   {
     std::vector<float> cx, cy, cz;

@@ -80,22 +80,33 @@ UPD_VECTOR_CLONES
           szz += cz * qz;
     }
   }
-  // The sum of the lanes, (v0 + v4 + v1 + v5) + (v2 + v6 + v3 + v7) in that grouping, by vector
-  // adds and one shuffle (a loop over the lanes compiled to a scalar add per lane).
-  const auto total = [](const LaneF& v) {
-    static_assert(kScanLanes == 8, "the reduction adds two halves of 4 lanes");
+  // The sum of each accumulator's lanes, (v0 + v4 + v1 + v5) + (v2 + v6 + v3 + v7) in that
+  // grouping, four accumulators at a time: the halves added, then two rounds of pairwise sums
+  // across accumulators (a lane-by-lane loop compiled to a scalar add per lane; one shuffle
+  // per accumulator cost ~90 instructions a call).
+  static_assert(kScanLanes == 8, "the reduction adds two halves of 4 lanes");
+  const auto half = [](const LaneF& v) {
     LaneQ lo, hi;
     std::memcpy(&lo, &v, sizeof lo);
     std::memcpy(&hi, reinterpret_cast<const char*>(&v) + sizeof lo, sizeof hi);
-    const LaneQ s = lo + hi;  // s_l = v_l + v_(l+4)
-    // GCC (12 on) and clang both have __builtin_shufflevector (GCC's __builtin_shuffle is not clang's).
-    const LaneQ p = s + __builtin_shufflevector(s, s, 1, 0, 3, 2);  // s0 + s1, ., s2 + s3, .
-    return static_cast<double>(p[0] + p[2]);
+    return lo + hi;  // s_l = v_l + v_(l+4)
   };
+  // (a0 + a1, a2 + a3, b0 + b1, b2 + b3). GCC (12 on) and clang both have
+  // __builtin_shufflevector (GCC's __builtin_shuffle is not clang's).
+  const auto pairs = [](const LaneQ& a, const LaneQ& b) {
+    return __builtin_shufflevector(a, b, 0, 2, 4, 6) + __builtin_shufflevector(a, b, 1, 3, 5, 7);
+  };
+  const auto four = [&](const LaneF& a, const LaneF& b, const LaneF& c, const LaneF& d) {
+    return pairs(pairs(half(a), half(b)), pairs(half(c), half(d)));
+  };
+  const LaneQ t0 = four(n, sx, sy, sz), t1 = four(sxx, sxy, sxz, syy);
+  const LaneQ t2 = pairs(pairs(half(syz), half(szz)), LaneQ{});
   Moments m;
-  m.n = total(n), m.x = total(sx), m.y = total(sy), m.z = total(sz);
-  m.xx = total(sxx), m.xy = total(sxy), m.xz = total(sxz);
-  m.yy = total(syy), m.yz = total(syz), m.zz = total(szz);
+  m.n = static_cast<double>(t0[0]), m.x = static_cast<double>(t0[1]);
+  m.y = static_cast<double>(t0[2]), m.z = static_cast<double>(t0[3]);
+  m.xx = static_cast<double>(t1[0]), m.xy = static_cast<double>(t1[1]);
+  m.xz = static_cast<double>(t1[2]), m.yy = static_cast<double>(t1[3]);
+  m.yz = static_cast<double>(t2[0]), m.zz = static_cast<double>(t2[1]);
   return m;
 }
 
