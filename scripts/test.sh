@@ -21,11 +21,14 @@ if [ "${CI:-}" = true ] || [ "${UPD_RELIABILITY:-0}" = 1 ]; then
     "$UPD_ROOT/scripts/fuzz.sh" "${UPD_FUZZ_SECONDS:-90}" pcd ply xyz kitti_bin pipeline ini rawlog
   step_done "fuzzing"
   # Every test program under ASan + UBSan + LeakSanitizer (apps/upd built instrumented), the
-  # navigation scenarios shortened (NavScenarioStart.*) and four long runs of `upd` left out:
-  # the 300 m and 10,000-frame playbacks, the ground-truth playback and the map merge (minutes
-  # each instrumented; by hand: scripts/sanitize.sh; docs/RELIABILITY.md, "In CI").
+  # navigation scenarios shortened (NavScenarioStart.*) and nine long runs left out (a minute
+  # or more each instrumented, on code the shorter cases run): the 300 m and 10,000-frame
+  # playbacks, the ground-truth playback, the map merge, the full-resolution real frame
+  # against the exact path, and the core's cases at d_m 1 m (the ramp's roughness index, the
+  # corner band's growth, the corner at 1 m). By hand: scripts/sanitize.sh
+  # (docs/RELIABILITY.md, "In CI").
   UPD_SANITIZE_SCOPE="core sim io maps mrpt_bridge nav gdal learn ros freenect apps" \
-  UPD_SANITIZE_EXCLUDE="^LongRun\.|^PlaybackSoak\.|^Playback\.SimulatedRunAgreesWithGroundTruth$|^MapCommands\.MergeCropAndInfoOfSimulatedRuns$" \
+  UPD_SANITIZE_EXCLUDE="^LongRun\.|^PlaybackSoak\.|^Playback\.SimulatedRunAgreesWithGroundTruth$|^MapCommands\.MergeCropAndInfoOfSimulatedRuns$|^RealData\.FullResolutionFrameAgreesWithTheExactPath$|^Ramp\.RoughnessIndexFlagsTheSmoothRampBodyButNotTheGround$|^CornerBand\.WidensWithTheSearchRadius$|^SearchRadii/Corner\..*/1$" \
     "$UPD_ROOT/scripts/sanitize.sh"
   step_done "the sanitizer build and suite"
 fi
