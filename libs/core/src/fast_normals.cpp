@@ -140,44 +140,28 @@ using detail::Moments;
 // cells around its own), grouped by cell and kept relative to the first finite point, as
 // coordinate arrays. The cells are numbered in order of first sight and found by a dense table
 // of ids over their box widened by one cell (one load per neighbour cell at an offset fixed per
-// grid); where that box would hold more than kDenseCellsPerPoint cells per point (far lone
-// points) by the hash grid, with the same ids.
+// grid); where the table declines the box (far lone points) by the hash grid, with the same
+// ids.
 struct RadiusGrid {
-  static constexpr std::size_t kDenseCellsPerPoint = 32;
   detail::CellGrid grid;       // ids by hash, where the dense table is off
   std::vector<std::int32_t> xyz;  // 3 per cell, in id order
   std::size_t n_cells = 0;
   bool has_dense = false;
-  std::vector<std::uint32_t> dense;  // cell ids over the widened box, x fastest
-  std::int64_t lo[3] = {0, 0, 0}, sy = 0, sz = 0;
+  detail::DenseCellTable dense;  // cell ids over the box widened by one cell
   std::array<std::int64_t, 27> dense_offsets{};  // the 27 cells around one, d = dx + 3 dy + 9 dz
   detail::CellLists points;    // cloud indices by cell
   std::vector<float> x, y, z;  // by cell: relative to the first finite point (then kFar slack)
 
-  std::size_t denseIndex(const std::int32_t* c) const {
-    return static_cast<std::size_t>((c[0] - lo[0]) + (c[1] - lo[1]) * sy + (c[2] - lo[2]) * sz);
-  }
+  std::size_t denseIndex(const std::int32_t* c) const { return dense.index(c[0], c[1], c[2]); }
 };
 
-// The dense table over the box [lo, hi] widened by one cell, or false where it would hold more
-// than kDenseCellsPerPoint cells per point.
+// The dense table over the box [lo, hi] widened by one cell and its 27 offsets, or false where
+// the table declines the box.
 bool makeDense(RadiusGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&hi)[3],
                std::size_t n_points) {
-  std::int64_t dim[3];
-  double volume = 1;
-  for (int a = 0; a < 3; ++a) {
-    dim[a] = std::int64_t{hi[a]} - lo[a] + 3;
-    volume *= static_cast<double>(dim[a]);
-  }
-  if (volume > static_cast<double>(RadiusGrid::kDenseCellsPerPoint * n_points + 4096)) {
-    return false;
-  }
-  g.dense.assign(static_cast<std::size_t>(volume), kNoIndex);
-  for (int a = 0; a < 3; ++a) g.lo[a] = std::int64_t{lo[a]} - 1;
-  g.sy = dim[0], g.sz = dim[0] * dim[1];
+  if (!g.dense.reset(lo, hi, 1, n_points)) return false;
   for (int d = 0; d < 27; ++d) {
-    g.dense_offsets[static_cast<std::size_t>(d)] =
-        (d % 3 - 1) + ((d / 3) % 3 - 1) * g.sy + (d / 9 - 1) * g.sz;
+    g.dense_offsets[static_cast<std::size_t>(d)] = g.dense.offset(d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1);
   }
   return true;
 }
@@ -220,7 +204,7 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
     if (cell_of[i] == kNoIndex) continue;
     const std::int32_t* c = &cell_xyz[3 * i];
     if (g.has_dense) {
-      std::uint32_t& id = g.dense[g.denseIndex(c)];
+      std::uint32_t& id = g.dense.ids[g.denseIndex(c)];
       if (id == kNoIndex) {
         id = static_cast<std::uint32_t>(g.n_cells);
         std::memcpy(&g.xyz[3 * g.n_cells++], c, 3 * sizeof(std::int32_t));
@@ -249,7 +233,7 @@ int cellsAround(const RadiusGrid& g, std::size_t c, std::array<std::uint32_t, 27
   int n_around = 0;
   const std::int32_t* xyz = &g.xyz[3 * c];
   if (g.has_dense) {
-    const std::uint32_t* at = g.dense.data() + g.denseIndex(xyz);
+    const std::uint32_t* at = g.dense.ids.data() + g.denseIndex(xyz);
     for (int d = 0; d < 27; ++d) {
       const std::uint32_t id = at[g.dense_offsets[static_cast<std::size_t>(d)]];
       if (id != kNoIndex) around[static_cast<std::size_t>(n_around++)] = id;

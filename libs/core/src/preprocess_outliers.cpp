@@ -57,21 +57,13 @@ struct PointGrid {
     return cells.find(cx, cy, cz);
   }
 
-  // The cell ids over the occupied cells' box widened by kDenseMargin cells on every side, x
-  // fastest (kNoIndex where empty), and the shells' cell offsets in it, nearest first: a shell's
-  // cells by one load each instead of a hash look-up. Off (has_dense false) where the box would
-  // hold more than kDenseCellsPerPoint cells per point.
+  // The cell ids over the occupied cells' box widened by kDenseMargin cells on every side, and
+  // the shells' cell offsets in it, nearest first: a shell's cells by one load each instead of a
+  // hash look-up. Off (has_dense false) where the table declines the box.
   static constexpr int kDenseMargin = 3;
-  static constexpr std::size_t kDenseCellsPerPoint = 32;
   bool has_dense = false;
-  std::vector<std::uint32_t> dense;
-  std::int64_t dense_lo[3] = {0, 0, 0};
-  std::int64_t dense_sy = 0, dense_sz = 0;  // strides of y and z
+  detail::DenseCellTable dense;
   std::array<std::vector<std::int64_t>, 4> dense_offsets;  // by ring (0 .. 3)
-  std::size_t denseIndex(std::int32_t cx, std::int32_t cy, std::int32_t cz) const {
-    return static_cast<std::size_t>((cx - dense_lo[0]) + (cy - dense_lo[1]) * dense_sy +
-                                    (cz - dense_lo[2]) * dense_sz);
-  }
   // The cells' coordinates, 3 per cell in id order (the ids in order of first sight, as the
   // hash's CellGrid numbers them).
   std::vector<std::int32_t> cell_xyz;
@@ -80,28 +72,17 @@ struct PointGrid {
 };
 
 // The cells' dense table (empty) and its shells' offsets over the box [lo, hi] widened by
-// kDenseMargin; false (has_dense off) where the box would hold more than kDenseCellsPerPoint
-// cells per point.
+// kDenseMargin; false (has_dense off) where the table declines the box.
 const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring);
 bool makeDense(PointGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&hi)[3],
                std::size_t n_points) {
-  g.has_dense = false;
-  double volume = 1;
-  std::int64_t dim[3];
-  for (int a = 0; a < 3; ++a) {
-    dim[a] = std::int64_t{hi[a]} - lo[a] + 1 + 2 * PointGrid::kDenseMargin;
-    volume *= static_cast<double>(dim[a]);
-  }
-  if (volume > static_cast<double>(PointGrid::kDenseCellsPerPoint * n_points + 4096)) return false;
-  g.dense.assign(static_cast<std::size_t>(volume), detail::kNoIndex);
-  for (int a = 0; a < 3; ++a) g.dense_lo[a] = std::int64_t{lo[a]} - PointGrid::kDenseMargin;
-  g.dense_sy = dim[0], g.dense_sz = dim[0] * dim[1];
+  g.has_dense = g.dense.reset(lo, hi, PointGrid::kDenseMargin, n_points);
+  if (!g.has_dense) return false;
   for (int ring = 0; ring <= PointGrid::kDenseMargin; ++ring) {
     std::vector<std::int64_t>& o = g.dense_offsets[static_cast<std::size_t>(ring)];
     o.clear();
-    for (const auto& d : shellOffsets(ring)) o.push_back(d[0] + d[1] * g.dense_sy + d[2] * g.dense_sz);
+    for (const auto& d : shellOffsets(ring)) o.push_back(g.dense.offset(d[0], d[1], d[2]));
   }
-  g.has_dense = true;
   return true;
 }
 
@@ -122,7 +103,7 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
     std::uint32_t n_cells = 0;
     for (std::size_t f = 0; f < finite.size(); ++f) {
       const std::int32_t cx = g.coords.x[f], cy = g.coords.y[f], cz = g.coords.z[f];
-      std::uint32_t& id = g.dense[g.denseIndex(cx, cy, cz)];
+      std::uint32_t& id = g.dense.ids[g.dense.index(cx, cy, cz)];
       if (id == detail::kNoIndex) id = n_cells++, g.cell_xyz.insert(g.cell_xyz.end(), {cx, cy, cz});
       cell_of[f] = id;
     }
@@ -358,7 +339,7 @@ class CellSearch {
   void shell(int ring, std::vector<std::uint32_t>& out) const {
     out.clear();
     if (g_->has_dense) {
-      const std::uint32_t* at = g_->dense.data() + g_->denseIndex(cx_, cy_, cz_);
+      const std::uint32_t* at = g_->dense.ids.data() + g_->dense.index(cx_, cy_, cz_);
       for (const std::int64_t o : g_->dense_offsets[static_cast<std::size_t>(ring)]) {
         const std::uint32_t c = at[o];
         if (c != detail::kNoIndex) out.push_back(c);
