@@ -161,7 +161,8 @@ bool makeDense(RadiusGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&
                std::size_t n_points) {
   if (!g.dense.reset(lo, hi, 1, n_points)) return false;
   for (int d = 0; d < 27; ++d) {
-    g.dense_offsets[static_cast<std::size_t>(d)] = g.dense.offset(d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1);
+    g.dense_offsets[static_cast<std::size_t>(d)] =
+        g.dense.offset(d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1);
   }
   return true;
 }

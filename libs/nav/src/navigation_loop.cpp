@@ -110,11 +110,10 @@ const FrameEvidence& NavigationLoop::addFrame(const core::PointCloud& cloud_worl
   } else {
     scorer_.score(cloud_world, Eigen::Isometry3d::Identity(), last_frame_);
   }
-  BaseState s;
-  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  const Pose2D pose = robotPose();
   const auto view = maps::viewPoints(last_frame_.cloud_world, last_frame_.classes,
                                      last_frame_.upd.zeta.empty() ? nullptr : &last_frame_.upd);
-  const Eigen::Vector2d robot_xy(s.pose_world_robot.x_m, s.pose_world_robot.y_m);
+  const Eigen::Vector2d robot_xy(pose.x_m, pose.y_m);
   last_fusion_ = maps::integrateScan(grid_, view, robot_xy, time_s, config_.fusion);
 
   // Missing ground: gaps whose near side the map (this frame included) reads as traversable
@@ -223,10 +222,9 @@ void NavigationLoop::navigateTo(const Eigen::Vector2d& goal_world) {
 }
 
 void NavigationLoop::replan() {
-  BaseState s;
-  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  const Pose2D pose = robotPose();
   last_plan_s_ = base_.timeS();
-  Route r = planRoute(grid_, fixed_world_, {s.pose_world_robot.x_m, s.pose_world_robot.y_m},
+  Route r = planRoute(grid_, fixed_world_, {pose.x_m, pose.y_m},
                       goal_world_, config_.route);
   if (r.found && r.length_m < best_route_m_ - kProgress_m) {
     best_route_m_ = r.length_m;
@@ -289,9 +287,8 @@ double NavigationLoop::routeHeadingError(const Pose2D& pose) const {
 }
 
 void NavigationLoop::restartStallWatch() {
-  BaseState s;
-  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
-  stall_anchor_xy_ = {s.pose_world_robot.x_m, s.pose_world_robot.y_m};
+  const Pose2D pose = robotPose();
+  stall_anchor_xy_ = {pose.x_m, pose.y_m};
   stall_anchor_s_ = base_.timeS();
 }
 
@@ -302,26 +299,33 @@ std::uint64_t cellKey(std::int64_t i, std::int64_t j) {
          static_cast<std::uint32_t>(j);
 }
 
+// Calls f(i, j, centre) for every grid cell (world indices: the centre of cell (i, j) is
+// ((i + 0.5) cs, (j + 0.5) cs)) in the square of half side r_m around xy.
+template <class F>
+void forEachCellAround(const Eigen::Vector2d& xy, double r_m, double cs, F&& f) {
+  const auto index = [&](double v_m) { return static_cast<std::int64_t>(std::floor(v_m / cs)); };
+  for (std::int64_t j = index(xy.y() - r_m); j <= index(xy.y() + r_m); ++j) {
+    for (std::int64_t i = index(xy.x() - r_m); i <= index(xy.x() + r_m); ++i) {
+      f(i, j, Eigen::Vector2d((static_cast<double>(i) + 0.5) * cs,
+                              (static_cast<double>(j) + 0.5) * cs));
+    }
+  }
+}
+
 // Centres of the cells within reach_m of the robot that the map has not observed and the robot
 // has not driven on (cells outside the grid's window included), in the robot frame.
 std::vector<Eigen::Vector2d> unknownCellsInRobot(const maps::TraversabilityGrid& grid,
                                                  const std::unordered_set<std::uint64_t>& driven,
                                                  const Pose2D& pose_world_robot, double reach_m) {
-  const double cs = grid.cellSize();
   const Eigen::Vector2d centre(pose_world_robot.x_m, pose_world_robot.y_m);
-  // World cell indices: the centre of cell (i, j) is ((i + 0.5) cs, (j + 0.5) cs).
-  const auto index = [&](double v_m) { return static_cast<std::int64_t>(std::floor(v_m / cs)); };
   std::vector<Eigen::Vector2d> out;
-  for (std::int64_t j = index(centre.y() - reach_m); j <= index(centre.y() + reach_m); ++j) {
-    for (std::int64_t i = index(centre.x() - reach_m); i <= index(centre.x() + reach_m); ++i) {
-      const Eigen::Vector2d c((static_cast<double>(i) + 0.5) * cs,
-                              (static_cast<double>(j) + 0.5) * cs);
-      if ((c - centre).norm() > reach_m || driven.count(cellKey(i, j)) > 0) continue;
-      const maps::GridCell* cell = grid.cellAt(c.x(), c.y());
-      if (cell != nullptr && maps::isKnown(*cell, grid.params())) continue;
-      out.push_back(worldToRobot(pose_world_robot, c));
-    }
-  }
+  forEachCellAround(centre, reach_m, grid.cellSize(),
+                    [&](std::int64_t i, std::int64_t j, const Eigen::Vector2d& c) {
+    if ((c - centre).norm() > reach_m || driven.count(cellKey(i, j)) > 0) return;
+    const maps::GridCell* cell = grid.cellAt(c.x(), c.y());
+    if (cell != nullptr && maps::isKnown(*cell, grid.params())) return;
+    out.push_back(worldToRobot(pose_world_robot, c));
+  });
   return out;
 }
 
@@ -329,18 +333,18 @@ std::vector<Eigen::Vector2d> unknownCellsInRobot(const maps::TraversabilityGrid&
 
 void NavigationLoop::markDrivenCells(const Pose2D& pose, double half_length_m,
                                      double half_width_m) {
-  const double cs = grid_.cellSize();
-  const double r = std::hypot(half_length_m, half_width_m);
-  const auto index = [&](double v_m) { return static_cast<std::int64_t>(std::floor(v_m / cs)); };
-  for (std::int64_t j = index(pose.y_m - r); j <= index(pose.y_m + r); ++j) {
-    for (std::int64_t i = index(pose.x_m - r); i <= index(pose.x_m + r); ++i) {
-      const Eigen::Vector2d c((static_cast<double>(i) + 0.5) * cs,
-                              (static_cast<double>(j) + 0.5) * cs);
-      if (rectangleSignedDistance(worldToRobot(pose, c), half_length_m, half_width_m) <= 0.0) {
-        driven_cells_.insert(cellKey(i, j));
-      }
+  forEachCellAround({pose.x_m, pose.y_m}, std::hypot(half_length_m, half_width_m), grid_.cellSize(),
+                    [&](std::int64_t i, std::int64_t j, const Eigen::Vector2d& c) {
+    if (rectangleSignedDistance(worldToRobot(pose, c), half_length_m, half_width_m) <= 0.0) {
+      driven_cells_.insert(cellKey(i, j));
     }
-  }
+  });
+}
+
+Pose2D NavigationLoop::robotPose() {
+  BaseState s;
+  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  return s.pose_world_robot;
 }
 
 Eigen::Vector2d NavigationLoop::polygonHalfSizes() const {
@@ -352,15 +356,14 @@ Eigen::Vector2d NavigationLoop::polygonHalfSizes() const {
 void NavigationLoop::updateDrivenAndUnobserved() {
   const double behind_m = config_.obstacles.unobserved_behind_m;
   if (behind_m <= 0.0 && (!config_.recovery.enabled || config_.recovery.into_unobserved)) return;
-  BaseState s;
-  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  const Pose2D pose = robotPose();
   const Eigen::Vector2d half = polygonHalfSizes();
-  markDrivenCells(s.pose_world_robot, half.x(), half.y());
+  markDrivenCells(pose, half.x(), half.y());
   if (behind_m <= 0.0) return;
   std::vector<Eigen::Vector2d> behind_world;
-  for (const Eigen::Vector2d& p : unknownCellsInRobot(grid_, driven_cells_, s.pose_world_robot,
+  for (const Eigen::Vector2d& p : unknownCellsInRobot(grid_, driven_cells_, pose,
                                                       half.x() + behind_m)) {
-    if (p.x() < -half.x() - grid_.cellSize()) behind_world.push_back(robotToWorld(s.pose_world_robot, p));
+    if (p.x() < -half.x() - grid_.cellSize()) behind_world.push_back(robotToWorld(pose, p));
   }
   obstacles_.setUnobservedBehind(std::move(behind_world));
 }
@@ -368,13 +371,12 @@ void NavigationLoop::updateDrivenAndUnobserved() {
 bool NavigationLoop::startRecoveryIfStalled() {
   const RecoveryParams& rp = config_.recovery;
   if (!rp.enabled) return false;
-  BaseState s;
-  if (!base_.readState(s)) throw std::runtime_error("the robot base does not report its pose");
+  const Pose2D pose = robotPose();
   // The navigator's own shape and obstacle points: the manoeuvre keeps the clearance it keeps.
   const Eigen::Vector2d half = polygonHalfSizes();
   const double half_length_m = half.x(), half_width_m = half.y();
   const double now = base_.timeS();
-  const Eigen::Vector2d xy(s.pose_world_robot.x_m, s.pose_world_robot.y_m);
+  const Eigen::Vector2d xy(pose.x_m, pose.y_m);
   if ((xy - stall_anchor_xy_).norm() > rp.stall_radius_m) {
     stall_anchor_xy_ = xy;
     stall_anchor_s_ = now;
@@ -384,12 +386,12 @@ bool NavigationLoop::startRecoveryIfStalled() {
   std::vector<Eigen::Vector2d> unobserved_robot;
   if (!rp.into_unobserved) {
     unobserved_robot = unknownCellsInRobot(
-        grid_, driven_cells_, s.pose_world_robot,
+        grid_, driven_cells_, pose,
         recoveryReach(half_length_m, half_width_m, rp, grid_.cellSize()));
   }
   const RecoveryMotion m =
-      planRecovery(obstacles_.pointsInRobot(s.pose_world_robot), unobserved_robot, half_length_m,
-                   half_width_m, routeHeadingError(s.pose_world_robot), rp);
+      planRecovery(obstacles_.pointsInRobot(pose), unobserved_robot, half_length_m,
+                   half_width_m, routeHeadingError(pose), rp);
   // Watch the next stretch of time whether or not a manoeuvre was found.
   stall_anchor_s_ = now;
   if (!m.feasible()) return false;

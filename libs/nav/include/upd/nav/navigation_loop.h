@@ -141,6 +141,8 @@ class NavigationLoop {
   bool startRecoveryIfStalled();
   /// Adds the cells under the polygon (half sizes) at the pose to driven_cells_.
   void markDrivenCells(const Pose2D& pose_world_robot, double half_length_m, double half_width_m);
+  /// The base's pose (std::runtime_error when it does not report one).
+  Pose2D robotPose();
   /// Half length and half width of the navigator's polygon [m].
   Eigen::Vector2d polygonHalfSizes() const;
   /// Marks the ground under the robot as driven and hands the obstacle source the unobserved
