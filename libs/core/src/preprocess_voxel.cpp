@@ -188,7 +188,7 @@ __attribute__((target("avx2,popcnt"))) bool voxelKeysAvx2(const float* __restric
                                            _mm256_cmp_ps(f[a], b1[a], _CMP_LE_OQ)));
     }
     if (_mm256_testz_ps(ok, ok)) {  // (none passes, as in the NaN holes and beyond the range)
-      const __m256i none = _mm256_set1_epi64x(-1);
+      const __m256i none = _mm256_set1_epi64x(static_cast<long long>(kNoKey));
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(keys + j), none);
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(keys + j + 4), none);
       continue;
