@@ -181,18 +181,15 @@ class NearestK {
   float d_[kMax];
 };
 
-// The points of a block of cells as one structure of arrays, padded to a multiple of 16 (cap)
-// with far-away points.
+// The points of a block of cells as one structure of arrays, padded to a multiple of 8 (cap,
+// gatherWithin's vectors) with far-away points.
 struct BlockPoints {
   std::vector<float> x, y, z;
   std::size_t n = 0, cap = 0;
   void fill(const PointGrid& g, const std::vector<std::uint32_t>& cells) {
-    n = 0;
-    for (const std::uint32_t c : cells) n += g.start[c + 1] - g.start[c];
-    cap = (n + 15) / 16 * 16;
-    if (x.size() < cap + kCopyLanes) {
-      x.resize(cap + kCopyLanes), y.resize(cap + kCopyLanes), z.resize(cap + kCopyLanes);
-    }
+    // (Room for the whole grid and the slack: no count of the block's points before the copy.)
+    const std::size_t room = g.index.size() + 2 * kCopyLanes;
+    if (x.size() < room) x.resize(room), y.resize(room), z.resize(room);
     float *bx = x.data(), *by = y.data(), *bz = z.data();
     std::size_t j = 0;
     for (const std::uint32_t c : cells) {
@@ -200,6 +197,8 @@ struct BlockPoints {
       detail::copyRunByEights(g.x.data(), g.y.data(), g.z.data(), b, e, bx + j, by + j, bz + j);
       j += e - b;
     }
+    n = j;
+    cap = (n + 7) / 8 * 8;
     for (; j < cap; ++j) bx[j] = by[j] = bz[j] = kFarPoint;  // (every point written once)
   }
 };
