@@ -184,10 +184,12 @@ __attribute__((target("avx2"))) inline void loadPadded(const float* cand, std::s
 
 // selectMeanAvx2's drops and sum over NV vectors (a count known when compiled, so that the
 // vectors stay in registers): cand[0, c) with 8 (NV - 1) < c <= 8 NV, the lanes past c -inf.
-// The c - want largest go by value, every lane equal to the largest at once (a compare and a
-// blend per vector, no search for its lane); where that took more than c - want (a value
-// among them twice), they go again one instance at a time from the start. Either way the
-// lanes kept are the same, in the same places, so the sum is the same bit for bit.
+// Those beyond a bound near the incoming kth that keeps want go first, all at once; then the
+// largest go by value, every lane equal to the largest at once (a compare and a blend per
+// vector, no search for its lane); where that left fewer than want (a value among those
+// dropped twice, or the want-th's among them), they go again one instance at a time from the
+// start. Either way the lanes kept are the same, in the same places, so the sum is the same
+// bit for bit.
 template <std::size_t NV>
 __attribute__((target("avx2,popcnt,bmi"))) double dropAndSum(const float* cand, std::size_t c,
                                                              std::size_t want, float& kth) {
@@ -195,7 +197,28 @@ __attribute__((target("avx2,popcnt,bmi"))) double dropAndSum(const float* cand, 
   const __m256 lowest_v = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
   __m256 v[NV];
   loadPadded(cand, c, v);
-  for (std::size_t drop = 0; drop < c - want; ++drop) {
+  std::size_t drops = c - want;
+  if (drops > 3) {
+    // Those beyond a bound near the incoming kth (the previous point's) go at once where
+    // at least want lie within it: they are larger than the want-th.
+    const __m256 bound[2] = {_mm256_set1_ps(kth * 0.9f), _mm256_set1_ps(kth * 1.05f)};
+    std::size_t within[2] = {0, 0};
+    for (std::size_t i = 0; i < NV; ++i) {
+      for (int b = 0; b < 2; ++b) {
+        within[b] += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(
+            _mm256_movemask_ps(_mm256_cmp_ps(v[i], bound[b], _CMP_LE_OQ)))));
+      }
+    }
+    const std::size_t pad = 8 * NV - c;  // (the padding, -inf, lies within any bound)
+    const int b = within[0] >= want + pad ? 0 : 1;
+    if (within[b] >= want + pad) {
+      for (std::size_t i = 0; i < NV; ++i) {
+        v[i] = _mm256_blendv_ps(lowest_v, v[i], _mm256_cmp_ps(v[i], bound[b], _CMP_LE_OQ));
+      }
+      drops = within[b] - pad - want;
+    }
+  }
+  for (std::size_t drop = 0; drop < drops; ++drop) {
     const __m256 top = maxOf(v);
     for (std::size_t i = 0; i < NV; ++i) {
       v[i] = _mm256_blendv_ps(v[i], lowest_v, _mm256_cmp_ps(v[i], top, _CMP_EQ_OQ));
