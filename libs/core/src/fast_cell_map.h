@@ -36,6 +36,13 @@ inline bool keyFitsAround(const std::int32_t* xyz, std::int32_t margin) {
                  std::int64_t{xyz[2]} + margin);
 }
 
+/// Writes v to the 8 floats from each of ox, oy and oz (a run's padding): three 8-float moves
+/// instead of a scalar loop (the three rows may alias as far as the compiler knows).
+inline void fillEight(float v, float* ox, float* oy, float* oz) {
+  const float e[8] = {v, v, v, v, v, v, v, v};
+  std::memcpy(ox, e, sizeof e), std::memcpy(oy, e, sizeof e), std::memcpy(oz, e, sizeof e);
+}
+
 /// Copies the points [b, e) of coordinate rows (x, y, z), sorted by cell, to (ox, oy, oz), 8 at
 /// a time: up to 7 values past e are read (the rows have that slack) and written (the caller
 /// overwrites them: the next run or its padding).

@@ -264,10 +264,11 @@ int cellsAround(const RadiusGrid& g, std::size_t c, std::array<std::uint32_t, 27
 // shrunk (no allocation once they have the room).
 std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<float>& cx,
                             std::vector<float>& cy, std::vector<float>& cz) {
-  std::array<std::uint32_t, 27> around{};
+  // (Not value-initialized: only the first n_around are read, each written first.)
+  std::array<std::uint32_t, 27> around;
   const int n_around = cellsAround(g, c, around);
   const std::uint32_t* start = g.points.start.data();
-  std::array<std::uint32_t, 27> begin{}, end{};
+  std::array<std::uint32_t, 27> begin, end;
   std::size_t total = 0;
   for (int a = 0; a < n_around; ++a) {
     begin[a] = start[around[a]], end[a] = start[around[a] + 1];
@@ -283,7 +284,8 @@ std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<floa
                             oy + m, oz + m);
     m += end[a] - begin[a];
   }
-  for (int l = 0; l < kScanLanes; ++l) ox[m + l] = oy[m + l] = oz[m + l] = kFar;
+  static_assert(kScanLanes == 8, "the padding is one fillEight");
+  detail::fillEight(kFar, ox + m, oy + m, oz + m);
   return static_cast<std::ptrdiff_t>(total);
 }
 

@@ -199,7 +199,8 @@ struct BlockPoints {
     }
     n = j;
     cap = (n + 7) / 8 * 8;
-    for (; j < cap; ++j) bx[j] = by[j] = bz[j] = kFarPoint;  // (every point written once)
+    // (Every point of the vectors written: the padding, 8 from n, in the slack.)
+    detail::fillEight(kFarPoint, bx + n, by + n, bz + n);
   }
 };
 
