@@ -247,6 +247,13 @@ struct CellLists {
   std::vector<std::uint32_t> order;  ///< item indices, grouped by cell
 
   bool empty(std::size_t c) const { return start[c] == start[c + 1]; }
+  /// The most items in one cell (0 without cells): with the number of cells of a block, room
+  /// for the block's items without counting them.
+  std::uint32_t mostInACell() const {
+    std::uint32_t most = 0;
+    for (std::size_t c = 0; c + 1 < start.size(); ++c) most = std::max(most, start[c + 1] - start[c]);
+    return most;
+  }
 };
 
 /// Groups items [0, n_items) by their cell cell(i) in [0, n_cells) (a stable counting sort);

@@ -123,10 +123,7 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   detail::listByCell(
       finite.size(), g.n_cells, [&](std::size_t f) { return cell_of[f]; }, by_cell);
   g.start.assign(by_cell.start.begin(), by_cell.start.end());
-  g.max_cell_points = 0;
-  for (std::size_t c = 0; c < g.n_cells; ++c) {
-    g.max_cell_points = std::max(g.max_cell_points, g.start[c + 1] - g.start[c]);
-  }
+  g.max_cell_points = by_cell.mostInACell();
   // (kCopyLanes of slack: BlockPoints::fill copies 8 at a time.)
   const std::size_t rows = finite.size() + kCopyLanes;
   g.x.resize(rows), g.y.resize(rows), g.z.resize(rows);
