@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -173,7 +174,8 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   const Eigen::Vector3d ref = cloud.point(first).cast<double>();
   const double inv = 1.0 / radius_m;
   // Every finite point's cell and the cells' box.
-  std::vector<std::int32_t> cell_xyz(3 * N);
+  // (Not zeroed: only the finite points' cells are written and read.)
+  const std::unique_ptr<std::int32_t[]> cell_xyz(new std::int32_t[3 * N]);
   std::vector<std::uint32_t> cell_of(N, kNoIndex);
   std::int32_t lo[3], hi[3];
   for (int a = 0; a < 3; ++a) {
