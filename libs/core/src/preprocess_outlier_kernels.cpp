@@ -157,9 +157,10 @@ __attribute__((target("avx2"))) inline double sumRoots(const __m256 (&v)[NV]) {
     sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(d))));
     sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(d, 1))));
   }
-  alignas(32) double lanes[4];
-  _mm256_store_pd(lanes, sum);
-  return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+  // ((l0 + l1) + (l2 + l3), in registers: no aligned stack array, no realigned frame.)
+  const __m128d pairs =
+      _mm_hadd_pd(_mm256_castpd256_pd128(sum), _mm256_extractf128_pd(sum, 1));
+  return _mm_cvtsd_f64(_mm_add_sd(pairs, _mm_unpackhi_pd(pairs, pairs)));
 }
 
 // The largest lane of v[0, NV), in every lane.
@@ -190,9 +191,13 @@ __attribute__((target("avx2"))) inline void loadPadded(const float* cand, std::s
 // dropped twice, or the want-th's among them), they go again one instance at a time from the
 // start. Either way the lanes kept are the same, in the same places, so the sum is the same
 // bit for bit.
+// (Not inlined into selectMeanAvx2: the larger counts' spills would give every call their
+// realigned stack frame.)
 template <std::size_t NV>
-__attribute__((target("avx2,popcnt,bmi"))) double dropAndSum(const float* cand, std::size_t c,
-                                                             std::size_t want, float& kth) {
+__attribute__((target("avx2,popcnt,bmi"), noinline)) double dropAndSum(const float* cand,
+                                                                       std::size_t c,
+                                                                       std::size_t want,
+                                                                       float& kth) {
   const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256 lowest_v = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
   __m256 v[NV];
