@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -82,8 +83,10 @@ TEST(CellBins, EveryPointLandsInTheCellOfItsCoordinates) {
         n, grid.size(), [&](std::size_t i) { return cell_of[i]; }, lists);
     ASSERT_EQ(lists.start.size(), grid.size() + 1);
     std::vector<int> seen(n, 0);
+    std::uint32_t most = 0;
     for (std::size_t c = 0; c < grid.size(); ++c) {
       EXPECT_FALSE(lists.empty(c));
+      most = std::max(most, lists.start[c + 1] - lists.start[c]);
       for (std::uint32_t q = lists.start[c]; q < lists.start[c + 1]; ++q) {
         const std::uint32_t i = lists.order[q];
         EXPECT_EQ(cell_of[i], c);
@@ -94,6 +97,7 @@ TEST(CellBins, EveryPointLandsInTheCellOfItsCoordinates) {
       }
     }
     for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(seen[i], cloud.valid[i] ? 1 : 0) << i;
+    EXPECT_EQ(lists.mostInACell(), most);  // (the room of the blocks copied from the lists)
   }
 }
 
@@ -120,6 +124,7 @@ TEST(CellBins, EmptyInput) {
       0, 0, [](std::size_t) { return detail::kNoIndex; }, lists);
   EXPECT_EQ(lists.start.size(), 1u);
   EXPECT_TRUE(lists.order.empty());
+  EXPECT_EQ(lists.mostInACell(), 0u);
 }
 
 }  // namespace

@@ -73,6 +73,27 @@ TEST(PreprocessKernels, GatherWithinKeepsThePointsWithinTheBoundInOrder) {
   EXPECT_GT(checked, 300);
 }
 
+// selectMean and selectMeanPlain of the candidates cand against the mean of the square roots
+// of the want smallest in double, and the want-th; the incoming kth is the want-th times
+// guess.
+void expectSelectMean(const std::vector<float>& cand, std::size_t want, float guess, int trial) {
+  const std::size_t c = cand.size();
+  std::vector<double> sorted(cand.begin(), cand.end());
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0;
+  for (std::size_t j = 0; j < want; ++j) sum += std::sqrt(sorted[j]);
+  const double mean = sum / static_cast<double>(want - 1);
+  for (const bool plain : {false, true}) {
+    std::vector<float> buf(c + 8);
+    std::copy(cand.begin(), cand.end(), buf.begin());
+    float kth = static_cast<float>(sorted[want - 1]) * guess;
+    const double got = plain ? detail::selectMeanPlain(buf.data(), c, want, kth)
+                             : detail::selectMean(buf.data(), c, want, kth);
+    EXPECT_NEAR(got, mean, 1e-12 * mean) << "trial " << trial << (plain ? " plain" : "");
+    EXPECT_EQ(kth, static_cast<float>(sorted[want - 1])) << "trial " << trial;
+  }
+}
+
 TEST(PreprocessKernels, SelectMeanIsTheMeanOfTheNearestWithTies) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(0.f, 0.01f);
@@ -92,25 +113,40 @@ TEST(PreprocessKernels, SelectMeanIsTheMeanOfTheNearestWithTies) {
         if (d >= s[want - 2] && d <= s[std::min(c - 1, want + 1)]) d = s[want - 1];
       }
     }
-    std::vector<double> sorted(cand.begin(), cand.end());
-    std::sort(sorted.begin(), sorted.end());
-    double sum = 0;
-    for (std::size_t j = 0; j < want; ++j) sum += std::sqrt(sorted[j]);
-    const double mean = sum / static_cast<double>(want - 1);
-    for (const bool plain : {false, true}) {
-      std::vector<float> buf(c + 8);
-      std::copy(cand.begin(), cand.end(), buf.begin());
-      // The incoming kth is a guess of the want-th (only the speed depends on it): near it,
-      // far on either side, or none.
-      const float guess[] = {-1.f, 0.2f, 0.6f, 1.f, 1.7f, 5.f,
-                             std::numeric_limits<float>::infinity()};
-      float kth = static_cast<float>(sorted[want - 1]) * guess[(trial / 7) % 7];
-      const double got = plain ? detail::selectMeanPlain(buf.data(), c, want, kth)
-                               : detail::selectMean(buf.data(), c, want, kth);
-      EXPECT_NEAR(got, mean, 1e-12 * mean) << "trial " << trial << (plain ? " plain" : "");
-      EXPECT_EQ(kth, static_cast<float>(sorted[want - 1])) << "trial " << trial;
-    }
+    // The incoming kth is a guess of the want-th (only the speed depends on it): near it, far
+    // on either side, or none.
+    const float guess[] = {-1.f, 0.2f, 0.6f, 1.f, 1.7f, 5.f,
+                           std::numeric_limits<float>::infinity()};
+    expectSelectMean(cand, want, guess[(trial / 7) % 7], trial);
   }
+}
+
+// The drop path takes the largest by value, all lanes equal to it at once, and where that
+// takes more than it should (a value among those dropped twice, or tied with the want-th) it
+// drops again one instance at a time: the same answer either way, wherever the ties fall.
+TEST(PreprocessKernels, SelectMeanWithTiesAmongTheDropped) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(0.f, 0.01f);
+  int tied = 0;
+  for (int trial = 0; trial < 800; ++trial) {
+    const std::size_t want = 2 + static_cast<std::size_t>(trial % 40);
+    const std::size_t c = want + 1 + static_cast<std::size_t>(trial % 16);  // (the drop path)
+    std::vector<float> cand(c);
+    for (float& d : cand) d = u(rng);
+    std::vector<float> s = cand;
+    std::sort(s.begin(), s.end());
+    // Two candidates share a value: among the dropped (above the want-th), straddling it, or
+    // below it.
+    const std::size_t at = (want - 1) + static_cast<std::size_t>(trial % 3) - 1;
+    if (at + 1 < c) {
+      for (float& d : cand) {
+        if (d == s[at + 1]) d = s[at], ++tied;
+      }
+    }
+    std::shuffle(cand.begin(), cand.end(), rng);
+    expectSelectMean(cand, want, 1.f, trial);
+  }
+  EXPECT_GT(tied, 700);
 }
 
 // The voxel grid's key pass on AVX2 against the plain loop: the same key for every point (NaN,

@@ -232,6 +232,24 @@ TEST(PreprocessReference, RandomCloudsKeepTheReferencesPointsAndCentroids) {
   }
 }
 
+// Holes in runs of every length from 1 to 11 (the voxel pass passes them 4 at a time), at the
+// start, inside and at the end of rows: the same points and centroids as the reference.
+TEST(PreprocessReference, HoleRunsOfEveryLength) {
+  PointCloud c = randomCloud(4, 24000, 200, true);
+  std::size_t holes = 0;
+  for (std::size_t row = 0; row < c.height; ++row) {
+    const std::size_t len = 1 + row % 11;
+    const std::size_t at = row % 3 == 0 ? 0 : (row % 3 == 1 ? 97 : c.width - len);
+    for (std::size_t col = at; col < at + len; ++col, ++holes) {
+      c.x[row * c.width + col] = kNan;
+    }
+  }
+  ASSERT_GT(holes, 700u);
+  PreprocessParams p = paperParams();
+  p.range_max_m = 2.6;
+  checkChain("hole runs", c, p);
+}
+
 // The mean distance of every point of c to its k nearest others, each compared with every point
 // in double (the k-d tree computes in float from its own origin: on a cloud spanning hundreds of
 // metres it is off by 1e-4 relative).

@@ -36,6 +36,13 @@ inline bool keyFitsAround(const std::int32_t* xyz, std::int32_t margin) {
                  std::int64_t{xyz[2]} + margin);
 }
 
+/// Writes v to the 8 floats from each of ox, oy and oz (a run's padding): three 8-float moves
+/// instead of a scalar loop (the three rows may alias as far as the compiler knows).
+inline void fillEight(float v, float* ox, float* oy, float* oz) {
+  const float e[8] = {v, v, v, v, v, v, v, v};
+  std::memcpy(ox, e, sizeof e), std::memcpy(oy, e, sizeof e), std::memcpy(oz, e, sizeof e);
+}
+
 /// Copies the points [b, e) of coordinate rows (x, y, z), sorted by cell, to (ox, oy, oz), 8 at
 /// a time: up to 7 values past e are read (the rows have that slack) and written (the caller
 /// overwrites them: the next run or its padding).
@@ -240,6 +247,13 @@ struct CellLists {
   std::vector<std::uint32_t> order;  ///< item indices, grouped by cell
 
   bool empty(std::size_t c) const { return start[c] == start[c + 1]; }
+  /// The most items in one cell (0 without cells): with the number of cells of a block, room
+  /// for the block's items without counting them.
+  std::uint32_t mostInACell() const {
+    std::uint32_t most = 0;
+    for (std::size_t c = 0; c + 1 < start.size(); ++c) most = std::max(most, start[c + 1] - start[c]);
+    return most;
+  }
 };
 
 /// Groups items [0, n_items) by their cell cell(i) in [0, n_cells) (a stable counting sort);

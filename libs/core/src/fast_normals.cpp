@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -150,6 +151,7 @@ struct RadiusGrid {
   detail::DenseCellTable dense;  // cell ids over the box widened by one cell
   std::array<std::int64_t, 27> dense_offsets{};  // the 27 cells around one, d = dx + 3 dy + 9 dz
   detail::CellLists points;    // cloud indices by cell
+  std::uint32_t max_cell_points = 0;  // the most points in a cell
   std::vector<float> x, y, z;  // by cell: relative to the first finite point (then kFar slack)
 
   std::size_t denseIndex(const std::int32_t* c) const { return dense.index(c[0], c[1], c[2]); }
@@ -172,7 +174,8 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   const Eigen::Vector3d ref = cloud.point(first).cast<double>();
   const double inv = 1.0 / radius_m;
   // Every finite point's cell and the cells' box.
-  std::vector<std::int32_t> cell_xyz(3 * N);
+  // (Not zeroed: only the finite points' cells are written and read.)
+  const std::unique_ptr<std::int32_t[]> cell_xyz(new std::int32_t[3 * N]);
   std::vector<std::uint32_t> cell_of(N, kNoIndex);
   std::int32_t lo[3], hi[3];
   for (int a = 0; a < 3; ++a) {
@@ -219,6 +222,7 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   g.xyz.resize(3 * g.n_cells);
   detail::listByCell(
       N, g.n_cells, [&](std::size_t i) { return cell_of[i]; }, g.points);
+  g.max_cell_points = g.points.mostInACell();
   const std::size_t n = g.points.order.size();
   // (Slack for gatherAround's copies, 8 at a time; the candidate rows have kScanLanes = 8 more.)
   g.x.assign(n + 8, kFar), g.y.assign(n + 8, kFar), g.z.assign(n + 8, kFar);
@@ -260,31 +264,29 @@ int cellsAround(const RadiusGrid& g, std::size_t c, std::array<std::uint32_t, 27
 }
 
 // The candidates of the points of cell c (the points of the 27 cells around it), as coordinate
-// rows for gatedMoments, padded with kFar; returns their number. The rows are resized, never
-// shrunk (no allocation once they have the room).
+// rows for gatedMoments, padded with kFar; returns their number. The rows are resized to room
+// for the fullest cell's points in each cell around (no count before the copy), never shrunk
+// (no allocation once they have the room).
 std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<float>& cx,
                             std::vector<float>& cy, std::vector<float>& cz) {
-  std::array<std::uint32_t, 27> around{};
+  // (Not value-initialized: only the first n_around are read, each written first.)
+  std::array<std::uint32_t, 27> around;
   const int n_around = cellsAround(g, c, around);
   const std::uint32_t* start = g.points.start.data();
-  std::array<std::uint32_t, 27> begin{}, end{};
-  std::size_t total = 0;
-  for (int a = 0; a < n_around; ++a) {
-    begin[a] = start[around[a]], end[a] = start[around[a] + 1];
-    total += end[a] - begin[a];
-  }
-  if (cx.size() < total + kScanLanes) {
-    cx.resize(total + kScanLanes), cy.resize(total + kScanLanes), cz.resize(total + kScanLanes);
-  }
+  // (8: the copies' overrun past the last run.)
+  const std::size_t room =
+      std::min(g.points.order.size(), std::size_t{g.max_cell_points} * 27) + 8 + kScanLanes;
+  if (cx.size() < room) cx.resize(room), cy.resize(room), cz.resize(room);
   float *ox = cx.data(), *oy = cy.data(), *oz = cz.data();
   std::size_t m = 0;
   for (int a = 0; a < n_around; ++a) {
-    detail::copyRunByEights(g.x.data(), g.y.data(), g.z.data(), begin[a], end[a], ox + m,
-                            oy + m, oz + m);
-    m += end[a] - begin[a];
+    const std::uint32_t b = start[around[a]], e = start[around[a] + 1];
+    detail::copyRunByEights(g.x.data(), g.y.data(), g.z.data(), b, e, ox + m, oy + m, oz + m);
+    m += e - b;
   }
-  for (int l = 0; l < kScanLanes; ++l) ox[m + l] = oy[m + l] = oz[m + l] = kFar;
-  return static_cast<std::ptrdiff_t>(total);
+  static_assert(kScanLanes == 8, "the padding is one fillEight");
+  detail::fillEight(kFar, ox + m, oy + m, oz + m);
+  return static_cast<std::ptrdiff_t>(m);
 }
 
 // Moments relative to p of the candidates [0, n) within sqrt(radius2), weighted by a Gaussian

@@ -146,34 +146,10 @@ __attribute__((target("avx2,popcnt"))) std::size_t narrowAvx2(float* cand, std::
   return kept;
 }
 
-// selectMeanAvx2's drops and sum over NV vectors (a count known when compiled, so that the
-// vectors stay in registers): cand[0, c) with 8 (NV - 1) < c <= 8 NV, the lanes past c -inf.
+// The square roots of the lanes of v[0, NV) summed in double, 4 lanes at a time (the lanes at
+// -inf, dropped or padding, add 0), and the 4 sums added in pairs.
 template <std::size_t NV>
-__attribute__((target("avx2,popcnt,bmi"))) double dropAndSum(const float* cand, std::size_t c,
-                                                             std::size_t want, float& kth) {
-  const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256 lowest_v = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
-  __m256 v[NV];
-  for (std::size_t i = 0; i < NV; ++i) v[i] = _mm256_loadu_ps(cand + 8 * i);
-  const __m256i in_last = _mm256_cmpgt_epi32(
-      _mm256_set1_epi32(static_cast<int>(c - 8 * (NV - 1))), lane_index);
-  v[NV - 1] = _mm256_blendv_ps(lowest_v, v[NV - 1], _mm256_castsi256_ps(in_last));
-  __m256 top = lowest_v;
-  for (std::size_t drop = 0; drop <= c - want; ++drop) {
-    __m256 m = v[0];
-    for (std::size_t i = 1; i < NV; ++i) m = _mm256_max_ps(m, v[i]);
-    top = maxAllLanes(m);
-    if (drop == c - want) break;  // (top: the want-th, the largest left)
-    // One instance of the largest goes (ties: the others stay, as in a selection).
-    for (std::size_t i = 0; i < NV; ++i) {
-      const auto eq = static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(v[i], top, _CMP_EQ_OQ)));
-      if (eq == 0) continue;
-      const __m256i lane = _mm256_set1_epi32(static_cast<int>(__builtin_ctz(eq)));
-      v[i] = _mm256_blendv_ps(v[i], lowest_v, _mm256_castsi256_ps(_mm256_cmpeq_epi32(lane_index, lane)));
-      break;
-    }
-  }
-  // The dropped and the padding are -inf: 0 after the max with 0, adding nothing.
+__attribute__((target("avx2"))) inline double sumRoots(const __m256 (&v)[NV]) {
   const __m256 zero = _mm256_setzero_ps();
   __m256d sum = _mm256_setzero_pd();
   for (std::size_t i = 0; i < NV; ++i) {
@@ -181,14 +157,105 @@ __attribute__((target("avx2,popcnt,bmi"))) double dropAndSum(const float* cand, 
     sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(d))));
     sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(d, 1))));
   }
-  alignas(32) double lanes[4];
-  _mm256_store_pd(lanes, sum);
-  kth = _mm_cvtss_f32(_mm256_castps256_ps128(top));
-  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) / static_cast<double>(want - 1);
+  // ((l0 + l1) + (l2 + l3), in registers: no aligned stack array, no realigned frame.)
+  const __m128d pairs =
+      _mm_hadd_pd(_mm256_castpd256_pd128(sum), _mm256_extractf128_pd(sum, 1));
+  return _mm_cvtsd_f64(_mm_add_sd(pairs, _mm_unpackhi_pd(pairs, pairs)));
 }
 
-// By dropping the c - want largest one at a time (the candidates within the previous point's
-// bound exceed want by a few): each drop a maximum over a few vectors, no branch per candidate;
+// The largest lane of v[0, NV), in every lane.
+template <std::size_t NV>
+__attribute__((target("avx2"))) inline __m256 maxOf(const __m256 (&v)[NV]) {
+  __m256 m = v[0];
+  for (std::size_t i = 1; i < NV; ++i) m = _mm256_max_ps(m, v[i]);
+  return maxAllLanes(m);
+}
+
+// cand[0, c) into v[0, NV), 8 (NV - 1) < c <= 8 NV, the lanes past c -inf.
+template <std::size_t NV>
+__attribute__((target("avx2"))) inline void loadPadded(const float* cand, std::size_t c,
+                                                       __m256 (&v)[NV]) {
+  for (std::size_t i = 0; i < NV; ++i) v[i] = _mm256_loadu_ps(cand + 8 * i);
+  const __m256i in_last =
+      _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(c - 8 * (NV - 1))),
+                         _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  v[NV - 1] = _mm256_blendv_ps(_mm256_set1_ps(-std::numeric_limits<float>::infinity()),
+                               v[NV - 1], _mm256_castsi256_ps(in_last));
+}
+
+// selectMeanAvx2's drops and sum over NV vectors (a count known when compiled, so that the
+// vectors stay in registers): cand[0, c) with 8 (NV - 1) < c <= 8 NV, the lanes past c -inf.
+// Those beyond a bound near the incoming kth that keeps want go first, all at once; then the
+// largest go by value, every lane equal to the largest at once (a compare and a blend per
+// vector, no search for its lane); where that left fewer than want (a value among those
+// dropped twice, or the want-th's among them), they go again one instance at a time from the
+// start. Either way the lanes kept are the same, in the same places, so the sum is the same
+// bit for bit.
+// (Not inlined into selectMeanAvx2: the larger counts' spills would give every call their
+// realigned stack frame.)
+template <std::size_t NV>
+__attribute__((target("avx2,popcnt,bmi"), noinline)) double dropAndSum(const float* cand,
+                                                                       std::size_t c,
+                                                                       std::size_t want,
+                                                                       float& kth) {
+  const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256 lowest_v = _mm256_set1_ps(-std::numeric_limits<float>::infinity());
+  __m256 v[NV];
+  loadPadded(cand, c, v);
+  std::size_t drops = c - want;
+  if (drops > 3) {
+    // Those beyond a bound near the incoming kth (the previous point's) go at once where
+    // at least want lie within it: they are larger than the want-th.
+    const __m256 bound[2] = {_mm256_set1_ps(kth * 0.9f), _mm256_set1_ps(kth * 1.05f)};
+    std::size_t within[2] = {0, 0};
+    for (std::size_t i = 0; i < NV; ++i) {
+      for (int b = 0; b < 2; ++b) {
+        within[b] += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(
+            _mm256_movemask_ps(_mm256_cmp_ps(v[i], bound[b], _CMP_LE_OQ)))));
+      }
+    }
+    const std::size_t pad = 8 * NV - c;  // (the padding, -inf, lies within any bound)
+    const int b = within[0] >= want + pad ? 0 : 1;
+    if (within[b] >= want + pad) {
+      for (std::size_t i = 0; i < NV; ++i) {
+        v[i] = _mm256_blendv_ps(lowest_v, v[i], _mm256_cmp_ps(v[i], bound[b], _CMP_LE_OQ));
+      }
+      drops = within[b] - pad - want;
+    }
+  }
+  for (std::size_t drop = 0; drop < drops; ++drop) {
+    const __m256 top = maxOf(v);
+    for (std::size_t i = 0; i < NV; ++i) {
+      v[i] = _mm256_blendv_ps(v[i], lowest_v, _mm256_cmp_ps(v[i], top, _CMP_EQ_OQ));
+    }
+  }
+  std::size_t left = 0;
+  for (std::size_t i = 0; i < NV; ++i) {
+    left += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(
+        _mm256_movemask_ps(_mm256_cmp_ps(v[i], lowest_v, _CMP_NEQ_OQ)))));
+  }
+  if (left != want) {
+    loadPadded(cand, c, v);
+    for (std::size_t drop = 0; drop < c - want; ++drop) {
+      const __m256 top = maxOf(v);
+      // One instance of the largest goes (ties: the others stay, as in a selection).
+      for (std::size_t i = 0; i < NV; ++i) {
+        const auto eq =
+            static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(v[i], top, _CMP_EQ_OQ)));
+        if (eq == 0) continue;
+        const __m256i lane = _mm256_set1_epi32(static_cast<int>(__builtin_ctz(eq)));
+        v[i] = _mm256_blendv_ps(v[i], lowest_v,
+                                _mm256_castsi256_ps(_mm256_cmpeq_epi32(lane_index, lane)));
+        break;
+      }
+    }
+  }
+  kth = _mm_cvtss_f32(_mm256_castps256_ps128(maxOf(v)));  // (the want-th, the largest left)
+  return sumRoots(v) / static_cast<double>(want - 1);
+}
+
+// By dropping the c - want largest (the candidates within the previous point's bound exceed
+// want by a few): each drop a maximum over a few vectors, no branch per candidate;
 // then the square roots of the rest summed a vector at a time. Many candidates (the first
 // point of a thread, a point gathered within its block's margin): first narrowed to those
 // within a bound near the incoming kth (the previous point's), then, if still many, the

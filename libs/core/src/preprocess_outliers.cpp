@@ -34,6 +34,7 @@ struct PointGrid {
   float ox = 0, oy = 0, oz = 0;  // anchor
   detail::CellGrid cells;
   std::vector<std::uint32_t> start;  // n_cells + 1
+  std::uint32_t max_cell_points = 0;  // the most points in a cell
   std::vector<float> x, y, z;        // by cell (then kCopyLanes of slack)
   std::vector<std::uint32_t> index;  // by cell: the cloud's index
   std::vector<std::uint32_t> cell_of;  // (buildGrid's buffers)
@@ -122,6 +123,7 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   detail::listByCell(
       finite.size(), g.n_cells, [&](std::size_t f) { return cell_of[f]; }, by_cell);
   g.start.assign(by_cell.start.begin(), by_cell.start.end());
+  g.max_cell_points = by_cell.mostInACell();
   // (kCopyLanes of slack: BlockPoints::fill copies 8 at a time.)
   const std::size_t rows = finite.size() + kCopyLanes;
   g.x.resize(rows), g.y.resize(rows), g.z.resize(rows);
@@ -181,18 +183,17 @@ class NearestK {
   float d_[kMax];
 };
 
-// The points of a block of cells as one structure of arrays, padded to a multiple of 16 (cap)
-// with far-away points.
+// The points of a block of cells as one structure of arrays, padded to a multiple of 8 (cap,
+// gatherWithin's vectors) with far-away points.
 struct BlockPoints {
   std::vector<float> x, y, z;
   std::size_t n = 0, cap = 0;
   void fill(const PointGrid& g, const std::vector<std::uint32_t>& cells) {
-    n = 0;
-    for (const std::uint32_t c : cells) n += g.start[c + 1] - g.start[c];
-    cap = (n + 15) / 16 * 16;
-    if (x.size() < cap + kCopyLanes) {
-      x.resize(cap + kCopyLanes), y.resize(cap + kCopyLanes), z.resize(cap + kCopyLanes);
-    }
+    // (Room for the fullest cell's points in every cell, at most the grid, and the slack: no
+    // count of the block's points before the copy.)
+    const std::size_t room =
+        std::min(g.index.size(), cells.size() * std::size_t{g.max_cell_points}) + 2 * kCopyLanes;
+    if (x.size() < room) x.resize(room), y.resize(room), z.resize(room);
     float *bx = x.data(), *by = y.data(), *bz = z.data();
     std::size_t j = 0;
     for (const std::uint32_t c : cells) {
@@ -200,7 +201,10 @@ struct BlockPoints {
       detail::copyRunByEights(g.x.data(), g.y.data(), g.z.data(), b, e, bx + j, by + j, bz + j);
       j += e - b;
     }
-    for (; j < cap; ++j) bx[j] = by[j] = bz[j] = kFarPoint;  // (every point written once)
+    n = j;
+    cap = (n + 7) / 8 * 8;
+    // (Every point of the vectors written: the padding, 8 from n, in the slack.)
+    detail::fillEight(kFarPoint, bx + n, by + n, bz + n);
   }
 };
 

@@ -405,6 +405,12 @@ class VoxelPass {
       const std::uint64_t key = keys[col];
       if (key == kNoKey) {
         ++col;
+        // (Holes and the cut-off background come in runs: passed 4 at a time, where all 4 are
+        // kNoKey, that is where their AND is.)
+        while (col + 4 <= n &&
+               (keys[col] & keys[col + 1] & keys[col + 2] & keys[col + 3]) == kNoKey) {
+          col += 4;
+        }
         continue;
       }
       if (key != last_key_) {
