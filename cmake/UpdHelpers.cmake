@@ -4,8 +4,8 @@
 include(GNUInstallDirs)
 
 function(upd_set_warnings target)
-  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow=local
-                                           -Wno-deprecated-copy)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wno-deprecated-copy
+                                           $<$<CXX_COMPILER_ID:GNU>:-Wshadow=local>)
 endfunction()
 
 # upd_add_library(name): the library upd_<name> (alias upd::<name>) of the sources in

@@ -53,9 +53,11 @@ if [ "$scope" != all ]; then
 fi
 
 # Line tables only (-g1): a finding still names file and line, and the build takes about a
-# third less time than with full debug information.
+# third less time than with full debug information. clang 14, as for the fuzzers: it compiles
+# the instrumented code in a third to a half of gcc 12's time.
 cmake -S "$UPD_ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DUPD_BUILD_BENCH=OFF \
       -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
+      -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14 \
       -DUPD_SANITIZE=address,undefined "${launcher[@]}" "${shared[@]}" >/dev/null
 if ((${#targets[@]})); then
   # An optional library's tests (learn, freenect, ros) exist only when it was configured.

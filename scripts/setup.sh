@@ -18,7 +18,8 @@ PACKAGES=(build-essential cmake pkg-config
           python3  # scripts/results.sh formats docs/RESULTS.md; the layout and results tests
           ros-core libroscpp-dev librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
           libgeometry-msgs-dev libvisualization-msgs-dev libtf2-ros-dev libtf2-msgs-dev
-          clang-14 libclang-rt-14-dev)  # libFuzzer and the sanitizers: scripts/fuzz.sh, sanitize.sh
+          clang-14 libclang-rt-14-dev libomp-14-dev)  # libFuzzer and the sanitizers (clang's
+          # OpenMP): scripts/fuzz.sh, sanitize.sh
           # ros-core ... libtf2-msgs-dev: ROS 1, `upd ros` and bags (roscore: their tests)
 
 missing=()

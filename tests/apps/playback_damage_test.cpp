@@ -5,6 +5,7 @@
 // summary.json and exits 3; --strict, or damage before the first frame, exits 1 with nothing
 // written.
 #include "run_upd.h"
+#include "sanitizer.h"
 #include "temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -265,7 +266,7 @@ TEST(PlaybackDamage, FlippedByteInASensoryFrame) {
 // and the reader reports the object as damage in one line. Under AddressSanitizer the
 // allocation aborts the process instead (its operator new does not throw): skipped there.
 TEST(PlaybackDamage, AnObjectClaimingAnImpossibleSizeIsDamageNotACrash) {
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(UPD_TEST_UNDER_ASAN)
   GTEST_SKIP() << "under AddressSanitizer an impossible allocation aborts instead of throwing";
 #endif
   constexpr std::uint32_t kLasers = 4321;  // a count found by its value in the written bytes

@@ -8,6 +8,7 @@
 //
 // UPD_SOAK_FRAMES=N plays N frames instead (docs/RELIABILITY.md, "Long runs").
 #include "run_upd.h"
+#include "sanitizer.h"
 #include "temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -99,7 +100,7 @@ TEST(PlaybackSoak, MemoryIsFlatOnceTheCourseIsMapped) {
         maps_max, t["grid_bytes"].get<std::size_t>() + t["octree_bytes"].get<std::size_t>());
   }
   EXPECT_GT(rss0, 0u);
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(UPD_TEST_UNDER_ASAN)
   // An instrumented `upd` (this test is built as `upd` is): AddressSanitizer's quarantine and
   // padding move its resident memory by tens of MiB from sample to sample (572-612 MiB over
   // 10,000 frames), which measures the sanitizer's allocator, not the maps; their bytes are

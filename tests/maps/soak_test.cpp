@@ -3,6 +3,7 @@
 // the same kept tiles), and so does the process's peak memory; the maps written at the end
 // equal ones built in two halves with a save to a file (.ot, grid state) and a reload between.
 #include "maps/frames.h"
+#include "sanitizer.h"
 #include "temp_dir.h"
 #include "upd/maps/grid_fusion.h"
 #include "upd/maps/grid_state.h"
@@ -149,7 +150,7 @@ TEST(Soak, MemoryIsFlatOnceTheCourseIsMapped) {
   EXPECT_LE(grid_end, grid_bytes + grid_bytes / 20);  // within 5 %: the same cells, new values
   EXPECT_LE(tree.keptTiles(), tree_tiles + 1);
   EXPECT_LE(tree_end, tree_bytes + tree_bytes / 5);
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(UPD_TEST_UNDER_ASAN)
   // AddressSanitizer holds freed blocks in its quarantine (up to 256 MB) before reusing them and
   // pads every block: the process's peak then measures the sanitizer's allocator (it grew by
   // 9.8 MB of 470 MB here), not the maps, whose own bytes are checked above.

@@ -90,6 +90,10 @@ std::ostream& TraversabilityOcTreeNode::writeData(std::ostream& s) const {
 }
 
 std::istream& TraversabilityOcTreeNode::readData(std::istream& s) {
+  // A failed stream (the data ended early) stops the read here: OctoMap's readNodesRecurs goes
+  // on with the child bits it could not read, uninitialized, and would build nodes from them
+  // (an exponential number, whatever the stack held).
+  if (!s) throw std::ios_base::failure("the octree's data ends before its last node");
   s.read(reinterpret_cast<char*>(&value), sizeof(value));
   s.read(reinterpret_cast<char*>(&trav_logodds_), sizeof(trav_logodds_));
   s.read(reinterpret_cast<char*>(&zeta_min_), sizeof(zeta_min_));
@@ -376,7 +380,13 @@ std::unique_ptr<TraversabilityOcTree> readTraversabilityOt(const std::string& pa
   }
   if (!(res > 0) || size < 0) throw fail("the header has no valid 'res' and 'size'");
   auto tree = std::make_unique<TraversabilityOcTree>(res);
-  if (size > 0) tree->readData(in);
+  if (size > 0) {
+    try {
+      tree->readData(in);
+    } catch (const std::ios_base::failure&) {
+      in.setstate(std::ios::failbit);  // reported below with the nodes read
+    }
+  }
   if (!in || static_cast<long long>(tree->size()) != size) {
     throw fail("truncated or corrupt data (" + std::to_string(tree->size()) + " of " +
                std::to_string(size) + " nodes read)");
