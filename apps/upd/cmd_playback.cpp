@@ -9,6 +9,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "map_folder.h"
+#include "output_folder.h"
 #include "playback_bag.h"
 #include "playback_damage.h"
 #include "playback_merge.h"
@@ -518,7 +519,7 @@ int runPlayback(const std::vector<std::string>& argv) {
   // The window first: without a display nothing is written.
   auto view = options.view ? std::make_unique<PlaybackView>(options.rawlog) : nullptr;
   const Truth truth = loadTruth(options);
-  fs::create_directories(options.out_dir);
+  OutputFolder out_folder(options.out_dir);  // removed again, if empty, on an error below
   if (options.ply) fs::create_directories(options.out_dir / "frames");
 
   Playback run(config);
@@ -537,6 +538,7 @@ int runPlayback(const std::vector<std::string>& argv) {
   memory["trace"] = run.memory_trace.json();
   summary["memory"] = memory;
   io::writeJsonAtomically((options.out_dir / "summary.json").string(), summary);
+  out_folder.keep();
   printSummary(options, summary, config.evaluation.tolerance_m);
   if (run.view) run.view->waitUntilClosed();
   if (run.damage) {

@@ -112,18 +112,18 @@ TEST(NavObstacleSource, MapCellsReachTheirBorder) {
     }
     if (to_cells < 0.02) continue;  // inside or at the cells
     double to_points = 1e9;
-    for (const auto& p : src.pointsInRobot(pose)) to_points = std::min(to_points, p.norm());
+    for (const auto& q : src.pointsInRobot(pose)) to_points = std::min(to_points, q.norm());
     // Points every half cell along the border: the nearest is at most a quarter cell along the
     // border from the nearest point of the cells; the centre alone is half a cell farther.
     EXPECT_LE(to_points, std::hypot(to_cells, 0.5 * half) + 1e-6) << robot.transpose();
     EXPECT_GE(to_points, to_cells - 1e-6) << robot.transpose();
   }
   // The border lies on the cells: nothing beyond them.
-  for (const auto& p : src.pointsInRobot({0.0, 0.0, 0.0})) {
-    EXPECT_GE(p.x(), 1.0 - 1e-6);
-    EXPECT_LE(p.x(), 1.2 + 1e-6);
-    EXPECT_GE(p.y(), 0.0 - 1e-6);
-    EXPECT_LE(p.y(), 0.2 + 1e-6);
+  for (const auto& q : src.pointsInRobot({0.0, 0.0, 0.0})) {
+    EXPECT_GE(q.x(), 1.0 - 1e-6);
+    EXPECT_LE(q.x(), 1.2 + 1e-6);
+    EXPECT_GE(q.y(), 0.0 - 1e-6);
+    EXPECT_LE(q.y(), 0.2 + 1e-6);
   }
 }
 

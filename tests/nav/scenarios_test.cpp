@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -23,9 +24,10 @@ namespace fs = std::filesystem;
 class NavScenario : public ::testing::Test {
  protected:
   void SetUp() override {
-    cache_ = fs::temp_directory_path() /
-             ("upd_nav_scn_" + std::to_string(::getpid()) + "_" +
-              ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    // A parameterized test's name holds a '/': flattened, so that TearDown removes it all.
+    std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::replace(test.begin(), test.end(), '/', '_');
+    cache_ = fs::temp_directory_path() / ("upd_nav_scn_" + std::to_string(::getpid()) + "_" + test);
     const std::string cfg = std::string(UPD_SOURCE_DIR) + "/config";
     config_ = loadNavConfig(cfg + "/dune-kinect.ini", cfg + "/dune-nav.ini");
     config_.ptg_cache_dir = cache_.string();  // tests run in parallel: no shared cache
