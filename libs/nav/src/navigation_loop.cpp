@@ -134,10 +134,12 @@ const FrameEvidence& NavigationLoop::addFrame(const core::PointCloud& cloud_worl
     }
   }
   fuseNonTraversable(gx, gy, gz, robot_xy, time_s);
-  // Step edges: where the fused elevations jump by more than the robot can climb (the UPD
-  // smooths low edges away); fused as NonTraversable evidence (at the cell's elevation) and
-  // obstacles at once.
+  // Step edges and bumps: where the fused elevations jump by more than the robot can climb, or
+  // rise as a low smooth rock (the UPD smooths both away); fused as NonTraversable evidence (at
+  // the cell's elevation) and obstacles at once.
   last_step_edges_ = maps::findStepEdges(grid_, robot_xy, config_.step_edges);
+  const std::vector<Eigen::Vector2d> bumps = maps::findBumps(grid_, robot_xy, config_.step_edges);
+  last_step_edges_.insert(last_step_edges_.end(), bumps.begin(), bumps.end());
   std::vector<float> ex, ey, ez;
   for (const auto& c : last_step_edges_) {
     const maps::GridCell* cell = grid_.cellAt(c.x(), c.y());

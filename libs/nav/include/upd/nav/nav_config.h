@@ -108,8 +108,8 @@ void forEachNavSection(NavConfig& c, F&& f) {
   f("ObstacleParams", "Which labelled points become obstacles for the reactive navigator.",
     c.obstacles);
   f("NegativeObstacleParams", "Drops and holes seen as missing ground.", c.negative);
-  f("StepEdgeParams", "Step edges found on the grid's elevations (upd/maps/step_edges.h).",
-    c.step_edges);
+  f("StepEdgeParams",
+    "Step edges and bumps found on the grid's elevations (upd/maps/step_edges.h).", c.step_edges);
   f("RoutePlannerParams", "The global route over the traversability grid.", c.route);
   f("NavigatorParams",
     "MRPT's reactive navigator (its PTGs come from the file that `ptg_ini` names; "

@@ -5,7 +5,7 @@
 //  1. hands in the latest depth frame, already in the world frame (z up) at the base's current
 //     pose: addFrame() scores it (upd::FrameScorer: UPD or roughness index), fuses it into the traversability grid,
 //     adds the missing ground of its gaps (negative_obstacles.h) whose near side the map knows
-//     as traversable and the step edges of the map's elevations near the robot
+//     as traversable and the step edges and bumps of the map's elevations near the robot
 //     (upd/maps/step_edges.h) as NonTraversable evidence, and makes all these and the frame's
 //     NonTraversable points the "current frame" obstacles;
 //  2. calls step(): every replan_period_s the route planner searches the map for a route to the
@@ -98,7 +98,8 @@ class NavigationLoop {
   const maps::GridFusionStats& lastFusion() const { return last_fusion_; }
   /// Missing-ground points (world xy) the last frame added as obstacles.
   const std::vector<Eigen::Vector2d>& lastMissingGround() const { return last_missing_ground_; }
-  /// Step-edge cells (world xy) the last frame added as obstacles (upd/maps/step_edges.h).
+  /// Step-edge and bump cells (world xy) the last frame added as obstacles
+  /// (upd/maps/step_edges.h).
   const std::vector<Eigen::Vector2d>& lastStepEdges() const { return last_step_edges_; }
   /// The navigator (nullptr before navigateTo()).
   const Navigator* navigator() const { return navigator_.get(); }
