@@ -88,10 +88,6 @@ bool fitRing(const std::vector<Offset>& ring, const std::vector<double>& h,
   return plane.coef.allFinite();
 }
 
-}  // namespace
-
-namespace {
-
 // The bump check's cell offsets: the ground ring and the disc inside it, in cells.
 struct BumpShape {
   std::vector<Offset> ring;
