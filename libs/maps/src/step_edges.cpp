@@ -240,20 +240,9 @@ std::vector<Eigen::Vector2d> findStepEdges(const TraversabilityGrid& grid,
   if (!params.enabled) return out;
   const int nx = grid.sizeX(), ny = grid.sizeY();
   const double cell = grid.cellSize();
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  // Mean elevation of the window cell (cx, cy); NaN when outside or with too few points.
-  const auto height = [&](int cx, int cy) {
-    if (cx < 0 || cy < 0 || cx >= nx || cy >= ny) return nan;
-    const GridCell& c = grid.at(cx, cy);
-    return c.hits >= static_cast<std::uint32_t>(params.min_hits) && std::isfinite(c.elevation_m)
-               ? static_cast<double>(c.elevation_m)
-               : nan;
-  };
+  const auto height = [&](int cx, int cy) { return cellHeight(grid, cx, cy, params.min_hits); };
   int cx0, cy0;
-  if (!grid.cellIndex(std::clamp(centre_xy.x(), grid.xMin(), grid.xMax() - 0.5 * cell),
-                      std::clamp(centre_xy.y(), grid.yMin(), grid.yMax() - 0.5 * cell), cx0, cy0)) {
-    return out;
-  }
+  if (!centreCell(grid, centre_xy, cx0, cy0)) return out;
   const int reach = static_cast<int>(std::ceil(params.range_m / cell));
   const double r2 = params.range_m * params.range_m;
   constexpr int kDirs[2][2] = {{1, 0}, {0, 1}};
