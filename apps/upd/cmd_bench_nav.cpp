@@ -5,6 +5,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "nav_run_config.h"
+#include "output_folder.h"
 
 #include "upd/io/json_io.h"
 #include "upd/nav/bench.h"
@@ -114,7 +115,7 @@ int runBenchNav(const std::vector<std::string>& argv) {
   std::vector<nav::BenchRow> expected;
   if (o.expect) expected = nav::readBenchCsv(*o.expect);  // a bad file fails before the runs
   namespace fs = std::filesystem;
-  fs::create_directories(o.output);
+  OutputFolder out_folder(o.output);  // removed again, if empty, when the first world fails
   const nav::BenchParams params;
   std::vector<nav::BenchRow> rows;
   for (int k = 0; k < o.worlds; ++k) {
@@ -136,6 +137,7 @@ int runBenchNav(const std::vector<std::string>& argv) {
     nav::writeBenchCsv((fs::path(o.output) / "worlds.csv").string(), rows);
     io::writeJsonAtomically((fs::path(o.output) / "summary.json").string(),
                             nav::benchSummary(rows));
+    out_folder.keep();
     if (!o.quiet) printRow(k + 1, o.worlds, row);
   }
   const nlohmann::json s = nav::benchSummary(rows);

@@ -13,6 +13,7 @@
 #include "live_source.h"
 #include "live_view.h"
 #include "live_watchdog.h"
+#include "output_folder.h"
 #include "run_config.h"
 #include "stop_signal.h"
 
@@ -119,7 +120,7 @@ nlohmann::json stallJson(const SourceStall& s, double timeout_s) {
 void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTally& t,
                       const maps::TraversabilityGrid& grid, const maps::GridStats& stats) {
   namespace fs = std::filesystem;
-  fs::create_directories(dir);
+  OutputFolder folder(dir);  // removed again, if empty, when a file cannot be written
   maps::writeColourPng(grid, (fs::path(dir) / "map.png").string());
   maps::writeRosMap(grid, (fs::path(dir) / "map").string());
   nlohmann::json j;
@@ -149,6 +150,7 @@ void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTa
                       {"error_message", t.outcome.error_message}};
   }
   io::writeJsonAtomically((fs::path(dir) / "summary.json").string(), j);
+  folder.keep();
   std::printf("  outputs in %s\n", dir.c_str());
 }
 

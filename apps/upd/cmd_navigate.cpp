@@ -4,6 +4,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "nav_run_config.h"
+#include "output_folder.h"
 
 #include "upd/nav/nav_config.h"
 #include "upd/nav/scenario.h"
@@ -68,7 +69,7 @@ int runNavigate(const std::vector<std::string>& argv) {
   const bool quiet = args.flag("--quiet");
 
   const std::string navlog = (std::filesystem::path(*out) / "navigation.reactivenavlog").string();
-  std::filesystem::create_directories(*out);
+  OutputFolder out_folder(*out);  // removed again, if empty, when the run fails
   if (!quiet) {
     std::printf("%s (%s): start (%.2f, %.2f), goal (%.2f, %.2f)\n", scenario->c_str(),
                 nav::toString(detector), world.start_xy_yaw.x(), world.start_xy_yaw.y(),
@@ -88,6 +89,7 @@ int runNavigate(const std::vector<std::string>& argv) {
   const nav::ScenarioResult r =
       nav::runScenario(world, *scenario, config, detector, navlog, progress);
   nav::writeScenarioOutputs(r, world, config.body, *out);
+  out_folder.keep();
 
   std::printf(
       "%s (%s): %s after %.1f s (%d steps), %.2f m driven, %d collisions, "

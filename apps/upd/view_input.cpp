@@ -45,22 +45,10 @@ ViewInput readFolder(const fs::path& dir) {
   return in;
 }
 
-// "ColorOcTree" or "TraversabilityOcTree" from the header's id line; "" when it has none.
-std::string octreeId(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  for (int k = 0; k < 8 && std::getline(in, line); ++k) {
-    if (line.rfind("id ", 0) == 0) return line.substr(3);
-  }
-  return "";
-}
-
 // map.ot, the ColorOcTree every OctoMap tool reads: its colour is the traversability colour of
 // map.png (grey without evidence), so the label comes back from it; zeta and cost do not.
 void snapshotColourOctree(const std::string& path, nav::MapSnapshot& out, double p_nontrav_threshold = 0.65) {
-  std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(path));
-  auto* colour = dynamic_cast<octomap::ColorOcTree*>(tree.get());
-  if (colour == nullptr) throw std::runtime_error(path + ": cannot read it as an OctoMap ColorOcTree");
+  const std::unique_ptr<octomap::ColorOcTree> colour = maps::readColourOt(path);
   for (auto it = colour->begin_leafs(), end = colour->end_leafs(); it != end; ++it) {
     if (!colour->isNodeOccupied(*it)) continue;
     nav::MapVoxelView v;
@@ -83,7 +71,7 @@ ViewInput readViewInput(const std::string& path, const Eigen::Vector3f& up) {
   ViewInput in;
   if (io::lowerExtension(path) == ".ot") {
     in.is_map = true;
-    if (octreeId(path) == "ColorOcTree") snapshotColourOctree(path, in.map);
+    if (maps::readOtHeader(path).id == "ColorOcTree") snapshotColourOctree(path, in.map);
     else nav::snapshotOctree(*maps::readTraversabilityOt(path), in.map);
     if (in.map.voxels.empty()) throw std::runtime_error(path + ": the tree has no occupied voxel to draw");
     return in;

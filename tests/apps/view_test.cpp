@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace upd {
@@ -92,6 +93,27 @@ TEST_F(ViewTest, ViewerWindowShowsZetaThenLabelsAfterTheKey) {
   EXPECT_GT(l.red, 1000u) << "the obstacles";
   EXPECT_GT(10 * l.red, l.green) << "the obstacles' bands: over 10 % of the traversable pixels";
   EXPECT_LT(l.blue, 50u) << "no zeta colours after the key";
+}
+
+TEST_F(ViewTest, TruncatedMapOtIsOneLineAndNoFile) {
+  // map.ot (OctoMap's ColorOcTree) whole draws; cut short it is an error, not a partial map.
+  const std::string whole = dir_->file("out/map.ot");
+  const std::string png = dir_->file("map_ot.png");
+  const CmdResult ok = runUpd("render " + whole + " --output " + png);
+  ASSERT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_TRUE(fs::exists(png));
+  const std::string bytes = test::readFileBytes(whole);
+  for (const std::size_t keep : {bytes.size() / 2, bytes.size() - 3}) {
+    const std::string cut = dir_->file("cut.ot");
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, keep);
+    const std::string out = dir_->file("cut.png");
+    const CmdResult r = runUpd("render " + cut + " --output " + out);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_NE(r.output.find(cut), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("truncated"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 TEST(ViewInput, BadInputIsOneLineAndNoFile) {

@@ -373,6 +373,44 @@ TEST(TraversabilityOctree, ColourOtIsAColorOcTreeColouredByTraversability) {
   }
 }
 
+TEST(TraversabilityOctree, ColourOtReloadsWholeOrNotAtAll) {
+  const auto tree = sceneTree();
+  TempDir dir("colour_read");
+  const std::string path = dir.file("map.ot");
+  upd::maps::writeColourOt(*tree, path);
+
+  const upd::maps::OtHeader header = upd::maps::readOtHeader(path);
+  EXPECT_EQ(header.id, "ColorOcTree");
+  EXPECT_DOUBLE_EQ(header.resolution, tree->getResolution());
+  EXPECT_EQ(header.nodes, tree->size());
+  const auto whole = upd::maps::readColourOt(path);
+  EXPECT_EQ(whole->size(), tree->size());
+  EXPECT_EQ(occupiedLeaves(*whole), occupiedLeaves(*tree));
+
+  // A file cut anywhere in its nodes is an error naming the file and the nodes read, never a
+  // smaller or garbled map (OctoMap's own reader builds nodes from the bits it could not read).
+  const std::string full = upd::test::readFileBytes(path);
+  for (const double share : {0.1, 0.5, 0.9, 0.999}) {
+    const std::string cut_path = dir.file("cut.ot");
+    std::ofstream(cut_path, std::ios::binary)
+        << full.substr(0, static_cast<std::size_t>(share * double(full.size())));
+    try {
+      upd::maps::readColourOt(cut_path);
+      ADD_FAILURE() << "no exception at " << share;
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(cut_path), std::string::npos) << what;
+      EXPECT_NE(what.find("of " + std::to_string(tree->size()) + " nodes read"), std::string::npos)
+          << what;
+    }
+  }
+  // Another tree type is named.
+  const std::string trav = dir.file("trav.ot");
+  upd::maps::writeTraversabilityOt(*tree, trav);
+  EXPECT_EQ(upd::maps::readOtHeader(trav).id, "TraversabilityOcTree");
+  EXPECT_THROW(upd::maps::readColourOt(trav), std::runtime_error);
+}
+
 TEST(TraversabilityOctree, RealOctomapFileLoadsAndRoundTrips) {
   UPD_REQUIRE_SHARED_FILE(path, "octomap/geb079.bt");
   octomap::OcTree reference(path);

@@ -339,22 +339,22 @@ void writeColourOt(const TraversabilityOcTree& tree, const std::string& path) {
   });
 }
 
-std::unique_ptr<TraversabilityOcTree> readTraversabilityOt(const std::string& path) {
-  // The header is parsed here (as AbstractOcTree::readHeader does) rather than through
-  // AbstractOcTree::read, so that a wrong file gives one clear exception instead of OctoMap's
-  // messages on stderr.
-  const auto fail = [&](const std::string& why) {
-    return std::runtime_error("cannot read octree '" + path + "': " + why);
-  };
+namespace {
+
+std::runtime_error otError(const std::string& path, const std::string& why) {
+  return std::runtime_error("cannot read octree '" + path + "': " + why);
+}
+
+// Opens an .ot file and parses its header (as AbstractOcTree::readHeader does, without its
+// messages on stderr), leaving the stream at the first node.
+std::ifstream openOt(const std::string& path, OtHeader& header) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw fail("cannot open the file");
+  if (!in) throw otError(path, "cannot open the file");
   std::string line;
   std::getline(in, line);
   if (line.rfind("# Octomap OcTree file", 0) != 0) {
-    throw fail("not an OctoMap .ot file (first line '" + line.substr(0, 40) + "')");
+    throw otError(path, "not an OctoMap .ot file (first line '" + line.substr(0, 40) + "')");
   }
-  std::string id;
-  double res = 0;
   long long size = -1;
   bool data = false;
   std::string token;
@@ -362,9 +362,9 @@ std::unique_ptr<TraversabilityOcTree> readTraversabilityOt(const std::string& pa
     if (token == "data") {
       data = true;
     } else if (token == "id") {
-      in >> id;
+      in >> header.id;
     } else if (token == "res") {
-      in >> res;
+      in >> header.resolution;
     } else if (token == "size") {
       in >> size;
     }
@@ -373,25 +373,62 @@ std::unique_ptr<TraversabilityOcTree> readTraversabilityOt(const std::string& pa
       std::getline(in, line);  // rest of the line (comments; the newline before the data)
     }
   }
-  if (!data) throw fail("the header has no 'data' line");
-  if (id != "TraversabilityOcTree") {
-    throw fail("it holds a " + (id.empty() ? std::string("tree of no type") : id) +
-               ", not a TraversabilityOcTree");
+  if (!data) throw otError(path, "the header has no 'data' line");
+  if (!(header.resolution > 0) || size < 0) {
+    throw otError(path, "the header has no valid 'res' and 'size'");
   }
-  if (!(res > 0) || size < 0) throw fail("the header has no valid 'res' and 'size'");
-  auto tree = std::make_unique<TraversabilityOcTree>(res);
-  if (size > 0) {
+  header.nodes = static_cast<std::size_t>(size);
+  return in;
+}
+
+// Reads the header's number of nodes into `tree`; a file that ends early or holds another
+// number of nodes is an error. The stream throws at its end: OctoMap's readNodesRecurs would
+// otherwise go on with child bits it could not read (uninitialized) and build nodes from them.
+template <class Tree>
+void readOtNodes(const std::string& path, std::ifstream& in, const OtHeader& header, Tree& tree) {
+  bool ended = false;
+  if (header.nodes > 0) {
+    in.exceptions(std::ios::failbit | std::ios::badbit);
     try {
-      tree->readData(in);
+      tree.readData(in);
     } catch (const std::ios_base::failure&) {
-      in.setstate(std::ios::failbit);  // reported below with the nodes read
+      ended = true;  // reported below with the nodes read
     }
   }
-  if (!in || static_cast<long long>(tree->size()) != size) {
-    throw fail("truncated or corrupt data (" + std::to_string(tree->size()) + " of " +
-               std::to_string(size) + " nodes read)");
+  if (ended || tree.size() != header.nodes) {
+    throw otError(path, "truncated or corrupt data (" + std::to_string(tree.size()) + " of " +
+                            std::to_string(header.nodes) + " nodes read)");
   }
+}
+
+template <class Tree>
+std::unique_ptr<Tree> readOtOfType(const std::string& path, const std::string& type) {
+  OtHeader header;
+  std::ifstream in = openOt(path, header);
+  if (header.id != type) {
+    throw otError(path, "it holds a " +
+                            (header.id.empty() ? std::string("tree of no type") : header.id) +
+                            ", not a " + type);
+  }
+  auto tree = std::make_unique<Tree>(header.resolution);
+  readOtNodes(path, in, header, *tree);
   return tree;
+}
+
+}  // namespace
+
+OtHeader readOtHeader(const std::string& path) {
+  OtHeader header;
+  openOt(path, header);
+  return header;
+}
+
+std::unique_ptr<TraversabilityOcTree> readTraversabilityOt(const std::string& path) {
+  return readOtOfType<TraversabilityOcTree>(path, "TraversabilityOcTree");
+}
+
+std::unique_ptr<octomap::ColorOcTree> readColourOt(const std::string& path) {
+  return readOtOfType<octomap::ColorOcTree>(path, "ColorOcTree");
 }
 
 }  // namespace upd::maps

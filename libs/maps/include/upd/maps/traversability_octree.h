@@ -46,6 +46,10 @@
 #include <memory>
 #include <string>
 
+namespace octomap {
+class ColorOcTree;
+}
+
 namespace upd::maps {
 
 class TraversabilityOcTree;
@@ -254,8 +258,20 @@ void writeOccupancyBt(const TraversabilityOcTree& tree, const std::string& path)
 /// A ColorOcTree .ot with the same structure and occupancy, coloured as the grid PNG (green
 /// traversable -> red non-traversable, grey without evidence): what octovis can show.
 void writeColourOt(const TraversabilityOcTree& tree, const std::string& path);
+/// An .ot file's header: the tree type (OctoMap's id line), the resolution and the node count.
+struct OtHeader {
+  std::string id;
+  double resolution = 0;
+  std::size_t nodes = 0;
+};
+/// Reads the header of an .ot file (without reading its nodes, and without OctoMap's messages
+/// on stderr). Throws std::runtime_error naming the file when it is not an OctoMap .ot.
+OtHeader readOtHeader(const std::string& path);
 /// Reads a .ot written by writeTraversabilityOt. Throws std::runtime_error naming the file when
-/// it cannot be read or holds another tree type.
+/// it cannot be read, holds another tree type, or ends before the header's number of nodes.
 std::unique_ptr<TraversabilityOcTree> readTraversabilityOt(const std::string& path);
+/// Reads a ColorOcTree .ot (writeColourOt's map.ot, or another OctoMap tool's), with the same
+/// checks as readTraversabilityOt.
+std::unique_ptr<octomap::ColorOcTree> readColourOt(const std::string& path);
 
 }  // namespace upd::maps
