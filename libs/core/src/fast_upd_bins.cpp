@@ -32,8 +32,10 @@ void toLattice(const float* __restrict x, const float* __restrict y, const float
     const float gx = lat.gx(x[j]), gy = lat.gy(y[j]), gz = lat.gz(z[j]);
     // NaN and infinity fail this test too. (& rather than &&, floors as floats, everything
     // loaded and computed before it is selected: no branch, so the loop vectorizes.)
-    const bool inside =
-        (std::fabs(gx) < kMaxCoord) & (std::fabs(gy) < kMaxCoord) & (std::fabs(gz) < kMaxCoord);
+    // (The tests cast to int: clang's -Wbitwise-instead-of-logical, the same code.)
+    const bool inside = (static_cast<int>(std::fabs(gx) < kMaxCoord) &
+                         static_cast<int>(std::fabs(gy) < kMaxCoord) &
+                         static_cast<int>(std::fabs(gz) < kMaxCoord)) != 0;
     const float fx = std::floor(gx), fy = std::floor(gy), fz = std::floor(gz);
     const float ax = nx[j], ay = ny[j], az = nz[j];
     const bool valid = ax == ax;
