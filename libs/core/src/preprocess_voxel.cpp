@@ -477,9 +477,9 @@ class VoxelPass {
 // voxelize with the calling thread's scratch s (a function of its own, kept from inlining and
 // from specializing on its argument: GCC computes a thread_local's address again, by a call
 // into the dynamic linker, at each use in a function that names it).
-__attribute__((noipa)) CropCounts voxelizeWith(VoxelScratch& s, const PointCloud& in,
-                                               double voxel_m, const RangeBoxTest* test,
-                                               PointCloud& out) {
+UPD_NOIPA CropCounts voxelizeWith(VoxelScratch& s, const PointCloud& in,
+                                  double voxel_m, const RangeBoxTest* test,
+                                  PointCloud& out) {
   out.sensor_origin = in.sensor_origin;
   std::size_t finite_before = 0;
   const std::size_t first = firstPassing(in, test, finite_before);
