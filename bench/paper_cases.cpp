@@ -191,9 +191,10 @@ core::PipelineParams sensorRateParams(const Eigen::Vector3f& up) {
   p.preprocess.range_min_m = 0.4;
   p.preprocess.range_max_m = 5.0;
   p.normals.radius_m = 0.1;
-  p.normals.fast_scan_px = 24;
+  p.normals.fast_scan_px = 40;
   p.upd.radius_m = 0.5;
-  p.upd.fast_cells_per_point = 0;
+  p.upd.fast_cells_per_radius = 5;
+  p.upd.fast_cells_per_point = 0.007;
   p.classify.zeta_min = 0.95;
   p.classify.zeta_caution = 0.99;
   p.classify.max_slope_rad = 25.0 * core::kDegToRad;

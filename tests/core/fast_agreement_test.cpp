@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "exact_agreement.h"
@@ -384,20 +385,31 @@ TEST(FastUpd, FinerLatticeKeepsItsCellsWithinTheBudget) {
   EXPECT_EQ(finerCellsPerRadius(4, 100, 0, 0.015), 4);        // no valid normal: as given
 }
 
+// Rocks sampled every 1 cm (~100 points per occupied 12.5 cm cell), 2 mm noise.
+Scene denseRocks() {
+  SceneParams sp;
+  sp.spacing_m = 0.01;
+  sp.noise_m = 0.002;
+  return makeScene("rocks", sp);
+}
+
+// d_m 0.5 m at 4 cells per d_m on any cloud.
+UpdParams fixedLattice() {
+  UpdParams p;
+  p.radius_m = 0.5;
+  p.fast_cells_per_point = 0;
+  return p;
+}
+
 TEST(FastUpd, DenseCloudsGetAFinerLatticeAndCloserSums) {
   // Rocks sampled every 1 cm (~100 points per occupied 12.5 cm cell) under a budget of 0.03
   // cells per point: a finer lattice, and sums closer to exact. Sampled every 2 cm (~25 points
   // per cell), they keep 4 cells per d_m. (Not every scene improves at every step: an
   // axis-aligned step's error depends on where the cell faces fall, and at 5 or 6 cells per
   // d_m it is larger than at 4; from 7 on it is smaller. Rocks and ramps improve steadily.)
-  SceneParams sp;
-  sp.spacing_m = 0.01;
-  sp.noise_m = 0.002;
-  const Scene dense = makeScene("rocks", sp);
+  const Scene dense = denseRocks();
   const Normals normals = exactNormals(dense);
-  UpdParams fixed;
-  fixed.radius_m = 0.5;
-  fixed.fast_cells_per_point = 0;
+  const UpdParams fixed = fixedLattice();
   UpdParams budget = fixed;
   budget.fast_cells_per_point = 0.03;
   FastUpdStats fs, bs;
@@ -417,6 +429,34 @@ TEST(FastUpd, DenseCloudsGetAFinerLatticeAndCloserSums) {
   FastUpdStats ss;
   computeUpdFast(sparse.cloud, exactNormals(sparse), budget, &ss);
   EXPECT_EQ(ss.cells_per_radius, 4);
+}
+
+TEST(FastUpd, LatticeIsChosenByTheRuleOnTheBaseLatticesCells) {
+  // The refinement is decided by counting the base lattice's cells, a sample first, without
+  // binning there: for budgets on either side of each step, the lattice is the rule's on the
+  // cells of a run at the base lattice, and the result is a run at that lattice's, bit for bit.
+  const Scene dense = denseRocks();
+  const Normals normals = exactNormals(dense);
+  const UpdParams fixed = fixedLattice();
+  FastUpdStats fs;
+  computeUpdFast(dense.cloud, normals, fixed, &fs);
+  const double valid = static_cast<double>(dense.cloud.size() - normals.invalid);
+  for (const double budget : {0.002, 0.008, 0.012, 0.02, 0.03, 0.1}) {
+    SCOPED_TRACE(budget);
+    UpdParams p = fixed;
+    p.fast_cells_per_point = budget;
+    FastUpdStats ps;
+    const UpdResult r = computeUpdFast(dense.cloud, normals, p, &ps);
+    const int m = finerCellsPerRadius(4, fs.cells, valid, budget);
+    EXPECT_EQ(ps.cells_per_radius, m);
+    UpdParams at_m = fixed;
+    at_m.fast_cells_per_radius = m;
+    const UpdResult e = computeUpdFast(dense.cloud, normals, at_m);
+    ASSERT_EQ(r.size(), e.size());
+    EXPECT_EQ(std::memcmp(r.zeta.data(), e.zeta.data(), r.zeta.size() * sizeof(float)), 0);
+    EXPECT_EQ(std::memcmp(r.rx.data(), e.rx.data(), r.rx.size() * sizeof(float)), 0);
+    EXPECT_EQ(r.k, e.k);
+  }
 }
 
 TEST(FastPaths, DegenerateInputsGiveNaNAndCounts) {

@@ -49,6 +49,7 @@ bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature);
 typedef float LaneF __attribute__((vector_size(kScanLanes * sizeof(float))));
 
 typedef float LaneQ __attribute__((vector_size(4 * sizeof(float))));
+typedef std::int32_t LaneI __attribute__((vector_size(kScanLanes * sizeof(std::int32_t))));
 
 inline void loadLanes(LaneF& v, const float* p) { std::memcpy(&v, p, sizeof v); }
 
@@ -62,8 +63,9 @@ UPD_VECTOR_CLONES
                             std::ptrdiff_t v0, std::ptrdiff_t v1, std::ptrdiff_t a0,
                             std::ptrdiff_t a1, std::ptrdiff_t row_step, float px, float py,
                             float pz, float radius2) {
-  const LaneF zero = {}, one = zero + 1.f;
-  LaneF n = zero, sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero,
+  const LaneF zero = {};
+  LaneI count = {};
+  LaneF sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero,
         syz = zero, szz = zero;
   for (std::ptrdiff_t b = v0; b <= v1; b += row_step) {
     const std::size_t row = static_cast<std::size_t>(b) * W;
@@ -73,9 +75,15 @@ UPD_VECTOR_CLONES
       loadLanes(x, X + at), loadLanes(y, Y + at), loadLanes(z, Z + at);
       const LaneF qx = x - px, qy = y - py, qz = z - pz;
       const LaneF d2 = qx * qx + qy * qy + qz * qz;
-      const LaneF w = d2 <= radius2 ? one : zero;
-      const LaneF cx = w * qx, cy = w * qy, cz = w * qz;
-      n += w, sx += cx, sy += cy, sz += cz;
+      // The points within the radius: all bits set in their lanes. The count as integers
+      // (one subtraction instead of a mask to 1.0 and an add) and q masked to +0 outside (the
+      // product with a 0 / 1 weight gave -0 for a negative q): each sum gets the same values
+      // and the same zeros, which leave it as it is, so the moments are the same bit for bit.
+      const LaneI in = d2 <= radius2;
+      const LaneF cx = (LaneF)((LaneI)qx & in), cy = (LaneF)((LaneI)qy & in),
+                  cz = (LaneF)((LaneI)qz & in);
+      count -= in;
+      sx += cx, sy += cy, sz += cz;
       sxx += cx * qx, sxy += cx * qy, sxz += cx * qz, syy += cy * qy, syz += cy * qz,
           szz += cz * qz;
     }
@@ -99,6 +107,7 @@ UPD_VECTOR_CLONES
   const auto four = [&](const LaneF& a, const LaneF& b, const LaneF& c, const LaneF& d) {
     return pairs(pairs(half(a), half(b)), pairs(half(c), half(d)));
   };
+  const LaneF n = __builtin_convertvector(count, LaneF);  // exact: counts below 2^24
   const LaneQ t0 = four(n, sx, sy, sz), t1 = four(sxx, sxy, sxz, syy);
   const LaneQ t2 = pairs(pairs(half(syz), half(szz)), LaneQ{});
   Moments m;

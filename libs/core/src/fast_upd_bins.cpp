@@ -32,8 +32,10 @@ void toLattice(const float* __restrict x, const float* __restrict y, const float
     const float gx = lat.gx(x[j]), gy = lat.gy(y[j]), gz = lat.gz(z[j]);
     // NaN and infinity fail this test too. (& rather than &&, floors as floats, everything
     // loaded and computed before it is selected: no branch, so the loop vectorizes.)
-    const bool inside =
-        (std::fabs(gx) < kMaxCoord) & (std::fabs(gy) < kMaxCoord) & (std::fabs(gz) < kMaxCoord);
+    // (The tests cast to int: clang's -Wbitwise-instead-of-logical, the same code.)
+    const bool inside = (static_cast<int>(std::fabs(gx) < kMaxCoord) &
+                         static_cast<int>(std::fabs(gy) < kMaxCoord) &
+                         static_cast<int>(std::fabs(gz) < kMaxCoord)) != 0;
     const float fx = std::floor(gx), fy = std::floor(gy), fz = std::floor(gz);
     const float ax = nx[j], ay = ny[j], az = nz[j];
     const bool valid = ax == ax;
@@ -147,25 +149,110 @@ Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& l
   return bins;
 }
 
+// The occupied cells of lattice lat and the points with a valid normal in them (binRange's
+// cells and the sum of their counts), over every step-th stripe of kStripe points from first:
+// step 1 counts every point; a larger step gives a lower bound of the cells.
+struct CellCount {
+  std::size_t cells = 0;
+  double valid = 0;
+};
+
+// A stripe's cells as countCells reads them: each point's cell (cx = kOutside as in toLattice)
+// and whether it differs from the point before's (prev: the cell before the stripe).
+struct CellStripe {
+  float cx[kStripe + 1], cy[kStripe + 1], cz[kStripe + 1];
+  std::uint8_t change[kStripe];
+};
+
+UPD_VECTOR_CLONES
+std::uint32_t cellChanges(const float* __restrict x, const float* __restrict y,
+                          const float* __restrict z, const float* __restrict nx,
+                          const Lattice& lat, std::size_t n, CellStripe& __restrict s) {
+  std::uint32_t valid = 0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const float gx = lat.gx(x[j]), gy = lat.gy(y[j]), gz = lat.gz(z[j]);
+    // (toLattice's test and floors: the same cells.)
+    const bool inside = (static_cast<int>(std::fabs(gx) < kMaxCoord) &
+                         static_cast<int>(std::fabs(gy) < kMaxCoord) &
+                         static_cast<int>(std::fabs(gz) < kMaxCoord)) != 0;
+    s.cx[j + 1] = inside ? std::floor(gx) : kOutside;
+    s.cy[j + 1] = std::floor(gy), s.cz[j + 1] = std::floor(gz);
+    valid += static_cast<std::uint32_t>(inside) & static_cast<std::uint32_t>(nx[j] == nx[j]);
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    const bool same = (static_cast<int>(s.cx[j + 1] == s.cx[j]) &
+                       static_cast<int>(s.cy[j + 1] == s.cy[j]) &
+                       static_cast<int>(s.cz[j + 1] == s.cz[j])) != 0;
+    s.change[j] = static_cast<std::uint8_t>(static_cast<int>(!same) &
+                                            static_cast<int>(s.cx[j + 1] != kOutside));
+  }
+  return valid;
+}
+
+CellCount countCells(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+                     std::size_t first, std::size_t step) {
+  static thread_local CellStripe s;
+  CellGrid grid;
+  CellCount count;
+  std::size_t valid = 0;
+  s.cx[0] = kOutside, s.cy[0] = s.cz[0] = 0.f;
+  const std::size_t n_pts = cloud.size();
+  for (std::size_t s0 = first; s0 < n_pts; s0 += step * kStripe) {
+    const std::size_t n = std::min(kStripe, n_pts - s0);
+    valid += cellChanges(&cloud.x[s0], &cloud.y[s0], &cloud.z[s0], &normals.nx[s0], lat, n, s);
+    for (std::size_t j = 0; j < n; ++j) {
+      if (!s.change[j]) continue;
+      bool inserted = false;
+      grid.insert(static_cast<std::int32_t>(s.cx[j + 1]), static_cast<std::int32_t>(s.cy[j + 1]),
+                  static_cast<std::int32_t>(s.cz[j + 1]), inserted);
+    }
+    // The stripe's last cell is the next one's previous (an outside point's too: kOutside).
+    s.cx[0] = s.cx[n], s.cy[0] = s.cy[n], s.cz[0] = s.cz[n];
+  }
+  count.cells = grid.size();
+  count.valid = static_cast<double>(valid);
+  return count;
+}
+
+// Every 4th stripe: on a frame far from the refinement budget (most cells seen by a quarter of
+// the image) the lower bound settles it for ~a tenth of a count of every point.
+constexpr std::size_t kSampleStep = 4;
+
+// The lattice's cells per d_m under fast_cells_per_point: finerCellsPerRadius on the cells and
+// valid points binning at f.m would give, found without binning. The cells of a sample and
+// the points with any valid normal bound the rule from the side of no refinement (it refines
+// less with more cells or fewer points): where they already keep f.m, so does every point's
+// count; otherwise every point is counted.
+int latticeCells(const FastFrame& f) {
+  const double cells_per_point = f.params.fast_cells_per_point;
+  const std::size_t first = f.chunks.first, n_pts = f.cloud.size();
+  std::size_t with_normal = 0;
+  const float* nx = f.normals.nx.data();
+  for (std::size_t i = first; i < n_pts; ++i) with_normal += nx[i] == nx[i] ? 1 : 0;
+  const CellCount sample = countCells(f.cloud, f.normals, f.lat, first, kSampleStep);
+  if (finerCellsPerRadius(f.m, sample.cells, static_cast<double>(with_normal),
+                          cells_per_point) == f.m) {
+    return f.m;
+  }
+  const CellCount all = countCells(f.cloud, f.normals, f.lat, first, 1);
+  return finerCellsPerRadius(f.m, all.cells, all.valid, cells_per_point);
+}
+
 }  // namespace
 
 Bins binFrame(FastFrame& f) {
   const double radius_m = f.params.radius_m;
-  Bins bins = binPoints(f.cloud, f.normals, f.lat, f.chunks, radius_m, f.cell_of);
   // A finer lattice where the points are dense (fast_cells_per_point): the node work grows
-  // with the cells, so it stays a fixed share of the per-point work.
+  // with the cells, so it stays a fixed share of the per-point work. Decided by counting the
+  // cells, so that the points are binned once.
   if (f.params.fast_cells_per_point > 0) {
-    double valid = 0;
-    for (const CellSums& cs : bins.sums) valid += cs.count;
-    const int finer =
-        finerCellsPerRadius(f.m, bins.sums.size(), valid, f.params.fast_cells_per_point);
+    const int finer = latticeCells(f);
     if (finer > f.m) {
       f.m = finer;
       f.lat.inv_cell = static_cast<float>(f.m / radius_m);
-      bins = binPoints(f.cloud, f.normals, f.lat, f.chunks, radius_m, f.cell_of);
     }
   }
-  return bins;
+  return binPoints(f.cloud, f.normals, f.lat, f.chunks, radius_m, f.cell_of);
 }
 
 }  // namespace upd::core::detail

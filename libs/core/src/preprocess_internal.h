@@ -10,6 +10,14 @@
 #include "upd/core/point_cloud.h"
 #include "upd/core/preprocess.h"
 
+// A function kept out of its callers and from being specialized on its arguments: GCC's noipa;
+// clang has no such attribute (it warns and ignores it), noinline is its nearest.
+#if defined(__clang__)
+#define UPD_NOIPA __attribute__((noinline))
+#else
+#define UPD_NOIPA __attribute__((noipa))
+#endif
+
 namespace upd::core::detail {
 
 /// The test of cropRange for a finite point q: within the range of the sensor origin and inside

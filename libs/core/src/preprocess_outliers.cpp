@@ -390,10 +390,10 @@ class CellSearch {
 // points not settled within 3 rings to rest. (A function of its own, kept from inlining and
 // from specializing on its argument: the caller's search is a thread_local, whose address GCC
 // computes again, by a call into the dynamic linker, at each use in a function that names it.)
-__attribute__((noipa)) void searchCells(CellSearch& search, const PointGrid& g,
-                                           std::size_t c0, std::size_t c1,
-                                           std::vector<double>& mean_dist,
-                                           std::vector<std::uint32_t>& rest) {
+UPD_NOIPA void searchCells(CellSearch& search, const PointGrid& g,
+                           std::size_t c0, std::size_t c1,
+                           std::vector<double>& mean_dist,
+                           std::vector<std::uint32_t>& rest) {
   for (std::size_t c = c0; c < c1; ++c) {
     search.startCell(c);
     for (std::uint32_t q = g.start[c]; q < g.start[c + 1]; ++q) {
@@ -496,11 +496,11 @@ std::vector<double> meanNeighbourDistances(const PointCloud& in, int k) {
 namespace {
 // meanNeighbourDistances with the calling thread's buffers (a function of its own: see
 // searchCells).
-__attribute__((noipa)) void meanNeighbourDistances(const PointCloud& in, int k,
-                                                      std::vector<double>& mean_dist,
-                                                      std::vector<std::uint32_t>& finite,
-                                                      std::vector<std::uint32_t>& rest,
-                                                      PointGrid& g) {
+UPD_NOIPA void meanNeighbourDistances(const PointCloud& in, int k,
+                                      std::vector<double>& mean_dist,
+                                      std::vector<std::uint32_t>& finite,
+                                      std::vector<std::uint32_t>& rest,
+                                      PointGrid& g) {
   mean_dist.assign(in.size(), std::numeric_limits<double>::quiet_NaN());
   finite.clear();
   for (std::size_t i = 0; i < in.size(); ++i) {

@@ -35,9 +35,16 @@ inline std::int32_t floorClamped(double v) {
 
 // Finite, and kept by the range and box tests of k: RangeBoxTest's arithmetic, branch-free
 // (& instead of &&), so that the loops calling it vectorize.
-inline bool passes(float fx, float fy, float fz, const KeyPassParams& k) {
+// All three finite, as 0 or 1: the tests joined by & on ints, not on bools (clang's
+// -Wbitwise-instead-of-logical; the same code as & on the bools).
+inline int finite3(float fx, float fy, float fz) {
   constexpr float kMaxF = std::numeric_limits<float>::max();
-  const bool finite = (std::abs(fx) <= kMaxF) & (std::abs(fy) <= kMaxF) & (std::abs(fz) <= kMaxF);
+  return static_cast<int>(std::abs(fx) <= kMaxF) & static_cast<int>(std::abs(fy) <= kMaxF) &
+         static_cast<int>(std::abs(fz) <= kMaxF);
+}
+
+inline bool passes(float fx, float fy, float fz, const KeyPassParams& k) {
+  const bool finite = finite3(fx, fy, fz) != 0;
   const auto sx = static_cast<double>(fx - k.ox), sy = static_cast<double>(fy - k.oy),
              sz = static_cast<double>(fz - k.oz);
   const double d2 = (sx * sx + sy * sy) + sz * sz;  // (Eigen's squaredNorm of 3: the same)
@@ -53,13 +60,12 @@ bool voxelKeysLoop(const float* __restrict x, const float* __restrict y, const f
                std::size_t n, const KeyPassParams& k, std::uint64_t* __restrict keys,
                std::size_t& finite) {
   constexpr std::int32_t kBias = static_cast<std::int32_t>(kKeyBias);
-  constexpr float kMaxF = std::numeric_limits<float>::max();
   std::uint32_t bad = 0;
   std::size_t finite_count = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const float fx = x[j], fy = y[j], fz = z[j];
     const bool pass = passes(fx, fy, fz, k);
-    finite_count += (std::abs(fx) <= kMaxF) & (std::abs(fy) <= kMaxF) & (std::abs(fz) <= kMaxF);
+    finite_count += static_cast<std::size_t>(finite3(fx, fy, fz));
     const std::int32_t cx = floorClamped((static_cast<double>(fx) - k.ref_x) * k.inv);
     const std::int32_t cy = floorClamped((static_cast<double>(fy) - k.ref_y) * k.inv);
     const std::int32_t cz = floorClamped((static_cast<double>(fz) - k.ref_z) * k.inv);
@@ -81,13 +87,12 @@ UPD_VECTOR_CLONES
 CropCounts cropCopyLoop(const float* __restrict x, const float* __restrict y,
                         const float* __restrict z, std::size_t n, const KeyPassParams& k,
                         float* __restrict ox, float* __restrict oy, float* __restrict oz) {
-  constexpr float kMaxF = std::numeric_limits<float>::max();
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::size_t finite_count = 0, kept = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const float fx = x[j], fy = y[j], fz = z[j];
     const bool pass = passes(fx, fy, fz, k);
-    finite_count += (std::abs(fx) <= kMaxF) & (std::abs(fy) <= kMaxF) & (std::abs(fz) <= kMaxF);
+    finite_count += static_cast<std::size_t>(finite3(fx, fy, fz));
     kept += pass ? 1 : 0;
     ox[j] = pass ? fx : nan;
     oy[j] = pass ? fy : nan;
@@ -472,9 +477,9 @@ class VoxelPass {
 // voxelize with the calling thread's scratch s (a function of its own, kept from inlining and
 // from specializing on its argument: GCC computes a thread_local's address again, by a call
 // into the dynamic linker, at each use in a function that names it).
-__attribute__((noipa)) CropCounts voxelizeWith(VoxelScratch& s, const PointCloud& in,
-                                               double voxel_m, const RangeBoxTest* test,
-                                               PointCloud& out) {
+UPD_NOIPA CropCounts voxelizeWith(VoxelScratch& s, const PointCloud& in,
+                                  double voxel_m, const RangeBoxTest* test,
+                                  PointCloud& out) {
   out.sensor_origin = in.sensor_origin;
   std::size_t finite_before = 0;
   const std::size_t first = firstPassing(in, test, finite_before);

@@ -37,11 +37,12 @@
 // normal is equal, so r = k n exactly and zeta = 1 at any slope. UpdResult::k is the
 // interpolated count rounded to an integer.
 //
-// A finer lattice where the points are dense (fast_cells_per_point, default 0.015): the points
-// are binned at fast_cells_per_radius first; if the occupied cells number well below
-// fast_cells_per_point per point with a valid normal, the lattice is rebinned at the largest
+// A finer lattice where the points are dense (fast_cells_per_point, default 0.015): the cells
+// the points occupy at fast_cells_per_radius are counted first (in a sample of the points, then,
+// unless the sample already has too many, in all of them); if they number well below
+// fast_cells_per_point per point with a valid normal, the points are binned at the largest
 // number of cells per d_m, up to twice fast_cells_per_radius, whose cells (estimated as a
-// surface's: growing as its square) stay within that budget. The node work, which follows the
+// surface's: growing as its square) stay within that budget, else at fast_cells_per_radius. The node work, which follows the
 // cells, then stays a fixed share of the per-point work, so the cost per point still does not
 // grow with d_m; what grows is the accuracy where a frame is dense. A full-resolution Kinect frame
 // of a near scene (region_growing: ~350 points per 12.5 cm cell) gets 8 cells per d_m, and its
