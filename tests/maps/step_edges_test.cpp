@@ -222,12 +222,52 @@ TEST(Bumps, PebblesPlanesRampsPlatformsAndRoughGroundAreNoBumps) {
       {"15 cm platform 2 x 2 m", [](double x, double y) {
          return std::abs(x - 1.5) < 1.0 && std::abs(y) < 1.0 ? 0.15 : 0.0;
        }},
+      {"8 cm step", [](double x, double) { return x > 1.03 ? 0.08 : 0.0; }},
+      {"ditch 0.6 m wide, 20 cm deep",
+       [](double x, double) { return std::abs(x - 1.2) < 0.3 ? -0.2 : 0.0; }},
       {"1 cm waves", [](double x, double y) {
          return 0.01 * std::sin(2 * kPi * x) + 0.01 * std::sin(2 * kPi * (0.6 * x + 0.8 * y) + 1.0);
        }},
   };
   for (const auto& [name, h] : scenes) {
     EXPECT_TRUE(findBumps(gridOfMeans(h), {0.0, 0.0}, params()).empty()) << name;
+  }
+}
+
+TEST(Bumps, TheBorderReachesBumpBorderMetresBeyondTheBumpsCells) {
+  // The body: the cells standing bump_edge_m above the ground; the border: cells whose centre
+  // lies within bump_border_m of a body cell's centre, and no others.
+  const Dome d{1.0, 0.3, 0.3, 0.2, 0.5, 0.07};
+  const auto grid = gridOfMeans([&](double x, double y) { return d.height(x, y); });
+  for (const double border : {0.0, 0.1, 0.15}) {
+    StepEdgeParams p = params();
+    p.bump_border_m = border;
+    const auto bumps = findBumps(grid, {0.0, 0.0}, p);
+    std::vector<Eigen::Vector2d> body;
+    for (int cy = 0; cy < grid.sizeY(); ++cy) {
+      for (int cx = 0; cx < grid.sizeX(); ++cx) {
+        if (grid.at(cx, cy).elevation_m > p.bump_edge_m) body.push_back(grid.cellCenter(cx, cy));
+      }
+    }
+    ASSERT_GE(body.size(), 4u);
+    for (const auto& c : body) EXPECT_TRUE(contains(bumps, c)) << border << ": " << c.transpose();
+    for (const auto& b : bumps) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const auto& c : body) nearest = std::min(nearest, (b - c).norm());
+      EXPECT_LE(nearest, border + 1e-6) << border << ": " << b.transpose();
+    }
+    // Every cell within the border of the body is marked.
+    for (int cy = 0; cy < grid.sizeY(); ++cy) {
+      for (int cx = 0; cx < grid.sizeX(); ++cx) {
+        const Eigen::Vector2d q = grid.cellCenter(cx, cy);
+        for (const auto& c : body) {
+          if ((q - c).norm() <= border + 1e-6) {
+            EXPECT_TRUE(contains(bumps, q)) << border << ": " << q.transpose();
+            break;
+          }
+        }
+      }
+    }
   }
 }
 
@@ -281,4 +321,7 @@ TEST(Bumps, BadParametersAreRejected) {
   p = params();
   p.bump_min_zeta = -0.5;
   expectRejected(p, "bump_min_zeta");
+  p = params();
+  p.bump_border_m = -0.1;
+  expectRejected(p, "bump_border_m");
 }

@@ -30,6 +30,8 @@ void StepEdgeParams::validate() const {
   core::requireParam(std::isfinite(bump_min_inliers) && bump_min_inliers > 0 &&
                          bump_min_inliers <= 1,
                      s, "bump_min_inliers", bump_min_inliers, "must be in (0, 1]");
+  core::requireParam(std::isfinite(bump_border_m) && bump_border_m >= 0, s, "bump_border_m",
+                     bump_border_m, "must be >= 0");
 }
 
 namespace {
@@ -191,10 +193,18 @@ std::vector<Eigen::Vector2d> findBumps(const TraversabilityGrid& grid,
   int cx0, cy0;
   if (!centreCell(grid, centre_xy, cx0, cy0)) return out;
   const BumpShape shape = bumpShape(params, cell);
-  // The bump cells found so far (1: a bump's body, 2: the cell round it), over the checked
-  // cells' box grown by the disc and one cell.
+  // The border: the offsets within bump_border_m of a body cell's centre.
+  std::vector<Offset> border;
+  const int border_cells = static_cast<int>(std::floor(params.bump_border_m / cell + 1e-9));
+  for (int dy = -border_cells; dy <= border_cells; ++dy) {
+    for (int dx = -border_cells; dx <= border_cells; ++dx) {
+      if (std::hypot(dx, dy) * cell <= params.bump_border_m + 1e-9) border.push_back({dx, dy});
+    }
+  }
+  // The bump cells found so far (1: a bump's body, 2: its border), over the checked cells' box
+  // grown by the disc and the border.
   const int reach = static_cast<int>(std::ceil(params.range_m / cell));
-  const int grow = shape.radius + 1;
+  const int grow = shape.radius + border_cells;
   const int bx0 = std::max(0, cx0 - reach - grow), by0 = std::max(0, cy0 - reach - grow);
   const int bx1 = std::min(nx - 1, cx0 + reach + grow), by1 = std::min(ny - 1, cy0 + reach + grow);
   const int bw = bx1 - bx0 + 1;
@@ -213,13 +223,11 @@ std::vector<Eigen::Vector2d> findBumps(const TraversabilityGrid& grid,
       if (!bumpPlane(grid, cx, cy, shape, params, h, plane)) continue;
       if (!bumpBody(grid, cx, cy, shape, plane, params, body)) continue;
       for (const Offset& o : body) {
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int qx = cx + o.dx + dx, qy = cy + o.dy + dy;
-            if (qx < bx0 || qy < by0 || qx > bx1 || qy > by1) continue;
-            std::uint8_t& b = bump[idx(qx, qy)];
-            b = dx == 0 && dy == 0 ? 1 : std::max<std::uint8_t>(b, 2);
-          }
+        for (const Offset& d : border) {
+          const int qx = cx + o.dx + d.dx, qy = cy + o.dy + d.dy;
+          if (qx < bx0 || qy < by0 || qx > bx1 || qy > by1) continue;
+          std::uint8_t& b = bump[idx(qx, qy)];
+          b = d.dx == 0 && d.dy == 0 ? 1 : std::max<std::uint8_t>(b, 2);
         }
       }
     }

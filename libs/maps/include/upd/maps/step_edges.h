@@ -31,9 +31,10 @@
 // ring (a platform or a ramp seen in part, not a rock), and every cell of it must read smooth to
 // the UPD (zeta_min >= bump_min_zeta: an edge the UPD sees, a tall rock's, a platform's, a
 // wall's, is the UPD's to mark; a map the UPD never scored, the oracle's, has no bumps). Found,
-// it is grown by one cell on every side: its flanks down to its foot, and the cell beyond it
-// (the 10 cm cells' centres then lie about where the rock's foot, grown by the truth's 5 cm
-// border, ends).
+// the cells whose centre lies within bump_border_m of one of its cells are marked too: its
+// flanks down to its foot and the truth's 5 cm border beyond. With 10 cm cells, 0.1 m adds the
+// four side neighbours of each cell, not the diagonal ones: their centres lie 14 cm out, up to
+// 9 cm beyond the border, and narrow the passages beside the rock.
 #pragma once
 
 #include "upd/core/params.h"
@@ -59,6 +60,7 @@ struct StepEdgeParams {
   double bump_fit_tolerance_m = 0.02;  ///< ring cells this close to the plane fit it [m]
   double bump_min_inliers = 0.75;    ///< share of the ring's known cells that must fit (0..1]
   double bump_min_zeta = 0.95;       ///< a bump's cells all have UPD zeta_min at least this
+  double bump_border_m = 0.1;        ///< cells this near a bump's cell centre are marked [m]
 
   void validate() const;  ///< std::invalid_argument naming the field
   template <class V>
@@ -84,6 +86,9 @@ struct StepEdgeParams {
     v("bump_min_zeta", bump_min_zeta,
       "a bump's cells all read smoother than this to the UPD (zeta_min); a rougher one is the "
       "UPD's to mark, a cell it never scored decides nothing [0, 1]");
+    v("bump_border_m", bump_border_m,
+      "cells whose centre lies within this of a bump cell's centre are marked too (0: the bump "
+      "only) [m]");
   }
 };
 
