@@ -123,8 +123,8 @@ TEST_P(NavScenarioStart, RobotHeadsForTheGoalWithoutCollision) {
 
 INSTANTIATE_TEST_SUITE_P(Worlds, NavScenarioStart,
                          ::testing::Values("rocks", "ramp", "ditch", "corridor"),
-                         [](const ::testing::TestParamInfo<const char*>& info) {
-                           return std::string(info.param);
+                         [](const ::testing::TestParamInfo<const char*>& param_info) {
+                           return std::string(param_info.param);
                          });
 
 }  // namespace

@@ -24,18 +24,23 @@ struct Stripe {
   float term[13][kStripe];  // the 13 of CellSums
 };
 
+// A point's lattice coordinates within the key range; NaN and infinity fail the test too. (&
+// rather than &&, on ints for clang's -Wbitwise-instead-of-logical: no branch, so the loops
+// that call it vectorize.)
+inline bool inLattice(float gx, float gy, float gz) {
+  return (static_cast<int>(std::fabs(gx) < kMaxCoord) & static_cast<int>(std::fabs(gy) < kMaxCoord) &
+          static_cast<int>(std::fabs(gz) < kMaxCoord)) != 0;
+}
+
 UPD_VECTOR_CLONES
 void toLattice(const float* __restrict x, const float* __restrict y, const float* __restrict z,
                const float* __restrict nx, const float* __restrict ny, const float* __restrict nz,
                const Lattice& lat, std::size_t n, Stripe& __restrict s) {
   for (std::size_t j = 0; j < n; ++j) {
     const float gx = lat.gx(x[j]), gy = lat.gy(y[j]), gz = lat.gz(z[j]);
-    // NaN and infinity fail this test too. (& rather than &&, floors as floats, everything
-    // loaded and computed before it is selected: no branch, so the loop vectorizes.)
-    // (The tests cast to int: clang's -Wbitwise-instead-of-logical, the same code.)
-    const bool inside = (static_cast<int>(std::fabs(gx) < kMaxCoord) &
-                         static_cast<int>(std::fabs(gy) < kMaxCoord) &
-                         static_cast<int>(std::fabs(gz) < kMaxCoord)) != 0;
+    // (Floors as floats, everything loaded and computed before it is selected: no branch, so
+    // the loop vectorizes.)
+    const bool inside = inLattice(gx, gy, gz);
     const float fx = std::floor(gx), fy = std::floor(gy), fz = std::floor(gz);
     const float ax = nx[j], ay = ny[j], az = nz[j];
     const bool valid = ax == ax;
@@ -171,10 +176,7 @@ std::uint32_t cellChanges(const float* __restrict x, const float* __restrict y,
   std::uint32_t valid = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const float gx = lat.gx(x[j]), gy = lat.gy(y[j]), gz = lat.gz(z[j]);
-    // (toLattice's test and floors: the same cells.)
-    const bool inside = (static_cast<int>(std::fabs(gx) < kMaxCoord) &
-                         static_cast<int>(std::fabs(gy) < kMaxCoord) &
-                         static_cast<int>(std::fabs(gz) < kMaxCoord)) != 0;
+    const bool inside = inLattice(gx, gy, gz);  // toLattice's test and floors: its cells
     s.cx[j + 1] = inside ? std::floor(gx) : kOutside;
     s.cy[j + 1] = std::floor(gy), s.cz[j + 1] = std::floor(gz);
     valid += static_cast<std::uint32_t>(inside) & static_cast<std::uint32_t>(nx[j] == nx[j]);
