@@ -23,7 +23,8 @@ const char* const kRenderUsage =
     "  --output FILE.png     the image (required)\n"
     "  --color C             zeta (default: green = plane, blue = discontinuity, zeta from 1\n"
     "                        down to sqrt(2)/2), label, cost, slope (0-45 deg), height or\n"
-    "                        rgb (the cloud's own colour)\n"
+    "                        rgb (the cloud's own colour); a map without zeta (map.ot)\n"
+    "                        is drawn by label unless asked otherwise\n"
     "  --normals             draw normals as short dark segments (at most ~1500)\n"
     "  --view-from X,Y,Z     camera position in the cloud frame (default: 35 deg above the\n"
     "                        cloud's centre, behind (-x) and to the side, or from the diagonal\n"
@@ -60,9 +61,9 @@ int runRender(const std::vector<std::string>& argv) {
   const auto output = args.str("--output");
   if (!output) throw UsageError("--output FILE.png is required");
   nav::RenderOptions opt;
-  const std::string color = args.str("--color").value_or("zeta");
+  const auto asked_color = args.str("--color");
   try {
-    opt.color = nav::parseFigureColor(color);
+    if (asked_color) nav::parseFigureColor(*asked_color);  // a bad name fails before the input
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--color: ") + e.what());
   }
@@ -72,7 +73,6 @@ int runRender(const std::vector<std::string>& argv) {
   if (const auto up = args.vector3("--up")) opt.up = *up;
   if (!(opt.up.norm() > 0)) throw UsageError("--up must not be the zero vector");
   if (const auto size = args.str("--size")) std::tie(opt.width, opt.height) = parseImageSize(*size);
-  opt.title = args.str("--title").value_or(baseName(input) + ": " + color);
 
   nav::MapStyle style = nav::MapStyle::Grid;
   try {
@@ -81,6 +81,9 @@ int runRender(const std::vector<std::string>& argv) {
     throw UsageError(std::string("--map: ") + e.what());
   }
   const ViewInput in = readViewInput(input, opt.up);
+  const std::string color = firstColor(in, asked_color);
+  opt.color = nav::parseFigureColor(color);
+  opt.title = args.str("--title").value_or(baseName(input) + ": " + color);
   if (!in.is_map) {
     nav::renderFigure(*in.cloud, opt, *output);
     std::printf("%s: %zu points drawn by %s to %s (%dx%d)\n", input.c_str(), in.cloud->size(), color.c_str(),

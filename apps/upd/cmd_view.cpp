@@ -23,7 +23,8 @@ const char* const kViewUsage =
     "  n normals on/off    m map: grid / octree / none    r reset the view\n"
     "  p save a screenshot (upd-view-NNN.png)    t help text on/off    q or Esc close\n\n"
     "options:\n"
-    "  --color C             the first colouring: zeta (default), label, cost, slope, height\n"
+    "  --color C             the first colouring: zeta (default; label for a map without\n"
+    "                        zeta, map.ot), label, cost, slope, height\n"
     "  --normals             start with the normals shown\n"
     "  --map grid|octree|none  a folder's map drawn first (default grid)\n"
     "  --up X,Y,Z            a cloud's up vector (default 0,0,1; 0,-1,0 for a camera frame)\n"
@@ -39,7 +40,7 @@ int runView(const std::vector<std::string>& argv) {
   const std::string input = args.positionals()[0];
   nav::ViewerOptions opt;
   try {
-    opt.color = nav::parseFigureColor(args.str("--color").value_or("zeta"));
+    if (const auto c = args.str("--color")) opt.color = nav::parseFigureColor(*c);
     opt.map = nav::parseMapStyle(args.str("--map").value_or("grid"));
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
@@ -56,6 +57,7 @@ int runView(const std::vector<std::string>& argv) {
 
   ViewInput in = readViewInput(input, opt.up);  // a bad file fails before a window opens
   if (in.is_map) opt.up = Eigen::Vector3f::UnitZ();
+  opt.color = nav::parseFigureColor(firstColor(in, args.str("--color")));
   opt.map = firstMapStyle(in, opt.map);
   opt.title = "upd view " + input;
   nav::Viewer viewer(opt);

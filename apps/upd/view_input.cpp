@@ -10,8 +10,8 @@
 #include <octomap/ColorOcTree.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -65,6 +65,15 @@ void snapshotColourOctree(const std::string& path, nav::MapSnapshot& out, double
 }
 
 }  // namespace
+
+std::string firstColor(const ViewInput& in, const std::optional<std::string>& asked) {
+  if (asked) return *asked;
+  if (!in.is_map || in.cloud) return "zeta";
+  const auto has = [](const auto& views) {
+    return std::any_of(views.begin(), views.end(), [](const auto& v) { return std::isfinite(v.zeta); });
+  };
+  return has(in.map.cells) || has(in.map.voxels) ? "zeta" : "label";
+}
 
 ViewInput readViewInput(const std::string& path, const Eigen::Vector3f& up) {
   if (fs::is_directory(path)) return readFolder(path);

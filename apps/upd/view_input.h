@@ -24,6 +24,10 @@ inline nav::MapStyle firstMapStyle(const ViewInput& in, nav::MapStyle asked) {
   return asked == nav::MapStyle::Grid && !in.map.hasGrid() ? nav::MapStyle::Octree : asked;
 }
 
+/// The colouring to draw first: the asked one, else zeta, but the labels for a map that holds
+/// no zeta (map.ot, the ColorOcTree, keeps only the labels' colours: by zeta it is all grey).
+std::string firstColor(const ViewInput& in, const std::optional<std::string>& asked);
+
 /// Reads path: a folder (map.tif, map_traversability.ot, map.3Dscene's path, the last
 /// frames/*.ply when present), a tree (.ot: map_traversability.ot, or map.ot, the ColorOcTree,
 /// whose colours give the labels only), or a cloud (scored with up when

@@ -95,13 +95,17 @@ TEST_F(ViewTest, ViewerWindowShowsZetaThenLabelsAfterTheKey) {
   EXPECT_LT(l.blue, 50u) << "no zeta colours after the key";
 }
 
-TEST_F(ViewTest, TruncatedMapOtIsOneLineAndNoFile) {
+TEST_F(ViewTest, MapOtDrawsByLabelAndTruncatedIsOneLineAndNoFile) {
   // map.ot (OctoMap's ColorOcTree) whole draws; cut short it is an error, not a partial map.
   const std::string whole = dir_->file("out/map.ot");
   const std::string png = dir_->file("map_ot.png");
-  const CmdResult ok = runUpd("render " + whole + " --output " + png);
+  const CmdResult ok = runUpd("render " + whole + " --output " + png + " --size 900x640");
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
-  EXPECT_TRUE(fs::exists(png));
+  // It holds no zeta, only the labels' colours: drawn by label unless asked, not all grey.
+  EXPECT_NE(ok.output.find("drawn by label"), std::string::npos) << ok.output;
+  const test::Counts c = countColours(loadPng(png), 900 - 170, 40);
+  EXPECT_GT(c.green, 5000u) << "traversable ground";
+  EXPECT_GT(c.red, 200u) << "the obstacles";
   const std::string bytes = test::readFileBytes(whole);
   for (const std::size_t keep : {bytes.size() / 2, bytes.size() - 3}) {
     const std::string cut = dir_->file("cut.ot");
