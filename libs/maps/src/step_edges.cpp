@@ -91,8 +91,24 @@ bool fitRing(const std::vector<Offset>& ring, const std::vector<double>& h,
 }
 
 // The bump check's cell offsets: the ground ring and the disc inside it, in cells.
+// The cell offsets whose distance from the centre lies in [r_min, r_max] cells (a small tolerance
+// above r_max, so that a radius of exactly n cells keeps the cells n away).
+std::vector<Offset> offsetsWithin(double r_min, double r_max) {
+  std::vector<Offset> out;
+  const int reach = static_cast<int>(std::ceil(r_max));
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const double r = std::hypot(dx, dy);
+      if (r >= r_min && r <= r_max + 1e-9) out.push_back({dx, dy});
+    }
+  }
+  return out;
+}
+
 struct BumpShape {
   std::vector<Offset> ring;
+  std::vector<Offset> border;  // within bump_border_m of a bump cell's centre (itself included)
+  int border_cells = 0;        // the border's reach [cells]
   int radius = 0;     // the disc's offsets are below `inner` cells: within radius of the cell
   double inner = 0.0;  // the ring's inner radius [cells]
   int side() const { return 2 * radius + 1; }
@@ -104,15 +120,11 @@ struct BumpShape {
 BumpShape bumpShape(const StepEdgeParams& params, double cell) {
   BumpShape b;
   b.inner = params.bump_ring_inner_m / cell;
-  const double outer = params.bump_ring_outer_m / cell;
-  const int reach = static_cast<int>(std::ceil(outer));
-  for (int dy = -reach; dy <= reach; ++dy) {
-    for (int dx = -reach; dx <= reach; ++dx) {
-      const double r = std::hypot(dx, dy);
-      if (r >= b.inner && r <= outer) b.ring.push_back({dx, dy});
-    }
-  }
+  b.ring = offsetsWithin(b.inner, params.bump_ring_outer_m / cell);
   b.radius = static_cast<int>(std::ceil(b.inner));
+  const double border = params.bump_border_m / cell;
+  b.border = offsetsWithin(0.0, border);
+  b.border_cells = static_cast<int>(std::floor(border + 1e-9));
   return b;
 }
 
@@ -193,18 +205,10 @@ std::vector<Eigen::Vector2d> findBumps(const TraversabilityGrid& grid,
   int cx0, cy0;
   if (!centreCell(grid, centre_xy, cx0, cy0)) return out;
   const BumpShape shape = bumpShape(params, cell);
-  // The border: the offsets within bump_border_m of a body cell's centre.
-  std::vector<Offset> border;
-  const int border_cells = static_cast<int>(std::floor(params.bump_border_m / cell + 1e-9));
-  for (int dy = -border_cells; dy <= border_cells; ++dy) {
-    for (int dx = -border_cells; dx <= border_cells; ++dx) {
-      if (std::hypot(dx, dy) * cell <= params.bump_border_m + 1e-9) border.push_back({dx, dy});
-    }
-  }
   // The bump cells found so far (1: a bump's body, 2: its border), over the checked cells' box
   // grown by the disc and the border.
   const int reach = static_cast<int>(std::ceil(params.range_m / cell));
-  const int grow = shape.radius + border_cells;
+  const int grow = shape.radius + shape.border_cells;
   const int bx0 = std::max(0, cx0 - reach - grow), by0 = std::max(0, cy0 - reach - grow);
   const int bx1 = std::min(nx - 1, cx0 + reach + grow), by1 = std::min(ny - 1, cy0 + reach + grow);
   const int bw = bx1 - bx0 + 1;
@@ -223,7 +227,7 @@ std::vector<Eigen::Vector2d> findBumps(const TraversabilityGrid& grid,
       if (!bumpPlane(grid, cx, cy, shape, params, h, plane)) continue;
       if (!bumpBody(grid, cx, cy, shape, plane, params, body)) continue;
       for (const Offset& o : body) {
-        for (const Offset& d : border) {
+        for (const Offset& d : shape.border) {
           const int qx = cx + o.dx + d.dx, qy = cy + o.dy + d.dy;
           if (qx < bx0 || qy < by0 || qx > bx1 || qy > by1) continue;
           std::uint8_t& b = bump[idx(qx, qy)];
