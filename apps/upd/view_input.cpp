@@ -47,10 +47,10 @@ ViewInput readFolder(const fs::path& dir) {
 
 // map.ot, the ColorOcTree every OctoMap tool reads: its colour is the traversability colour of
 // map.png (grey without evidence), so the label comes back from it; zeta and cost do not.
-void snapshotColourOctree(const std::string& path, nav::MapSnapshot& out, double p_nontrav_threshold = 0.65) {
-  const std::unique_ptr<octomap::ColorOcTree> colour = maps::readColourOt(path);
-  for (auto it = colour->begin_leafs(), end = colour->end_leafs(); it != end; ++it) {
-    if (!colour->isNodeOccupied(*it)) continue;
+void snapshotColourOctree(const octomap::ColorOcTree& colour, nav::MapSnapshot& out,
+                          double p_nontrav_threshold = 0.65) {
+  for (auto it = colour.begin_leafs(), end = colour.end_leafs(); it != end; ++it) {
+    if (!colour.isNodeOccupied(*it)) continue;
     nav::MapVoxelView v;
     v.centre = Eigen::Vector3f(float(it.getX()), float(it.getY()), float(it.getZ()));
     v.size = float(it.getSize());
@@ -80,8 +80,9 @@ ViewInput readViewInput(const std::string& path, const Eigen::Vector3f& up) {
   ViewInput in;
   if (io::lowerExtension(path) == ".ot") {
     in.is_map = true;
-    if (maps::readOtHeader(path).id == "ColorOcTree") snapshotColourOctree(path, in.map);
-    else nav::snapshotOctree(*maps::readTraversabilityOt(path), in.map);
+    const maps::AnyOt tree = maps::readAnyOt(path);
+    if (tree.colour) snapshotColourOctree(*tree.colour, in.map);
+    else nav::snapshotOctree(*tree.traversability, in.map);
     if (in.map.voxels.empty()) throw std::runtime_error(path + ": the tree has no occupied voxel to draw");
     return in;
   }

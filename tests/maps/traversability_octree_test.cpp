@@ -411,6 +411,38 @@ TEST(TraversabilityOctree, ColourOtReloadsWholeOrNotAtAll) {
   EXPECT_THROW(upd::maps::readColourOt(trav), std::runtime_error);
 }
 
+TEST(TraversabilityOctree, AnyOtReadsEitherTreeTheHeaderNamesAndRefusesAnother) {
+  const auto tree = sceneTree();
+  TempDir dir("any_ot");
+  const std::string trav = dir.file("map_traversability.ot");
+  const std::string colour = dir.file("map.ot");
+  upd::maps::writeTraversabilityOt(*tree, trav);
+  upd::maps::writeColourOt(*tree, colour);
+
+  const upd::maps::AnyOt a = upd::maps::readAnyOt(trav);
+  ASSERT_TRUE(a.traversability);
+  EXPECT_FALSE(a.colour);
+  EXPECT_EQ(occupiedLeaves(*a.traversability), occupiedLeaves(*tree));
+  const upd::maps::AnyOt b = upd::maps::readAnyOt(colour);
+  ASSERT_TRUE(b.colour);
+  EXPECT_FALSE(b.traversability);
+  EXPECT_EQ(occupiedLeaves(*b.colour), occupiedLeaves(*tree));
+
+  // A plain OcTree .ot (another tool's) is named, with the file.
+  const std::string plain = dir.file("plain.ot");
+  octomap::OcTree occupancy(tree->getResolution());
+  occupancy.updateNode(octomap::point3d(0.1f, 0.1f, 0.1f), true);
+  ASSERT_TRUE(occupancy.write(plain));
+  try {
+    upd::maps::readAnyOt(plain);
+    ADD_FAILURE() << "a plain OcTree was read";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(plain), std::string::npos) << what;
+    EXPECT_NE(what.find("holds a OcTree"), std::string::npos) << what;
+  }
+}
+
 TEST(TraversabilityOctree, RealOctomapFileLoadsAndRoundTrips) {
   UPD_REQUIRE_SHARED_FILE(path, "octomap/geb079.bt");
   octomap::OcTree reference(path);

@@ -402,17 +402,23 @@ void readOtNodes(const std::string& path, std::ifstream& in, const OtHeader& hea
 }
 
 template <class Tree>
-std::unique_ptr<Tree> readOtOfType(const std::string& path, const std::string& type) {
-  OtHeader header;
-  std::ifstream in = openOt(path, header);
-  if (header.id != type) {
-    throw otError(path, "it holds a " +
-                            (header.id.empty() ? std::string("tree of no type") : header.id) +
-                            ", not a " + type);
-  }
+std::unique_ptr<Tree> readOtNodesInto(const std::string& path, std::ifstream& in, const OtHeader& header) {
   auto tree = std::make_unique<Tree>(header.resolution);
   readOtNodes(path, in, header, *tree);
   return tree;
+}
+
+std::runtime_error wrongOtType(const std::string& path, const OtHeader& header, const std::string& wanted) {
+  return otError(path, "it holds a " + (header.id.empty() ? std::string("tree of no type") : header.id) +
+                           ", not a " + wanted);
+}
+
+template <class Tree>
+std::unique_ptr<Tree> readOtOfType(const std::string& path, const std::string& type) {
+  OtHeader header;
+  std::ifstream in = openOt(path, header);
+  if (header.id != type) throw wrongOtType(path, header, type);
+  return readOtNodesInto<Tree>(path, in, header);
 }
 
 }  // namespace
@@ -429,6 +435,20 @@ std::unique_ptr<TraversabilityOcTree> readTraversabilityOt(const std::string& pa
 
 std::unique_ptr<octomap::ColorOcTree> readColourOt(const std::string& path) {
   return readOtOfType<octomap::ColorOcTree>(path, "ColorOcTree");
+}
+
+AnyOt readAnyOt(const std::string& path) {
+  OtHeader header;
+  std::ifstream in = openOt(path, header);
+  AnyOt any;
+  if (header.id == "TraversabilityOcTree") {
+    any.traversability = readOtNodesInto<TraversabilityOcTree>(path, in, header);
+  } else if (header.id == "ColorOcTree") {
+    any.colour = readOtNodesInto<octomap::ColorOcTree>(path, in, header);
+  } else {
+    throw wrongOtType(path, header, "TraversabilityOcTree or a ColorOcTree");
+  }
+  return any;
 }
 
 }  // namespace upd::maps

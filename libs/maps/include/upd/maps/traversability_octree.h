@@ -273,5 +273,13 @@ std::unique_ptr<TraversabilityOcTree> readTraversabilityOt(const std::string& pa
 /// Reads a ColorOcTree .ot (writeColourOt's map.ot, or another OctoMap tool's), with the same
 /// checks as readTraversabilityOt.
 std::unique_ptr<octomap::ColorOcTree> readColourOt(const std::string& path);
+/// Either tree UPD-Nav writes as .ot; exactly one member is set.
+struct AnyOt {
+  std::unique_ptr<TraversabilityOcTree> traversability;
+  std::unique_ptr<octomap::ColorOcTree> colour;
+};
+/// Reads a TraversabilityOcTree or a ColorOcTree .ot, whichever the header names, opening the
+/// file once, with the same checks as readTraversabilityOt; another tree type is an error.
+AnyOt readAnyOt(const std::string& path);
 
 }  // namespace upd::maps
