@@ -232,6 +232,20 @@ TEST(PreprocessReference, RandomCloudsKeepTheReferencesPointsAndCentroids) {
   }
 }
 
+// The voxel pass's hash map is sized for the voxels of the calls before: clouds of a few hundred
+// voxels and of thousands in turn on the same threads (the map grows within a call, and is
+// made smaller again after one with far fewer voxels) keep the reference's points and centroids.
+TEST(PreprocessReference, VoxelCountsGrowingAndShrinkingCallAfterCall) {
+  PreprocessParams p = paperParams();
+  p.range_max_m = 2.6;
+  std::uint32_t seed = 20;
+  for (const std::size_t n : {600u, 12000u, 400u, 12000u, 3000u}) {
+    const PointCloud c = randomCloud(seed, n, seed % 2 == 0 ? 200 : 0, true);  // (organized or not)
+    ++seed;
+    checkChain(std::to_string(n) + " points", c, p);
+  }
+}
+
 // Holes in runs of every length from 1 to 11 (the voxel pass passes them 4 at a time), at the
 // start, inside and at the end of rows: the same points and centroids as the reference.
 TEST(PreprocessReference, HoleRunsOfEveryLength) {
