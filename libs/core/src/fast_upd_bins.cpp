@@ -4,6 +4,7 @@
 // points in one vector loop, and the sums of a run of points in one cell added at once.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -14,14 +15,20 @@ namespace upd::core::detail {
 namespace {
 
 // A stripe of points in lattice terms, the first pass of binRange: each point's cell (cx, cy,
-// cz: integers as floats, exact below 2^24; cx = kOutside for a point that is not finite or
-// lies beyond the key range) and its contribution to the CellSums of its cell, in their order
-// (count, normal, position inside the cell, its products), zeros where the normal is invalid.
+// cz at j + 1: integers as floats, exact below 2^24; cx = kOutside for a point that is not
+// finite or lies beyond the key range; index 0 holds the previous stripe's last cell), whether
+// it starts a run (its cell differs from the point before's), and its contribution to the
+// CellSums of its cell, in their order (count, normal, position inside the cell, its
+// products), zeros where the normal is invalid. Each row has a vector of slack after the
+// stripe (a run's last vector reads it, masked).
 constexpr float kOutside = -2.f * kMaxCoord;
 constexpr std::size_t kStripe = 256;
+constexpr std::size_t kTerms = 13;
+constexpr std::size_t kRunLanes = 8;
 struct Stripe {
-  float cx[kStripe], cy[kStripe], cz[kStripe];
-  float term[13][kStripe];  // the 13 of CellSums
+  float cx[kStripe + 1], cy[kStripe + 1], cz[kStripe + 1];
+  std::uint8_t starts[kStripe + 8];  // starts[n] = 1: the end of the stripe's last run
+  float term[kTerms][kStripe + kRunLanes];
 };
 
 // A point's lattice coordinates within the key range; NaN and infinity fail the test too. (&
@@ -32,21 +39,27 @@ inline bool inLattice(float gx, float gy, float gz) {
           static_cast<int>(std::fabs(gz) < kMaxCoord)) != 0;
 }
 
+// Fills the stripe for n points; returns true when a finite point lies beyond the key range.
 UPD_VECTOR_CLONES
-void toLattice(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+bool toLattice(const float* __restrict x, const float* __restrict y, const float* __restrict z,
                const float* __restrict nx, const float* __restrict ny, const float* __restrict nz,
                const Lattice& lat, std::size_t n, Stripe& __restrict s) {
+  int beyond = 0;
   for (std::size_t j = 0; j < n; ++j) {
     const float gx = lat.gx(x[j]), gy = lat.gy(y[j]), gz = lat.gz(z[j]);
     // (Floors as floats, everything loaded and computed before it is selected: no branch, so
     // the loop vectorizes.)
     const bool inside = inLattice(gx, gy, gz);
+    const bool finite = (static_cast<int>(x[j] - x[j] == 0.f) &
+                         static_cast<int>(y[j] - y[j] == 0.f) &
+                         static_cast<int>(z[j] - z[j] == 0.f)) != 0;
+    beyond |= static_cast<int>(!inside) & static_cast<int>(finite);
     const float fx = std::floor(gx), fy = std::floor(gy), fz = std::floor(gz);
     const float ax = nx[j], ay = ny[j], az = nz[j];
     const bool valid = ax == ax;
     const float px = valid ? gx - fx : 0.f, py = valid ? gy - fy : 0.f, pz = valid ? gz - fz : 0.f;
-    s.cx[j] = inside ? fx : kOutside;
-    s.cy[j] = fy, s.cz[j] = fz;
+    s.cx[j + 1] = inside ? fx : kOutside;
+    s.cy[j + 1] = fy, s.cz[j + 1] = fz;
     auto& t = s.term;
     t[0][j] = valid ? 1.f : 0.f;
     t[1][j] = valid ? ax : 0.f, t[2][j] = valid ? ay : 0.f, t[3][j] = valid ? az : 0.f;
@@ -54,55 +67,133 @@ void toLattice(const float* __restrict x, const float* __restrict y, const float
     t[7][j] = px * px, t[8][j] = px * py, t[9][j] = px * pz, t[10][j] = py * py;
     t[11][j] = py * pz, t[12][j] = pz * pz;
   }
+  for (std::size_t j = 0; j < n; ++j) {
+    // (An outside point's cy and cz are whatever its floors gave: its cx decides.)
+    const bool outside = s.cx[j + 1] == kOutside;
+    const bool same = (static_cast<int>(s.cx[j + 1] == s.cx[j]) &
+                       (static_cast<int>(outside) | (static_cast<int>(s.cy[j + 1] == s.cy[j]) &
+                                                     static_cast<int>(s.cz[j + 1] == s.cz[j])))) !=
+                      0;
+    s.starts[j] = same ? 0 : 1;
+  }
+  return beyond != 0;
 }
 
-// Bins points [begin, end) into b, writing each point's cell (local to b) into cell_of.
-// Consecutive points (image rows, scan lines) mostly share a cell: the sums of such a run are
-// kept in one vector register (a point adds its 13 terms at once) and the hash map is
-// consulted once per change of cell. Returns false when a point lies beyond the lattice's key
-// range (it is left out).
-UPD_VECTOR_CLONES
-bool binRange(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
-              std::size_t begin, std::size_t end, Bins& b, std::uint32_t* cell_of) {
-  float lx = kOutside, ly = 0, lz = 0;  // the cell of the run
-  std::uint32_t last = kNoIndex;
-  bool fits = true;
-  float r0 = 0, r1 = 0, r2 = 0, r3 = 0, r4 = 0, r5 = 0, r6 = 0, r7 = 0, r8 = 0, r9 = 0, r10 = 0,
-        r11 = 0, r12 = 0;
-  const auto flush = [&] {
-    if (last != kNoIndex && r0 > 0.f) {
-      b.sums[last].add({r0, r1, r2, r3, r4, r5, r6, r7, r8, r9, r10, r11, r12});
-    }
-    r0 = r1 = r2 = r3 = r4 = r5 = r6 = r7 = r8 = r9 = r10 = r11 = r12 = 0.f;
+// The first run start after j (starts[n] is set): 8 flags at a time, most runs being longer.
+__attribute__((always_inline)) inline std::size_t nextStart(const std::uint8_t* starts, std::size_t j) {
+  for (;; j += 8) {
+    std::uint64_t eight;
+    std::memcpy(&eight, starts + j, sizeof eight);
+    if (eight != 0) return j + static_cast<std::size_t>(__builtin_ctzll(eight)) / 8;
+  }
+}
+
+typedef float RunLanes __attribute__((vector_size(kRunLanes * sizeof(float))));
+typedef std::int32_t RunMask __attribute__((vector_size(kRunLanes * sizeof(std::int32_t))));
+typedef float RunQuad __attribute__((vector_size(4 * sizeof(float))));
+
+// The sums of four vectors' lanes, ((v0 + v4) + (v2 + v6)) + ((v1 + v5) + (v3 + v7)) each, as
+// one vector: the halves added, then two rounds of pairwise sums across the vectors.
+__attribute__((always_inline)) inline RunQuad laneSums(const RunLanes& a, const RunLanes& b, const RunLanes& c,
+                        const RunLanes& d) {
+  const auto half = [](const RunLanes& v) {
+    return __builtin_shufflevector(v, v, 0, 1, 2, 3) + __builtin_shufflevector(v, v, 4, 5, 6, 7);
   };
-  static thread_local Stripe s;
-  for (std::size_t s0 = begin; s0 < end; s0 += kStripe) {
-    const std::size_t n = std::min(kStripe, end - s0);
-    toLattice(&cloud.x[s0], &cloud.y[s0], &cloud.z[s0], &normals.nx[s0], &normals.ny[s0],
-              &normals.nz[s0], lat, n, s);
-    for (std::size_t j = 0; j < n; ++j) {
-      const std::size_t i = s0 + j;
-      if (s.cx[j] == kOutside) {
-        if (std::isfinite(cloud.x[i]) && std::isfinite(cloud.y[i]) && std::isfinite(cloud.z[i])) {
-          fits = false;
-        }
-        cell_of[i] = kNoIndex;
-        continue;
-      }
-      if (s.cx[j] != lx || s.cy[j] != ly || s.cz[j] != lz) {
-        flush();
-        lx = s.cx[j], ly = s.cy[j], lz = s.cz[j];
-        last = b.cellOf(static_cast<std::int32_t>(lx), static_cast<std::int32_t>(ly),
-                        static_cast<std::int32_t>(lz));
-      }
-      cell_of[i] = last;
-      const auto& t = s.term;
-      r0 += t[0][j], r1 += t[1][j], r2 += t[2][j], r3 += t[3][j], r4 += t[4][j];
-      r5 += t[5][j], r6 += t[6][j], r7 += t[7][j], r8 += t[8][j], r9 += t[9][j];
-      r10 += t[10][j], r11 += t[11][j], r12 += t[12][j];
+  const auto pairs = [](const RunQuad& x, const RunQuad& y) {
+    return __builtin_shufflevector(x, y, 0, 2, 4, 6) + __builtin_shufflevector(x, y, 1, 3, 5, 7);
+  };
+  return pairs(pairs(half(a), half(b)), pairs(half(c), half(d)));
+}
+
+// The terms of the stripe's points [j, e) (one run) added to the sums of their cell: a vector
+// of kRunLanes points at a time, the last vector's lanes beyond e masked to +0; then the lanes
+// added up, four terms at a time.
+__attribute__((always_inline)) inline void addRun(const Stripe& s, std::size_t j, std::size_t e, CellSums& cell) {
+  RunLanes acc[kTerms + 3] = {};
+  for (; j + kRunLanes <= e; j += kRunLanes) {
+    for (std::size_t k = 0; k < kTerms; ++k) {
+      RunLanes v;
+      std::memcpy(&v, &s.term[k][j], sizeof v);
+      acc[k] += v;
     }
   }
-  flush();
+  if (j < e) {
+    const RunMask lanes = {0, 1, 2, 3, 4, 5, 6, 7};
+    const RunMask keep = lanes < static_cast<std::int32_t>(e - j);
+    for (std::size_t k = 0; k < kTerms; ++k) {
+      RunLanes v;
+      std::memcpy(&v, &s.term[k][j], sizeof v);
+      acc[k] += (RunLanes)((RunMask)v & keep);
+    }
+  }
+  const RunQuad q0 = laneSums(acc[0], acc[1], acc[2], acc[3]);
+  if (!(q0[0] > 0.f)) return;  // no valid normal in the run: nothing to add
+  const RunQuad q1 = laneSums(acc[4], acc[5], acc[6], acc[7]);
+  const RunQuad q2 = laneSums(acc[8], acc[9], acc[10], acc[11]);
+  const RunQuad q3 = laneSums(acc[12], acc[13], acc[14], acc[15]);
+  cell.add({q0[0], q0[1], q0[2], q0[3], q1[0], q1[1], q1[2], q1[3], q2[0], q2[1], q2[2], q2[3],
+            q3[0]});
+}
+
+// A stripe's runs of points in one cell, found before they are summed (so that the sums' loop
+// makes no call and keeps its vectors in registers).
+struct Runs {
+  std::uint16_t begin[kStripe], end[kStripe];
+  std::uint32_t cell[kStripe];
+  std::size_t n = 0;
+};
+
+// What binRange works in: the calling thread's, kept (thread_local, reached once per range).
+struct StripeBuffers {
+  Stripe s;
+  Runs runs;
+};
+
+// Bins points [begin, end) into b, writing each point's cell (local to b) into cell_of.
+// Consecutive points (image rows, scan lines) mostly share a cell: the stripe's runs of points
+// in one cell are found from the start flags, 8 at a time, the hash map is consulted once per
+// run, and a run's terms are summed a vector of points at a time. Returns false when a point
+// lies beyond the lattice's key range (it is left out).
+UPD_VECTOR_CLONES
+bool binRange(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+              std::size_t begin, std::size_t end, Bins& b, std::uint32_t* cell_of,
+              StripeBuffers& buf) {
+  Stripe& s = buf.s;
+  Runs& runs = buf.runs;
+  std::uint32_t last = kNoIndex;  // the cell of the run
+  bool fits = true;
+  s.cx[0] = kOutside, s.cy[0] = s.cz[0] = 0.f;  // (no run before the range)
+  for (std::size_t s0 = begin; s0 < end; s0 += kStripe) {
+    const std::size_t n = std::min(kStripe, end - s0);
+    if (toLattice(&cloud.x[s0], &cloud.y[s0], &cloud.z[s0], &normals.nx[s0], &normals.ny[s0],
+                  &normals.nz[s0], lat, n, s)) {
+      fits = false;
+    }
+    s.starts[n] = 1;
+    runs.n = 0;
+    for (std::size_t j = 0; j < n;) {
+      const std::size_t e = nextStart(s.starts, j + 1);
+      if (s.starts[j]) {
+        last = s.cx[j + 1] == kOutside
+                   ? kNoIndex
+                   : b.cellOf(static_cast<std::int32_t>(s.cx[j + 1]),
+                              static_cast<std::int32_t>(s.cy[j + 1]),
+                              static_cast<std::int32_t>(s.cz[j + 1]));
+      }
+      std::fill(cell_of + s0 + j, cell_of + s0 + e, last);
+      if (last != kNoIndex) {
+        runs.begin[runs.n] = static_cast<std::uint16_t>(j);
+        runs.end[runs.n] = static_cast<std::uint16_t>(e);
+        runs.cell[runs.n++] = last;
+      }
+      j = e;
+    }
+    for (std::size_t r = 0; r < runs.n; ++r) {
+      addRun(s, runs.begin[r], runs.end[r], b.sums[runs.cell[r]]);
+    }
+    // The stripe's last cell is the next one's previous (an outside point's too: kOutside).
+    s.cx[0] = s.cx[n], s.cy[0] = s.cy[n], s.cz[0] = s.cz[n];
+  }
   return fits;
 }
 
@@ -120,8 +211,10 @@ Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& l
 #pragma omp parallel for schedule(static) reduction(& : all_fit)
   for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
     const auto cu = static_cast<std::size_t>(c);
+    static thread_local StripeBuffers stripes;  // (this thread's: named inside the region)
     all_fit &=
-        binRange(cloud, normals, lat, chunks.begin(cu), chunks.end(cu), chunk_bins[cu], cell_of)
+        binRange(cloud, normals, lat, chunks.begin(cu), chunks.end(cu), chunk_bins[cu], cell_of,
+                 stripes)
             ? 1
             : 0;
   }

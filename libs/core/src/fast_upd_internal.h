@@ -55,10 +55,13 @@ struct CellRow {
   float f[kFields];
 };
 
-// The blend of a cell's 8 nodes as a polynomial (fast_upd_interp.cpp): the 8 coefficients of
-// the 4 forms of the 4 values (r_x, r_y, r_z, k), as 8 vectors of 16 floats.
-struct CellBlend {
-  float c[8][16];  // c[monomial][form * 4 + value], forms A, Bx, By, Bz (read as Vec16)
+// The blend of a cell's 8 nodes as a polynomial in the position inside the cell
+// (fast_upd_interp.cpp): the coefficients of its 20 monomials for each of the 4 values (r_x,
+// r_y, r_z, k), and the cell's lower corner in lattice coordinates.
+constexpr int kMonomials = 20;
+struct CellPoly {
+  Quad c[kMonomials];  // c[monomial][value]
+  float corner[3];
 };
 
 // The points with a valid normal grouped by cell (counting sort; point order within a cell),
@@ -180,7 +183,7 @@ struct FastUpdBuffers {
   std::vector<std::uint32_t> cell_nodes;  // 8 per cell
   std::vector<CellRow> rows;              // per cell
   std::vector<NodeSums> node_sums;        // per node
-  std::vector<CellBlend> blends;          // per cell
+  std::vector<CellPoly> polys;            // per cell
   CellPoints points;
 };
 

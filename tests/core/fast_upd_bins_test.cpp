@@ -1,0 +1,160 @@
+// The fast UPD's binning (binFrame: a stripe's runs of points in one cell summed a vector of
+// points at a time) against a plain per-point reference: every point lands in the cell of its
+// lattice coordinates, every cell's sums (count, normals, positions and their products) are the
+// sums over its points in double to float rounding, points without coordinates get no cell,
+// and the result is the same bit for bit on one thread and two. Image rows crossing cells in
+// runs of every length (one point to several vectors of 8), NaN holes and invalid normals
+// inside runs, stripe and chunk boundaries in the middle of a run. Fixed seeds.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <random>
+#include <tuple>
+#include <vector>
+
+#include "../../libs/core/src/fast_upd_internal.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace upd::core {
+namespace {
+
+using detail::kNoIndex;
+
+void setThreads([[maybe_unused]] int n) {
+#ifdef _OPENMP
+  omp_set_num_threads(n);
+#endif
+}
+using Key = std::tuple<std::int32_t, std::int32_t, std::int32_t>;
+
+// An organized cloud of W x H pixels: rows across a gently curved surface, so that a row
+// crosses the cells in runs whose length varies with the row's slope; NaN holes in bursts
+// and single pixels, and invalid normals on finite points.
+struct Scene {
+  PointCloud cloud;
+  Normals normals;
+};
+
+Scene makeScene(std::size_t W, std::size_t H, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> jitter(-0.002f, 0.002f);
+  std::bernoulli_distribution hole(0.03), burst(0.01), no_normal(0.05);
+  Scene s;
+  s.cloud.resizeOrganized(W, H);
+  s.normals = Normals::unset(W * H);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::size_t burst_left = 0;
+  for (std::size_t v = 0; v < H; ++v) {
+    // The pixel pitch along the row from 0.2 mm to 3 cm: runs of 1 to ~500 points per cell.
+    const float pitch = 0.0002f + 0.03f * static_cast<float>(v % 17) / 16.f;
+    for (std::size_t u = 0; u < W; ++u) {
+      const std::size_t i = v * W + u;
+      if (burst(rng)) burst_left = 1 + rng() % 40;
+      if (burst_left > 0 || hole(rng)) {
+        burst_left -= burst_left > 0 ? 1 : 0;
+        s.cloud.x[i] = s.cloud.y[i] = s.cloud.z[i] = nan;
+        continue;
+      }
+      const float x = 3.f + pitch * static_cast<float>(u) + jitter(rng);
+      const float y = 0.05f * static_cast<float>(v) + jitter(rng);
+      const float z = 0.3f * std::sin(0.7f * x) + 0.1f * std::cos(1.3f * y);
+      s.cloud.x[i] = x, s.cloud.y[i] = y, s.cloud.z[i] = z;
+      if (no_normal(rng)) continue;
+      const Eigen::Vector3f n = Eigen::Vector3f(jitter(rng), 0.2f + jitter(rng), 1.f).normalized();
+      s.normals.nx[i] = n.x(), s.normals.ny[i] = n.y(), s.normals.nz[i] = n.z();
+    }
+  }
+  return s;
+}
+
+struct Binned {
+  detail::Bins bins;
+  std::vector<std::uint32_t> cell_of;
+  detail::Lattice lat;
+};
+
+Binned bin(const Scene& s, const UpdParams& params, int threads) {
+  setThreads(threads);
+  detail::FastFrame f(s.cloud, s.normals, params);
+  f.m = params.fast_cells_per_radius;
+  f.lat.inv_cell = static_cast<float>(f.m / params.radius_m);
+  std::size_t first = 0;
+  while (!s.cloud.isFinite(first)) ++first;
+  f.lat.rx = s.cloud.x[first], f.lat.ry = s.cloud.y[first], f.lat.rz = s.cloud.z[first];
+  f.chunks = detail::PointChunks::of(first, s.cloud.size());
+  Binned out;
+  out.cell_of.assign(s.cloud.size(), kNoIndex);
+  f.cell_of = out.cell_of.data();
+  out.bins = detail::binFrame(f);
+  out.lat = f.lat;
+  setThreads(2);
+  return out;
+}
+
+TEST(FastUpdBins, RunSumsEqualThePerPointSums) {
+  UpdParams params;
+  params.radius_m = 0.5;
+  params.fast_cells_per_radius = 5;
+  params.fast_cells_per_point = 0;  // the base lattice only
+  // 700 x 300: several chunks of points (2^15 at most each) and stripes of 256 in every row.
+  const Scene s = makeScene(700, 300, 11);
+  const Binned one = bin(s, params, 1);
+  const Binned two = bin(s, params, 2);
+
+  // The reference: every point's cell from its lattice coordinates (the same float
+  // arithmetic), its terms summed in double.
+  std::map<Key, std::array<double, 13>> ref;
+  const detail::Lattice& lat = one.lat;
+  for (std::size_t i = 0; i < s.cloud.size(); ++i) {
+    if (!s.cloud.isFinite(i)) {
+      ASSERT_EQ(one.cell_of[i], kNoIndex) << "point " << i;
+      continue;
+    }
+    const float gx = lat.gx(s.cloud.x[i]), gy = lat.gy(s.cloud.y[i]), gz = lat.gz(s.cloud.z[i]);
+    const float fx = std::floor(gx), fy = std::floor(gy), fz = std::floor(gz);
+    const Key key{static_cast<std::int32_t>(fx), static_cast<std::int32_t>(fy),
+                  static_cast<std::int32_t>(fz)};
+    ASSERT_NE(one.cell_of[i], kNoIndex) << "point " << i;
+    const std::int32_t* xyz = one.bins.grid.xyz(one.cell_of[i]);
+    ASSERT_EQ(Key(xyz[0], xyz[1], xyz[2]), key) << "point " << i;
+    std::array<double, 13>& r = ref[key];
+    if (!(s.normals.nx[i] == s.normals.nx[i])) continue;
+    const double px = gx - fx, py = gy - fy, pz = gz - fz;
+    const double t[13] = {1,       s.normals.nx[i], s.normals.ny[i], s.normals.nz[i], px,
+                          py,      pz,              px * px,         px * py,         px * pz,
+                          py * py, py * pz,         pz * pz};
+    for (int k = 0; k < 13; ++k) r[static_cast<std::size_t>(k)] += t[k];
+  }
+  ASSERT_EQ(one.bins.sums.size(), ref.size());
+  for (std::size_t c = 0; c < one.bins.sums.size(); ++c) {
+    const std::int32_t* xyz = one.bins.grid.xyz(c);
+    const std::array<double, 13>& r = ref.at(Key(xyz[0], xyz[1], xyz[2]));
+    const detail::CellSums& got = one.bins.sums[c];
+    const float g[13] = {got.count, got.nx,  got.ny,  got.nz,  got.px,  got.py, got.pz,
+                         got.pxx,   got.pxy, got.pxz, got.pyy, got.pyz, got.pzz};
+    EXPECT_EQ(static_cast<double>(g[0]), r[0]) << "cell " << c;  // counts are exact
+    for (int k = 1; k < 13; ++k) {
+      // Float sums of up to a few thousand terms of magnitude <= 1.
+      EXPECT_NEAR(g[k], r[static_cast<std::size_t>(k)], 2e-6 * r[0] + 1e-6)
+          << "cell " << c << " term " << k;
+    }
+  }
+  // Thread count: the same cells, ids and sums bit for bit.
+  ASSERT_EQ(one.cell_of, two.cell_of);
+  ASSERT_EQ(one.bins.sums.size(), two.bins.sums.size());
+  for (std::size_t c = 0; c < one.bins.sums.size(); ++c) {
+    ASSERT_EQ(std::memcmp(&one.bins.sums[c], &two.bins.sums[c], sizeof(detail::CellSums)), 0)
+        << "cell " << c;
+  }
+}
+
+}  // namespace
+}  // namespace upd::core
