@@ -1,14 +1,17 @@
 // The navigation benchmark's pieces that need no closed loop: generated worlds are solvable on
 // the ground truth for the robot's footprint (the optimal path keeps its clearance and joins
-// start and goal), the summary's figures, worlds.csv read back as written, and the comparison
+// start and goal; hard ones keep the wider margin the navigator needs, which leaves the easy and
+// default worlds as they are), the summary's figures, worlds.csv read back as written, and the comparison
 // that the CI regression runs.
 #include "upd/nav/bench.h"
 
+#include "upd/maps/grid_planner.h"
 #include "upd/sim/truth_raster.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -54,6 +57,61 @@ TEST(NavBench, GeneratedWorldsAreSolvableForTheFootprint) {
               << sim::toString(d) << " seed " << seed;
         }
       }
+    }
+  }
+}
+
+// True when a way joins start and goal on the truth (0.1 m cells, the border closed) keeping
+// clearance_m from every cell that is not traversable.
+bool wayWithClearance(const sim::WorldSpec& world, double clearance_m) {
+  const sim::TruthRaster truth(world.terrain, 0.1);
+  std::vector<std::uint8_t> blocked(static_cast<std::size_t>(truth.sizeX()) * truth.sizeY());
+  for (int iy = 0; iy < truth.sizeY(); ++iy) {
+    for (int ix = 0; ix < truth.sizeX(); ++ix) {
+      const bool border = ix == 0 || iy == 0 || ix == truth.sizeX() - 1 || iy == truth.sizeY() - 1;
+      blocked[static_cast<std::size_t>(iy) * truth.sizeX() + ix] =
+          border || truth.at(ix, iy) != core::Label::Traversable;
+    }
+  }
+  maps::PlannerGridView view;
+  view.width = truth.sizeX();
+  view.height = truth.sizeY();
+  view.cell_m = 0.1;
+  view.blocked = blocked.data();
+  const auto cell = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d c = (p - truth.origin()) / 0.1;
+    return Eigen::Vector2i(static_cast<int>(std::floor(c.x())), static_cast<int>(std::floor(c.y())));
+  };
+  maps::GridPlannerParams gp;
+  gp.inflation_m = clearance_m;
+  return maps::planGridPath(view, cell(world.start_xy_yaw.head<2>()), cell(world.goal_xy), gp).found;
+}
+
+// Hard worlds keep a margin the navigator needs on their way: every passage at least the
+// robot's width plus twice hard_footprint_margin_m (0.2 m; about their narrowest wall gap);
+// with the others' 0.1 m, seeds 1-3 had passages of 0.8 m between obstacles, in which the
+// oracle's robot circled until the time limit. Easy and default worlds do not depend on it.
+TEST(NavBench, HardWorldsKeepTheirMarginAndTheOthersDoNotDependOnIt) {
+  const sim::RobotBodyParams body;
+  const BenchParams params;
+  for (int seed = 1; seed <= 3; ++seed) {
+    sim::WorldGenParams gen;
+    gen.seed = seed;
+    gen.difficulty = sim::Difficulty::Hard;
+    const BenchWorld w = makeBenchWorld(gen, body, params);
+    EXPECT_TRUE(wayWithClearance(w.generated.world, 0.5 * body.width_m + 0.2)) << "hard seed " << seed;
+  }
+  BenchParams wider = params;
+  wider.hard_footprint_margin_m = 0.5;
+  for (sim::Difficulty d : {sim::Difficulty::Easy, sim::Difficulty::Default}) {
+    for (int seed = 1; seed <= 3; ++seed) {
+      sim::WorldGenParams gen;
+      gen.seed = seed;
+      gen.difficulty = d;
+      const BenchWorld a = makeBenchWorld(gen, body, params), b = makeBenchWorld(gen, body, wider);
+      EXPECT_EQ(a.generated.attempts, b.generated.attempts);
+      EXPECT_EQ(a.generated.world.description, b.generated.world.description);
+      EXPECT_EQ(a.optimal_path_m, b.optimal_path_m) << sim::toString(d) << " seed " << seed;
     }
   }
 }

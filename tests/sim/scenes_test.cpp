@@ -352,6 +352,61 @@ TEST(Terrain, PrimitivesHaveTheirHeights) {
   EXPECT_GE(t.maxHeight(), 0.3);
 }
 
+// The height is the highest of the roughness and the shapes (a ditch's floor where a ditch is),
+// whether a shape stands above the roughness's bound (its waves then go unsummed) or below it.
+TEST(Terrain, HeightIsTheHighestOfRoughnessAndShapes) {
+  upd::sim::Roughness rough;
+  rough.rms_height_m = 0.012;  // waves of up to about 5 cm
+  rough.wavelength_m = 1.0;
+  rough.seed = 3;
+  upd::sim::Terrain waves({-3, -3}, {3, 3});
+  waves.setRoughness(rough);
+  upd::sim::Box high, low;  // above and below the waves' reach
+  high.center_xy = {-1.5, 0.0};
+  high.height_m = 0.1;
+  low.center_xy = {1.5, 0.0};
+  low.height_m = 0.02;
+  upd::sim::Rock rock;  // from 0.2 m at its centre down to 0 at its rim
+  rock.center_xy = {0.0, 1.5};
+  rock.radius_x_m = 0.5;
+  rock.radius_y_m = 0.4;
+  rock.height_m = 0.2;
+  upd::sim::Ditch ditch;
+  ditch.center_xy = {0.0, -1.5};
+  ditch.length_m = 1.0;
+  ditch.width_m = 0.5;
+  ditch.depth_m = 0.3;
+  upd::sim::Terrain t({-3, -3}, {3, 3});
+  t.add(high).add(low).add(rock).add(ditch).setRoughness(rough);
+  const auto inBox = [](const upd::sim::Box& b, double x, double y) {
+    return std::abs(x - b.center_xy.x()) <= 0.5 * b.length_m &&
+           std::abs(y - b.center_xy.y()) <= 0.5 * b.width_m;
+  };
+  int below_waves = 0;
+  for (double y = -2.5; y <= 2.5; y += 0.0137) {
+    for (double x = -2.5; x <= 2.5; x += 0.0137) {
+      double expected = waves.heightAt(x, y);
+      if (std::abs(x - ditch.center_xy.x()) <= 0.5 * ditch.length_m &&
+          std::abs(y - ditch.center_xy.y()) <= 0.5 * ditch.width_m) {
+        expected = -ditch.depth_m;
+      } else {
+        if (inBox(high, x, y)) expected = std::max(expected, high.height_m);
+        if (inBox(low, x, y)) {
+          below_waves += expected > low.height_m ? 1 : 0;
+          expected = std::max(expected, low.height_m);
+        }
+        const double u = (x - rock.center_xy.x()) / rock.radius_x_m;
+        const double v = (y - rock.center_xy.y()) / rock.radius_y_m;
+        if (u * u + v * v <= 1.0) {
+          expected = std::max(expected, rock.height_m * std::sqrt(1.0 - (u * u + v * v)));
+        }
+      }
+      ASSERT_NEAR(t.heightAt(x, y), expected, 1e-12) << x << ", " << y;
+    }
+  }
+  EXPECT_GT(below_waves, 100);  // the waves rise above the low box in places
+}
+
 TEST(Terrain, TruthRuleOnPrimitives) {
   upd::sim::Terrain t({-5, -5}, {5, 5});
   upd::sim::Box low;  // a 3 cm step: a wheel climbs it

@@ -223,6 +223,10 @@ std::vector<Eigen::Vector2d> findBumps(const TraversabilityGrid& grid,
     for (int cx = std::max(0, cx0 - reach); cx <= std::min(nx - 1, cx0 + reach); ++cx) {
       if ((grid.cellCenter(cx, cy) - centre_xy).squaredNorm() > r2) continue;
       if (bump[idx(cx, cy)] == 1) continue;  // inside a bump found from another cell
+      // A bump's body holds the cell it starts from and is smooth to the UPD throughout
+      // (bumpBody): a cell not read smooth starts none, so its ring is not fitted (on an
+      // oracle's or the baseline's map, which hold no zeta, no cell's is).
+      if (!(grid.at(cx, cy).zeta_min >= params.bump_min_zeta)) continue;
       RingPlane plane;
       if (!bumpPlane(grid, cx, cy, shape, params, h, plane)) continue;
       if (!bumpBody(grid, cx, cy, shape, plane, params, body)) continue;

@@ -375,7 +375,7 @@ double Terrain::shapeHeight(const Shape& s, double x, double y, bool& inside) co
 
 double Terrain::heightAt(double x, double y) const {
   if (!contains(x, y)) return 0.0;
-  double h = waves_.empty() ? 0.0 : roughnessAt(x, y);
+  double shapes = -std::numeric_limits<double>::infinity();
   double ditch_floor = std::numeric_limits<double>::infinity();
   for (std::uint32_t id : cell_shapes_[cellOf(x, y)]) {
     const Shape& s = shapes_[id];
@@ -385,10 +385,15 @@ double Terrain::heightAt(double x, double y) const {
     if (s.kind == Shape::Kind::Ditch) {
       ditch_floor = std::min(ditch_floor, sh);
     } else {
-      h = std::max(h, sh);
+      shapes = std::max(shapes, sh);
     }
   }
-  return std::isfinite(ditch_floor) ? ditch_floor : h;
+  if (std::isfinite(ditch_floor)) return ditch_floor;
+  // The surface is max(roughness, shapes), and the roughness never exceeds its bound (the
+  // amplitudes' sum; 1e-9 m covers the rounding of the sines and of the sum): under a shape
+  // standing higher its waves, most of the cost of a height, need not be summed.
+  if (shapes > roughness_bound_m_ + 1e-9) return shapes;
+  return std::max(waves_.empty() ? 0.0 : roughnessAt(x, y), shapes);
 }
 
 double Terrain::slopeAt(double x, double y) const {
