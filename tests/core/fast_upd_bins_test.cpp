@@ -4,7 +4,9 @@
 // sums over its points in double to float rounding, points without coordinates get no cell,
 // and the result is the same bit for bit on one thread and two. Image rows crossing cells in
 // runs of every length (one point to several vectors of 8), NaN holes and invalid normals
-// inside runs, stripe and chunk boundaries in the middle of a run. Fixed seeds.
+// inside runs, stripe and chunk boundaries in the middle of a run. Also the chunks every stage
+// deals out (equal shares of the finite points), and the whole fast UPD the same bit for bit
+// on 1, 2 and 3 threads. Fixed seeds.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -89,7 +91,7 @@ Binned bin(const Scene& s, const UpdParams& params, int threads) {
   std::size_t first = 0;
   while (!s.cloud.isFinite(first)) ++first;
   f.lat.rx = s.cloud.x[first], f.lat.ry = s.cloud.y[first], f.lat.rz = s.cloud.z[first];
-  f.chunks = detail::PointChunks::of(first, s.cloud.size());
+  f.chunks = detail::PointChunks::of(s.cloud, first);
   Binned out;
   out.cell_of.assign(s.cloud.size(), kNoIndex);
   f.cell_of = out.cell_of.data();
@@ -104,7 +106,8 @@ TEST(FastUpdBins, RunSumsEqualThePerPointSums) {
   params.radius_m = 0.5;
   params.fast_cells_per_radius = 5;
   params.fast_cells_per_point = 0;  // the base lattice only
-  // 700 x 300: several chunks of points (2^15 at most each) and stripes of 256 in every row.
+  // 700 x 300: several chunks of points (about 2^15 finite ones each) and stripes of 256 in
+  // every row.
   const Scene s = makeScene(700, 300, 11);
   const Binned one = bin(s, params, 1);
   const Binned two = bin(s, params, 2);
@@ -153,6 +156,85 @@ TEST(FastUpdBins, RunSumsEqualThePerPointSums) {
   for (std::size_t c = 0; c < one.bins.sums.size(); ++c) {
     ASSERT_EQ(std::memcmp(&one.bins.sums[c], &two.bins.sums[c], sizeof(detail::CellSums)), 0)
         << "cell " << c;
+  }
+}
+
+// A scene whose first `sky` rows are NaN, as a camera's above the horizon.
+Scene withSky(Scene s, std::size_t sky_rows) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < sky_rows * s.cloud.width; ++i) {
+    s.cloud.x[i] = s.cloud.y[i] = s.cloud.z[i] = nan;
+  }
+  return s;
+}
+
+TEST(FastUpdChunks, CoverThePointsInEqualSharesOfTheFiniteOnes) {
+  const Scene s = withSky(makeScene(640, 480, 5), 200);
+  for (const std::size_t from : {std::size_t(0), std::size_t(1000), std::size_t(150000)}) {
+    const detail::PointChunks c = detail::PointChunks::of(s.cloud, from);
+    std::size_t first = from;
+    while (!s.cloud.isFinite(first)) ++first;
+    EXPECT_EQ(c.first_finite, first) << "from " << from;
+    ASSERT_EQ(c.count % 4, 0u) << "from " << from;
+    ASSERT_EQ(c.bound.size(), c.count + 1);
+    EXPECT_EQ(c.begin(0), from);
+    EXPECT_EQ(c.end(c.count - 1), s.cloud.size());
+    std::vector<std::size_t> finite(c.count, 0);
+    std::size_t total = 0;
+    for (std::size_t k = 0; k < c.count; ++k) {
+      ASSERT_LE(c.begin(k), c.end(k)) << "chunk " << k;
+      if (k > 0) {
+        EXPECT_EQ(c.begin(k) % 256, 0u) << "chunk " << k;
+      }
+      for (std::size_t i = c.begin(k); i < c.end(k); ++i) finite[k] += s.cloud.isFinite(i) ? 1 : 0;
+      total += finite[k];
+    }
+    // The cuts fall at the first multiple of 256 where the finite share is reached.
+    for (std::size_t k = 0; k < c.count; ++k) {
+      EXPECT_NEAR(static_cast<double>(finite[k]), static_cast<double>(total) / c.count, 256.0)
+          << "from " << from << ", chunk " << k;
+    }
+  }
+  // No finite point: one chunk, first_finite at the end.
+  const Scene sky = withSky(makeScene(300, 20, 5), 20);
+  const detail::PointChunks none = detail::PointChunks::of(sky.cloud, 0);
+  EXPECT_EQ(none.count, 1u);
+  EXPECT_EQ(none.first_finite, sky.cloud.size());
+  EXPECT_EQ(none.begin(0), 0u);
+  EXPECT_EQ(none.end(0), sky.cloud.size());
+}
+
+// The whole fast UPD, its lattice chosen by fast_cells_per_point (the cells counted by the
+// team), on a frame with a NaN sky: the same rx, ry, rz, zeta and k bit for bit on 1, 2 and 3
+// threads.
+TEST(FastUpd, ResultDoesNotDependOnTheThreadCount) {
+  const Scene s = withSky(makeScene(640, 480, 9), 150);
+  UpdParams params;
+  params.radius_m = 0.5;
+  params.fast_cells_per_radius = 5;
+  params.fast_cells_per_point = 0.5;
+  std::vector<UpdResult> results;
+  std::vector<int> lattices;
+  for (const int threads : {1, 2, 3}) {
+    setThreads(threads);
+    FastUpdStats stats;
+    results.push_back(computeUpdFast(s.cloud, s.normals, params, &stats));
+    lattices.push_back(stats.cells_per_radius);
+  }
+  setThreads(2);
+  ASSERT_GT(lattices[0], 5) << "the scene should refine the lattice";
+  const UpdResult& one = results[0];
+  ASSERT_GT(s.cloud.size() - one.invalid, s.cloud.size() / 2);
+  for (std::size_t t = 1; t < results.size(); ++t) {
+    const UpdResult& r = results[t];
+    EXPECT_EQ(lattices[t], lattices[0]);
+    EXPECT_EQ(r.invalid, one.invalid);
+    EXPECT_EQ(r.k, one.k);
+    for (const auto field : {&UpdResult::rx, &UpdResult::ry, &UpdResult::rz, &UpdResult::zeta}) {
+      ASSERT_EQ(std::memcmp((r.*field).data(), (one.*field).data(), sizeof(float) * s.cloud.size()),
+                0)
+          << "threads " << t + 1;
+    }
   }
 }
 

@@ -73,7 +73,7 @@ TEST(FastUpdInterp, RunsAndSinglePointsFollowTheNodeBlend) {
     cloud.y[i] = f.lat.ry + (static_cast<float>(corner[1]) + frac[i].y()) / f.lat.inv_cell;
     cloud.z[i] = f.lat.rz + (static_cast<float>(corner[2]) + frac[i].z()) / f.lat.inv_cell;
   }
-  f.chunks = detail::PointChunks::of(0, n);
+  f.chunks = detail::PointChunks::of(cloud, 0);
   f.cell_of = cell_of.data();
   UpdResult out;
   out.rx.assign(n, -7.f), out.ry.assign(n, -7.f), out.rz.assign(n, -7.f);

@@ -1,6 +1,7 @@
 // Private to the fast normals (fast_normals.cpp: the PCA arithmetic and the hash-grid path;
-// fast_normals_organized.cpp: the image-window path): the moments of a neighbourhood, the
-// normal from them, and the vector loop that gathers the moments of the points within a radius.
+// fast_normals_organized.cpp: the image-window path; fast_normals_pitch.cpp: the sensor's
+// angular pitch it sizes windows by): the moments of a neighbourhood, the normal from them,
+// and the vector loop that gathers the moments of the points within a radius.
 #pragma once
 
 #include <Eigen/Core>
@@ -8,9 +9,11 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <vector>
 
 #include "fast_simd.h"
 #include "upd/core/normals.h"
+#include "upd/core/point_cloud.h"
 
 namespace upd::core::detail {
 
@@ -39,6 +42,12 @@ bool normalFromUnitCovariance(const double (&cov)[6], Eigen::Vector3f& n, float&
 // 0 where it returns false; the same values bit for bit, four at a time on AVX2.
 void normalsFromUnitCovariances(const double (*cov)[6], std::size_t count, Eigen::Vector3f* n,
                                 float* curvature, std::uint8_t* ok);
+
+// The angular pitch of the sensor per column (along_u: the angle between the rays of columns
+// u and u + 1) and per row [rad], from the ranges of an organized cloud
+// (fast_normals_pitch.cpp); empty when too few neighbouring pixels have a range.
+void pitchProfiles(const PointCloud& cloud, const float* range, std::vector<float>& along_u,
+                   std::vector<float>& along_v);
 
 // The same from the moments of a neighbourhood (m.n is the sum of the weights). The caller
 // checks that there are at least 3 points.

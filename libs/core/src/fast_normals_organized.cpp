@@ -95,70 +95,6 @@ void scanImages(const float* __restrict x, const float* __restrict y, const floa
   }
 }
 
-// The chord between the unit rays of pixels i and i + step, i = first + t * step, for t in
-// [0, n): the angle between them to 1e-6 at these sizes; NaN where either has no range.
-UPD_VECTOR_CLONES
-void lineChords(const float* __restrict x, const float* __restrict y, const float* __restrict z,
-                const float* __restrict range, std::size_t first, std::size_t step, std::size_t n,
-                const Eigen::Vector3f& origin, float* __restrict chord) {
-  const float ox = origin.x(), oy = origin.y(), oz = origin.z();
-  for (std::size_t t = 0; t < n; ++t) {
-    const std::size_t i = first + t * step, j = i + step;
-    const float inv_i = 1.f / range[i], inv_j = 1.f / range[j];
-    const float dx = (x[i] - ox) * inv_i - (x[j] - ox) * inv_j;
-    const float dy = (y[i] - oy) * inv_i - (y[j] - oy) * inv_j;
-    const float dz = (z[i] - oz) * inv_i - (z[j] - oz) * inv_j;
-    chord[t] = std::sqrt(dx * dx + dy * dy + dz * dz);
-  }
-}
-
-// The angular pitch of the sensor per column (along_u: the angle between the rays of columns
-// u and u + 1) or per row [rad]: the smallest over every 16th line, so that windows sized from
-// it hold the whole ball even where the pitch shrinks (off-axis, by cos^2 of the angle for a
-// pinhole camera). Columns without a sample take the median; a pitch below half the median
-// (duplicated pixels) is raised to it. Empty when too few pairs are valid.
-std::vector<float> pitchProfile(const PointCloud& cloud, const float* range, bool along_u) {
-  const std::size_t W = cloud.width, H = cloud.height;
-  const std::size_t lines = along_u ? H : W, len = along_u ? W : H;
-  const std::size_t sampled = (lines + 15) / 16, pairs = len - 1;
-  std::vector<float> chords(sampled * pairs);
-  // Each thread reads the rows of its static share of the image, as in the stages after: rows
-  // are dealt out whole, columns by their pairs' rows. (Reading lines of the image that the
-  // other core writes next frame made that write twice as slow.)
-#pragma omp parallel
-  {
-    const int team = openmp::teamSize(), me = openmp::threadIndex();
-    const std::size_t k0 = along_u ? sampled * me / team : 0,
-                      k1 = along_u ? sampled * (me + 1) / team : sampled;
-    const std::size_t t0 = along_u ? 0 : pairs * me / team,
-                      t1 = along_u ? pairs : pairs * (me + 1) / team;
-    for (std::size_t k = k0; k < k1; ++k) {
-      const std::size_t l = 16 * k;
-      lineChords(cloud.x.data(), cloud.y.data(), cloud.z.data(), range,
-                 along_u ? l * W : l + t0 * W, along_u ? 1 : W, t1 - t0, cloud.sensor_origin,
-                 &chords[k * pairs + t0]);
-    }
-  }
-  std::vector<float> lowest(len, std::numeric_limits<float>::infinity());
-  std::vector<float> all;
-  all.reserve(chords.size());
-  for (std::size_t k = 0; k < sampled; ++k) {
-    for (std::size_t t = 0; t < pairs; ++t) {
-      const float a = chords[k * pairs + t];
-      if (!(a == a)) continue;
-      lowest[t] = std::min(lowest[t], a);
-      all.push_back(a);
-    }
-  }
-  if (all.size() < 16) return {};
-  auto mid = all.begin() + static_cast<std::ptrdiff_t>(all.size() / 2);
-  std::nth_element(all.begin(), mid, all.end());
-  const float median = *mid;
-  if (!(median > 0.f)) return {};
-  for (float& p : lowest) p = std::isfinite(p) ? std::max(p, 0.5f * median) : median;
-  return lowest;
-}
-
 // Largest half-width of a scanned window [pixels]; windows wider than
 // NormalParams::fast_scan_px are sampled every 2nd or 4th row and column.
 constexpr std::ptrdiff_t kMaxHalf = 96;
@@ -344,6 +280,7 @@ struct BlockTable {
 constexpr std::size_t kTask = 64;
 void blockTaskNormals(const WindowScan& scan, const BlockTable& blocks, std::size_t b0) {
   const std::size_t count = std::min(kTask, blocks.size() - b0);
+  std::fill(blocks.bn + 5 * b0, blocks.bn + 5 * (b0 + count), kNaN);  // (a block without one)
   const float* const range = scan.im.range;
   double cov[6][kTask] = {};  // (only the first count are read; zeroed for -Wmaybe-uninitialized)
   float nx[kTask], ny[kTask], nz[kTask], curv[kTask];
@@ -550,8 +487,7 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   // buffers are reused from frame to frame.
   out.nx.resize(N), out.ny.resize(N), out.nz.resize(N), out.curvature.resize(N);
   out.invalid = 0;
-  std::size_t first = 0;
-  while (first < N && !cloud.isFinite(first)) ++first;
+  const std::size_t first = firstFinite(cloud);
   if (first == N) {
     out = Normals::unset(N);
     out.invalid = N;
@@ -561,8 +497,8 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   OrganizedBuffers& buf = buffers;
   ScanImages im = fillScanImages(cloud, cloud.point(first), buf);
   fillSparseColumns(im, buf);
-  const std::vector<float> pitch_u = pitchProfile(cloud, im.range, true);
-  const std::vector<float> pitch_v = pitchProfile(cloud, im.range, false);
+  std::vector<float> pitch_u, pitch_v;
+  detail::pitchProfiles(cloud, im.range, pitch_u, pitch_v);
   if (pitch_u.empty() || pitch_v.empty()) {
     // Not a central projection we can measure (too few neighbouring valid pixels, or all rays
     // equal): the hash grid finds the same neighbours.
@@ -579,7 +515,7 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   blocks.Wi = static_cast<std::ptrdiff_t>(im.W), blocks.Hi = static_cast<std::ptrdiff_t>(im.H);
   blocks.BW = (blocks.Wi + blocks.D - 1) / blocks.D,
   blocks.BH = (blocks.Hi + blocks.D - 1) / blocks.D;
-  buf.blocks.assign(5 * blocks.size(), kNaN);
+  buf.blocks.resize(5 * blocks.size());  // (each task of blockNormals fills its own)
   blocks.bn = buf.blocks.data();
   blockNormals(scan, blocks);
   const Eigen::Vector3f origin = cloud.sensor_origin;

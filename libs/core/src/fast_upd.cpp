@@ -27,6 +27,44 @@ void checkInputs(const PointCloud& cloud, const Normals& normals, const UpdParam
 
 }  // namespace
 
+namespace detail {
+
+PointChunks PointChunks::of(const PointCloud& cloud, std::size_t from) {
+  constexpr std::size_t kBlock = 256;
+  const std::size_t n = cloud.size(), n_blocks = (n + kBlock - 1) / kBlock;
+  std::vector<std::uint32_t> finite(n_blocks);
+#pragma omp parallel for schedule(static)
+  for (std::ptrdiff_t bb = 0; bb < static_cast<std::ptrdiff_t>(n_blocks); ++bb) {
+    const auto b = static_cast<std::size_t>(bb);
+    finite[b] = static_cast<std::uint32_t>(
+        countFinite(cloud, std::max(from, b * kBlock), (b + 1) * kBlock));
+  }
+  PointChunks c;
+  std::size_t total = 0;
+  c.first_finite = n;
+  for (std::size_t b = 0; b < n_blocks; ++b) {
+    if (finite[b] > 0 && c.first_finite == n) {
+      c.first_finite = std::max(from, b * kBlock);
+      while (!cloud.isFinite(c.first_finite)) ++c.first_finite;
+    }
+    total += finite[b];
+  }
+  constexpr std::size_t kFinitePerFour = std::size_t(1) << 16;  // ~2^14 a chunk
+  c.count = total == 0 ? 1 : 4 * ((total + kFinitePerFour - 1) / kFinitePerFour);
+  c.bound.assign(c.count + 1, n);
+  c.bound[0] = from;
+  std::size_t next = 1, seen = 0;
+  for (std::size_t b = 0; b < n_blocks && next < c.count; ++b) {
+    seen += finite[b];
+    while (next < c.count && seen * c.count >= next * total) {
+      c.bound[next++] = std::min(n, (b + 1) * kBlock);
+    }
+  }
+  return c;
+}
+
+}  // namespace detail
+
 int finerCellsPerRadius(int cells_per_radius, std::size_t cells, double valid_points,
                         double cells_per_point) {
   const int top = std::min(2 * cells_per_radius, 16);
@@ -61,20 +99,20 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   detail::FastFrame f(cloud, normals, params);
   f.m = params.fast_cells_per_radius;  // or finer (binFrame)
   f.lat.inv_cell = static_cast<float>(f.m / params.radius_m);
-  std::size_t first = 0;
-  while (first < n_pts && !cloud.isFinite(first)) ++first;
-  for (std::size_t i = 0; i < first; ++i) detail::setUnscored(out, i);
+  // The chunks start at the first point: the binning gives the points without a cell
+  // (non-finite ones) kNoIndex and the interpolation leaves them unscored.
+  f.chunks = detail::PointChunks::of(cloud, 0);
+  const std::size_t first = f.chunks.first_finite;
   if (first == n_pts) {
+    for (std::size_t i = 0; i < n_pts; ++i) detail::setUnscored(out, i);
     out.invalid = n_pts;
     return;
   }
   f.lat.rx = cloud.x[first], f.lat.ry = cloud.y[first], f.lat.rz = cloud.z[first];
-  f.chunks = detail::PointChunks::of(first, n_pts);
   static thread_local detail::FastUpdBuffers buffers;  // the calling thread's, kept
   detail::FastUpdBuffers& buf = buffers;
   buf.cell_of.resize(n_pts);
   f.cell_of = buf.cell_of.data();
-  std::fill(f.cell_of, f.cell_of + first, kNoIndex);
 
   const detail::Bins bins = detail::binFrame(f);
   const std::size_t n_cells = bins.sums.size();
@@ -84,8 +122,7 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   detail::computeNodeSums(index, bins, buf.rows.data(), f.m, buf.node_sums);
   const std::vector<char> refine = detail::cellsToRefine(
       buf.node_sums.data(), buf.cell_nodes.data(), n_cells, params.fast_refine_spread);
-  std::size_t invalid = first;  // the points before the first finite one
-  invalid += detail::interpolateFrame(f, bins, buf, refine, out);
+  std::size_t invalid = detail::interpolateFrame(f, bins, buf, refine, out);
   std::size_t refined_points = 0;
   if (params.fast_refine_spread > 0) {
     invalid +=

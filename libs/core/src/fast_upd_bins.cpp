@@ -9,6 +9,7 @@
 #include <string>
 
 #include "fast_upd_internal.h"
+#include "upd/core/openmp.h"
 
 namespace upd::core::detail {
 
@@ -208,7 +209,7 @@ Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& l
   // to the threads in the same contiguous shares, so that a point's data stay in one core's
   // cache (see copyCloud). Dynamic schedules scattered them, and on a two-vCPU VM a line the
   // other core has read costs twice as much to write again.
-#pragma omp parallel for schedule(static) reduction(& : all_fit)
+#pragma omp parallel for schedule(dynamic, 1) reduction(& : all_fit)
   for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
     const auto cu = static_cast<std::size_t>(c);
     static thread_local StripeBuffers stripes;  // (this thread's: named inside the region)
@@ -284,29 +285,63 @@ std::uint32_t cellChanges(const float* __restrict x, const float* __restrict y,
   return valid;
 }
 
-CellCount countCells(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
-                     std::size_t first, std::size_t step) {
-  static thread_local CellStripe s;
-  CellGrid grid;
-  CellCount count;
+// The cells and valid points of the sampled stripes [j0, j1) (stripe j starts at first +
+// j * step * kStripe) into grid; returns the valid points.
+std::size_t countStripes(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+                         std::size_t first, std::size_t step, std::size_t j0, std::size_t j1,
+                         CellGrid& grid) {
+  CellStripe s;  // (on the stack: a thread_local's address costs a call at each use here)
   std::size_t valid = 0;
   s.cx[0] = kOutside, s.cy[0] = s.cz[0] = 0.f;
   const std::size_t n_pts = cloud.size();
-  for (std::size_t s0 = first; s0 < n_pts; s0 += step * kStripe) {
+  for (std::size_t j = j0; j < j1; ++j) {
+    const std::size_t s0 = first + j * step * kStripe;
     const std::size_t n = std::min(kStripe, n_pts - s0);
     valid += cellChanges(&cloud.x[s0], &cloud.y[s0], &cloud.z[s0], &normals.nx[s0], lat, n, s);
-    for (std::size_t j = 0; j < n; ++j) {
-      if (!s.change[j]) continue;
-      bool inserted = false;
-      grid.insert(static_cast<std::int32_t>(s.cx[j + 1]), static_cast<std::int32_t>(s.cy[j + 1]),
-                  static_cast<std::int32_t>(s.cz[j + 1]), inserted);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!s.change[i]) continue;
+      grid.insert(static_cast<std::int32_t>(s.cx[i + 1]), static_cast<std::int32_t>(s.cy[i + 1]),
+                  static_cast<std::int32_t>(s.cz[i + 1]));
     }
     // The stripe's last cell is the next one's previous (an outside point's too: kOutside).
     s.cx[0] = s.cx[n], s.cy[0] = s.cy[n], s.cz[0] = s.cz[n];
   }
-  count.cells = grid.size();
+  return valid;
+}
+
+// The team's threads count contiguous shares of the sampled stripes, each into a grid of its
+// own; the cells are then their union (a few thousand: the points are what costs).
+CellCount countCells(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+                     std::size_t first, std::size_t step) {
+  const std::size_t n_stripes = (cloud.size() - first + step * kStripe - 1) / (step * kStripe);
+  std::vector<CellGrid> grids(static_cast<std::size_t>(openmp::maxThreads()));
+  std::size_t valid = 0;
+#pragma omp parallel reduction(+ : valid)
+  {
+    const auto team = static_cast<std::size_t>(openmp::teamSize());
+    const auto me = static_cast<std::size_t>(openmp::threadIndex());
+    valid += countStripes(cloud, normals, lat, first, step, n_stripes * me / team,
+                          n_stripes * (me + 1) / team, grids[me]);
+  }
+  CellGrid& all = grids[0];
+  for (std::size_t t = 1; t < grids.size(); ++t) {
+    for (std::size_t c = 0; c < grids[t].size(); ++c) {
+      const std::int32_t* xyz = grids[t].xyz(c);
+      all.insert(xyz[0], xyz[1], xyz[2]);
+    }
+  }
+  CellCount count;
+  count.cells = all.size();
   count.valid = static_cast<double>(valid);
   return count;
+}
+
+// The values of x[0, n) that are not NaN (the points with a normal), in a vector loop.
+UPD_VECTOR_CLONES
+std::size_t countNumbers(const float* __restrict x, std::size_t n) {
+  std::uint32_t k = 0;
+  for (std::size_t i = 0; i < n; ++i) k += static_cast<std::uint32_t>(x[i] == x[i]);
+  return k;
 }
 
 // Every 4th stripe: on a frame far from the refinement budget (most cells seen by a quarter of
@@ -320,10 +355,15 @@ constexpr std::size_t kSampleStep = 4;
 // count; otherwise every point is counted.
 int latticeCells(const FastFrame& f) {
   const double cells_per_point = f.params.fast_cells_per_point;
-  const std::size_t first = f.chunks.first, n_pts = f.cloud.size();
+  const std::size_t first = f.chunks.first_finite, n_pts = f.cloud.size();
   std::size_t with_normal = 0;
-  const float* nx = f.normals.nx.data();
-  for (std::size_t i = first; i < n_pts; ++i) with_normal += nx[i] == nx[i] ? 1 : 0;
+  constexpr std::size_t kShare = 1 << 14;
+  const auto n_shares = static_cast<std::ptrdiff_t>((n_pts - first + kShare - 1) / kShare);
+#pragma omp parallel for schedule(static) reduction(+ : with_normal)
+  for (std::ptrdiff_t k = 0; k < n_shares; ++k) {
+    const std::size_t b = first + static_cast<std::size_t>(k) * kShare;
+    with_normal += countNumbers(f.normals.nx.data() + b, std::min(kShare, n_pts - b));
+  }
   const CellCount sample = countCells(f.cloud, f.normals, f.lat, first, kSampleStep);
   if (finerCellsPerRadius(f.m, sample.cells, static_cast<double>(with_normal),
                           cells_per_point) == f.m) {

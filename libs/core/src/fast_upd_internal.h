@@ -5,9 +5,9 @@
 //   refined cells                                     whose nodes disagree, summed per point
 //   interpolation               fast_upd_interp.cpp  every point from its cell's 8 nodes
 //   exact band                  fast_upd_exact.cpp   exact sums near the label threshold
-// Every stage deals the points out in the same fixed chunks (PointChunks) with a static
-// schedule, so that the result does not depend on the thread count and a point's data stay in
-// one core's cache from stage to stage.
+// Every stage deals the points out in the same chunks (PointChunks, fixed by the points) with
+// a static schedule, so that the result does not depend on the thread count and a point's data
+// stay in one core's cache from stage to stage.
 #pragma once
 
 #include <algorithm>
@@ -106,23 +106,19 @@ inline void setUnscored(UpdResult& out, std::size_t i) {
   out.k[i] = 0;
 }
 
-// The points [first, n_pts) in count chunks of size points (the last may be shorter): fixed by
-// the number of points alone.
+// The points [from, n) in count chunks of about equal numbers of finite points, cut at
+// multiples of 256 points; count is a multiple of 4 (1 without a finite point). Fixed by the
+// points alone, so the same for any number of threads (the binning merges its sums in chunk
+// order), and a static schedule gives 1, 2 or 4 threads equal shares of the finite points,
+// wherever in the frame they lie (a sky of NaN above, a near floor below).
 struct PointChunks {
-  std::size_t first = 0, n_pts = 0, size = 1, count = 0;
+  std::size_t first_finite = 0;  // the first finite point at or after from (n: none)
+  std::size_t count = 0;
+  std::vector<std::size_t> bound;  // chunk c is [bound[c], bound[c + 1])
 
-  // Chunks of equal size, at most 2^15 points (a multiple of 256): the same for any number of
-  // threads, and a static schedule gives two threads an equal share.
-  static PointChunks of(std::size_t first, std::size_t n_pts) {
-    PointChunks c;
-    c.first = first, c.n_pts = n_pts;
-    const std::size_t n = (n_pts - first + (std::size_t(1) << 15) - 1) >> 15;
-    c.size = ((n_pts - first + n - 1) / n + 255) / 256 * 256;
-    c.count = (n_pts - first + c.size - 1) / c.size;
-    return c;
-  }
-  std::size_t begin(std::size_t c) const { return first + c * size; }
-  std::size_t end(std::size_t c) const { return std::min(n_pts, begin(c) + size); }
+  static PointChunks of(const PointCloud& cloud, std::size_t from);
+  std::size_t begin(std::size_t c) const { return bound[c]; }
+  std::size_t end(std::size_t c) const { return bound[c + 1]; }
 };
 
 // The occupied cells of a run of points with their sums: what binning produces per chunk and

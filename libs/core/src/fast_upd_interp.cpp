@@ -262,7 +262,7 @@ std::size_t interpolateFrame(const FastFrame& f, const Bins& bins, FastUpdBuffer
   std::size_t invalid = 0;
   const PointChunks& chunks = f.chunks;
   const auto min_k = static_cast<float>(f.params.min_neighbors);
-#pragma omp parallel for schedule(static) reduction(+ : invalid)
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : invalid)
   for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(chunks.count); ++c) {
     const std::size_t begin = chunks.begin(static_cast<std::size_t>(c));
     const std::size_t end = chunks.end(static_cast<std::size_t>(c));

@@ -1,9 +1,11 @@
 #include "upd/core/point_cloud.h"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
 #include "upd/core/openmp.h"
+#include "upd/core/vector_clones.h"
 
 #include "preprocess_internal.h"
 
@@ -45,7 +47,38 @@ void copyColour(const PointCloud& in, PointCloud& out) {
     std::memcpy(out.b.data() + begin, in.b.data() + begin, len);
   }
 }
+// countFinite's loop: x - x is 0 for a finite x and NaN otherwise.
+UPD_VECTOR_CLONES
+std::size_t countFiniteIn(const float* __restrict x, const float* __restrict y,
+                          const float* __restrict z, std::size_t n) {
+  std::uint32_t k = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    k += static_cast<std::uint32_t>(static_cast<int>(x[i] - x[i] == 0.f) &
+                                    static_cast<int>(y[i] - y[i] == 0.f) &
+                                    static_cast<int>(z[i] - z[i] == 0.f));
+  }
+  return k;
+}
+
 }  // namespace
+
+std::size_t countFinite(const PointCloud& cloud, std::size_t begin, std::size_t end) {
+  end = std::min(end, cloud.size());
+  return begin < end ? countFiniteIn(cloud.x.data() + begin, cloud.y.data() + begin,
+                                     cloud.z.data() + begin, end - begin)
+                     : 0;
+}
+
+std::size_t firstFinite(const PointCloud& cloud, std::size_t from) {
+  constexpr std::size_t kBlock = 256;
+  const std::size_t n = cloud.size();
+  for (std::size_t b = from; b < n; b += kBlock) {
+    if (countFinite(cloud, b, b + kBlock) == 0) continue;
+    while (!cloud.isFinite(b)) ++b;
+    return b;
+  }
+  return n;
+}
 
 void detail::copyAllButPoints(const PointCloud& in, PointCloud& out) {
   const std::size_t n = in.size();

@@ -89,6 +89,13 @@ struct PointCloud {
   }
 };
 
+/// The points of [begin, end) whose x, y and z are all finite (PointCloud::isFinite), counted
+/// in a vector loop.
+std::size_t countFinite(const PointCloud& cloud, std::size_t begin, std::size_t end);
+/// The first point at or after from that is finite; size() when there is none. (A vector scan
+/// a block at a time: an organized frame's NaN sky may fill a third of it.)
+std::size_t firstFinite(const PointCloud& cloud, std::size_t from = 0);
+
 /// out = in, reusing out's buffers; returns the number of finite points. The OpenMP team
 /// copies the arrays in static shares, so that each thread writes the part of the cloud it
 /// will read in the stages after: a serial copy rewrote the lines the other core had read in
