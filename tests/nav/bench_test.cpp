@@ -87,33 +87,38 @@ bool wayWithClearance(const sim::WorldSpec& world, double clearance_m) {
   return maps::planGridPath(view, cell(world.start_xy_yaw.head<2>()), cell(world.goal_xy), gp).found;
 }
 
-// Hard worlds keep a margin the navigator needs on their way: every passage at least the
-// robot's width plus twice hard_footprint_margin_m (0.2 m; about their narrowest wall gap);
+// Each difficulty's worlds are checked solvable with its own clearance (sim::solvableClearance):
+// hard worlds keep 0.2 m beyond the half-width on their way (about their narrowest wall gap;
 // with the others' 0.1 m, seeds 1-3 had passages of 0.8 m between obstacles, in which the
-// oracle's robot circled until the time limit. Easy and default worlds do not depend on it.
-TEST(NavBench, HardWorldsKeepTheirMarginAndTheOthersDoNotDependOnIt) {
+// oracle's robot circled until the time limit). BenchParams::footprint_margin_m overrides it.
+TEST(NavBench, EachDifficultyIsCheckedWithItsOwnClearance) {
+  EXPECT_EQ(sim::solvableClearance(sim::Difficulty::Easy), 0.1);
+  EXPECT_EQ(sim::solvableClearance(sim::Difficulty::Default), 0.1);
+  EXPECT_EQ(sim::solvableClearance(sim::Difficulty::Hard), 0.2);
   const sim::RobotBodyParams body;
   const BenchParams params;
-  for (int seed = 1; seed <= 3; ++seed) {
-    sim::WorldGenParams gen;
-    gen.seed = seed;
-    gen.difficulty = sim::Difficulty::Hard;
-    const BenchWorld w = makeBenchWorld(gen, body, params);
-    EXPECT_TRUE(wayWithClearance(w.generated.world, 0.5 * body.width_m + 0.2)) << "hard seed " << seed;
-  }
-  BenchParams wider = params;
-  wider.hard_footprint_margin_m = 0.5;
-  for (sim::Difficulty d : {sim::Difficulty::Easy, sim::Difficulty::Default}) {
+  bool hard_differs_at_0_1 = false;
+  for (sim::Difficulty d : {sim::Difficulty::Easy, sim::Difficulty::Default, sim::Difficulty::Hard}) {
+    BenchParams same = params, narrow = params;
+    same.footprint_margin_m = sim::solvableClearance(d);
+    narrow.footprint_margin_m = 0.1;
     for (int seed = 1; seed <= 3; ++seed) {
       sim::WorldGenParams gen;
       gen.seed = seed;
       gen.difficulty = d;
-      const BenchWorld a = makeBenchWorld(gen, body, params), b = makeBenchWorld(gen, body, wider);
+      const BenchWorld a = makeBenchWorld(gen, body, params), b = makeBenchWorld(gen, body, same);
       EXPECT_EQ(a.generated.attempts, b.generated.attempts);
       EXPECT_EQ(a.generated.world.description, b.generated.world.description);
       EXPECT_EQ(a.optimal_path_m, b.optimal_path_m) << sim::toString(d) << " seed " << seed;
+      if (d != sim::Difficulty::Hard) continue;
+      EXPECT_TRUE(wayWithClearance(a.generated.world, 0.5 * body.width_m + 0.2))
+          << "hard seed " << seed;
+      hard_differs_at_0_1 = hard_differs_at_0_1 || makeBenchWorld(gen, body, narrow)
+                                                            .generated.world.description !=
+                                                        a.generated.world.description;
     }
   }
+  EXPECT_TRUE(hard_differs_at_0_1) << "hard seeds 1-3 drew the same worlds with 0.1 m";
 }
 
 // A stop on an open map is the navigator's unless the planner had given up at the end: plans

@@ -62,10 +62,10 @@ const char* toString(FailureCause c) {
 
 void BenchParams::validate() const {
   const char* s = "BenchParams";
-  core::requireParam(std::isfinite(footprint_margin_m) && footprint_margin_m >= 0, s,
-                     "footprint_margin_m", footprint_margin_m, "must be >= 0");
-  core::requireParam(std::isfinite(hard_footprint_margin_m) && hard_footprint_margin_m >= 0, s,
-                     "hard_footprint_margin_m", hard_footprint_margin_m, "must be >= 0");
+  if (footprint_margin_m) {
+    core::requireParam(std::isfinite(*footprint_margin_m) && *footprint_margin_m >= 0, s,
+                       "footprint_margin_m", *footprint_margin_m, "must be >= 0");
+  }
   core::requireParam(std::isfinite(reference_speed_mps) && reference_speed_mps > 0, s,
                      "reference_speed_mps", reference_speed_mps, "must be > 0");
   core::requireParam(std::isfinite(time_limit_factor) && time_limit_factor >= 1, s,
@@ -110,8 +110,8 @@ BenchWorld makeBenchWorld(const sim::WorldGenParams& gen, const sim::RobotBodyPa
                           const BenchParams& params) {
   params.validate();
   BenchWorld w;
-  const double margin_m = gen.difficulty == sim::Difficulty::Hard ? params.hard_footprint_margin_m
-                                                                    : params.footprint_margin_m;
+  const double margin_m =
+      params.footprint_margin_m.value_or(sim::solvableClearance(gen.difficulty));
   const auto solvable = [&](const sim::WorldSpec& candidate) {
     return !truthPath(candidate, body, margin_m).empty();
   };

@@ -57,15 +57,16 @@ struct Kinds {
   int rocks, ramps, steps, ditches, passages;
   double min_gap_m, max_gap_m;  // passage widths between the wall faces
   double roughness_rms_m;
+  double solvable_clearance_m;  // solvableClearance
 };
 
 Kinds kindsOf(Difficulty d, double robot_width_m) {
   switch (d) {
-    case Difficulty::Easy: return {5, 1, 1, 0, 0, 0.0, 0.0, 0.003};
-    case Difficulty::Default: return {8, 1, 2, 1, 1, 1.3, 2.4, 0.006};
+    case Difficulty::Easy: return {5, 1, 1, 0, 0, 0.0, 0.0, 0.003, 0.1};
+    case Difficulty::Default: return {8, 1, 2, 1, 1, 1.3, 2.4, 0.006, 0.1};
     case Difficulty::Hard: break;
   }
-  return {12, 2, 2, 2, 2, robot_width_m + kPassageMargin_m, 2.0, 0.012};
+  return {12, 2, 2, 2, 2, robot_width_m + kPassageMargin_m, 2.0, 0.012, 0.2};
 }
 
 // Draws one candidate world; nullopt when a feature found no free place.
@@ -255,6 +256,8 @@ std::string describe(const WorldGenParams& p, const WorldFeatures& f) {
 }
 
 }  // namespace
+
+double solvableClearance(Difficulty d) { return kindsOf(d, 0.0).solvable_clearance_m; }
 
 GeneratedWorld generateWorld(const WorldGenParams& params, const SolvableCheck& solvable) {
   params.validate();

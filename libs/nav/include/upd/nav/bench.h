@@ -4,8 +4,8 @@
 //
 // A world is solvable when the ground-truth planner of the simulated run
 // (mrpt_bridge::planSimulatedRoute: the project's grid A* on the truth raster) finds a way from
-// start to goal keeping half the robot's width plus footprint_margin_m (hard worlds:
-// hard_footprint_margin_m) from non-traversable truth. The optimal path is the same planner's
+// start to goal keeping half the robot's width plus the difficulty's clearance
+// (sim::solvableClearance, unless footprint_margin_m says otherwise) from non-traversable truth. The optimal path is the same planner's
 // straightened path keeping half the width (the bare footprint: no navigator can do shorter
 // without touching an obstacle), the optimal time its length at reference_speed_mps (the
 // navigator's top speed).
@@ -33,6 +33,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,12 +52,9 @@ enum class FailureCause { None, FalseObstacle, MissedObstacle, Planning, Navigat
 const char* toString(FailureCause c);
 
 struct BenchParams {
-  double footprint_margin_m = 0.1;   ///< the solvability check's clearance beyond half-width [m]
-  /// The same for hard worlds [m]: every passage on their solvable way is at least the robot's
-  /// width plus about twice this, near their narrowest wall gap (width + 0.5 m). With 0.1 m
-  /// their clutter left passages of 0.8 m, in which MRPT's navigator circles until the time
-  /// limit even on the oracle's map (docs/NAVIGATION.md, "Navigation benchmark").
-  double hard_footprint_margin_m = 0.2;
+  /// The solvability check's clearance beyond half the robot's width [m]; unset: the world's
+  /// difficulty's (sim::solvableClearance: 0.1 m, hard worlds 0.2 m).
+  std::optional<double> footprint_margin_m;
   double reference_speed_mps = 0.4;  ///< the optimal time is the optimal path at this [m/s]
   double time_limit_factor = 4.0;    ///< a world's time limit: this x the optimal time ...
   double min_time_limit_s = 60.0;    ///< ... and at least this [s]

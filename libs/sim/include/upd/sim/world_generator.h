@@ -62,6 +62,13 @@ struct GeneratedWorld {
   int attempts = 1;  ///< candidates drawn until one passed the check
 };
 
+/// The clearance beyond half the robot's width with which a world of difficulty d is to be
+/// checked solvable (the caller's SolvableCheck) [m]: 0.1 m; 0.2 m for hard worlds, whose
+/// clutter with 0.1 m left passages of 0.8 m on the way, in which MRPT's navigator circles
+/// until the time limit even on the true map (docs/NAVIGATION.md, "Navigation benchmark").
+/// With 0.2 m every passage on a hard world's way is about as wide as its narrowest wall gap.
+double solvableClearance(Difficulty d);
+
 /// A candidate world passes when the robot can drive from its start to its goal.
 using SolvableCheck = std::function<bool(const WorldSpec&)>;
 
