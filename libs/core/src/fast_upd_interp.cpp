@@ -142,7 +142,14 @@ struct PointOut {
     k[j] = scored ? static_cast<std::uint32_t>(count + 0.5f) : 0;
     return scored ? 0 : 1;
   }
-  // The same for the kRunLanes points from j0.
+  // Points [b, e) unscored (no cell: not finite, or beyond the lattice); returns e - b.
+  std::size_t unscore(std::size_t b, std::size_t e) const {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (float* v : {rx, ry, rz, zeta}) std::fill(v + b, v + e, nan);
+    std::fill(k + b, k + e, 0u);
+    return e - b;
+  }
+  // The same as store for the kRunLanes points from j0.
   __attribute__((always_inline)) std::size_t storeLanes(std::size_t j0,
                                                         const Lanes (&value)[4]) const {
     const LaneMask scored = value[3] + 0.5f >= min_k;
@@ -207,18 +214,13 @@ std::size_t interpolate(const PointCloud& cloud, const Lattice& lat, const std::
                         std::size_t end, UpdResult& result) {
   const PointOut out{result.rx.data(),   result.ry.data(), result.rz.data(),
                      result.zeta.data(), result.k.data(),  min_k};
-  const float nan = std::numeric_limits<float>::quiet_NaN();
   std::size_t invalid = 0;
   for (std::size_t i = begin; i < end;) {
     const std::uint32_t c = cell_of[i];
     std::size_t e = i + 1;
     while (e < end && cell_of[e] == c) ++e;
     if (c == kNoIndex) {
-      for (std::size_t j = i; j < e; ++j) {
-        out.rx[j] = out.ry[j] = out.rz[j] = out.zeta[j] = nan;
-        out.k[j] = 0;
-      }
-      invalid += e - i;
+      invalid += out.unscore(i, e);
     } else if (!skip[c]) {
       invalid += scoreRun(polys[c], lat, cloud.x.data(), cloud.y.data(), cloud.z.data(), i, e, out);
     }
