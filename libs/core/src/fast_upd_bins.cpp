@@ -205,10 +205,12 @@ Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& l
   const auto n_chunks = static_cast<std::ptrdiff_t>(chunks.count);
   std::vector<Bins> chunk_bins(chunks.count);
   int all_fit = 1;
-  // Static schedules here and in the later stages: every stage of a frame deals the points out
-  // to the threads in the same contiguous shares, so that a point's data stay in one core's
-  // cache (see copyCloud). Dynamic schedules scattered them, and on a two-vCPU VM a line the
-  // other core has read costs twice as much to write again.
+  // A dynamic schedule over the chunks (equal numbers of finite points): a chunk's cost still
+  // varies with its points' runs (far points cross cells more often), and with static shares
+  // of them the second thread waited for the first on most frames; the merge below runs in
+  // chunk order, so the result does not depend on who took which chunk. (The other stages
+  // keep static shares, so that a point's data mostly stay in one core's cache: see
+  // copyCloud.)
 #pragma omp parallel for schedule(dynamic, 1) reduction(& : all_fit)
   for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
     const auto cu = static_cast<std::size_t>(c);

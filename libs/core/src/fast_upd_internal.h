@@ -5,9 +5,9 @@
 //   refined cells                                     whose nodes disagree, summed per point
 //   interpolation               fast_upd_interp.cpp  every point from its cell's 8 nodes
 //   exact band                  fast_upd_exact.cpp   exact sums near the label threshold
-// Every stage deals the points out in the same chunks (PointChunks, fixed by the points) with
-// a static schedule, so that the result does not depend on the thread count and a point's data
-// stay in one core's cache from stage to stage.
+// Every stage deals the points out in the same chunks (PointChunks, fixed by the points), so
+// that the result does not depend on the thread count; the binning and the interpolation take
+// them dynamically, the others in static shares.
 #pragma once
 
 #include <algorithm>
