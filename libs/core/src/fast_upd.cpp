@@ -44,8 +44,7 @@ PointChunks PointChunks::of(const PointCloud& cloud, std::size_t from) {
   c.first_finite = n;
   for (std::size_t b = 0; b < n_blocks; ++b) {
     if (finite[b] > 0 && c.first_finite == n) {
-      c.first_finite = std::max(from, b * kBlock);
-      while (!cloud.isFinite(c.first_finite)) ++c.first_finite;
+      c.first_finite = firstFinite(cloud, std::max(from, b * kBlock));
     }
     total += finite[b];
   }

@@ -69,6 +69,8 @@ std::size_t countFinite(const PointCloud& cloud, std::size_t begin, std::size_t 
                      : 0;
 }
 
+std::size_t PointCloud::countFinite() const { return core::countFinite(*this, 0, size()); }
+
 std::size_t firstFinite(const PointCloud& cloud, std::size_t from) {
   constexpr std::size_t kBlock = 256;
   const std::size_t n = cloud.size();

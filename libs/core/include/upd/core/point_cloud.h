@@ -76,17 +76,8 @@ struct PointCloud {
     width = w;
     height = h;
   }
-  /// Number of points with finite coordinates.
-  std::size_t countFinite() const {
-    // x * 0 is 0 for a finite x and NaN for an infinite or NaN one: a test without branches,
-    // so the loop vectorizes (isFinite's && and std::isfinite kept it scalar).
-    std::size_t n = 0;
-    const float *px = x.data(), *py = y.data(), *pz = z.data();
-    for (std::size_t i = 0; i < size(); ++i) {
-      n += px[i] * 0.f + py[i] * 0.f + pz[i] * 0.f == 0.f ? 1 : 0;
-    }
-    return n;
-  }
+  /// Number of points with finite coordinates (core::countFinite over the whole cloud).
+  std::size_t countFinite() const;
 };
 
 /// The points of [begin, end) whose x, y and z are all finite (PointCloud::isFinite), counted
