@@ -264,6 +264,55 @@ TEST(PreprocessReference, HoleRunsOfEveryLength) {
   checkChain("hole runs", c, p);
 }
 
+// A depth camera's frame of w x h pixels (focal length 0.75 w) looking at a tilted, rippled
+// surface, 1.5-2.7 m away, with NaN holes: a 2 cm voxel spans several pixels of a row and
+// several rows, as on a Kinect frame.
+PointCloud depthFrame(std::size_t w, std::size_t h) {
+  PointCloud c;
+  const float f = 0.75f * static_cast<float>(w);
+  for (std::size_t v = 0; v < h; ++v) {
+    for (std::size_t u = 0; u < w; ++u) {
+      const float du = (static_cast<float>(u) - 0.5f * static_cast<float>(w)) / f;
+      const float dv = (static_cast<float>(v) - 0.5f * static_cast<float>(h)) / f;
+      const float depth = 1.5f + 1.2f * static_cast<float>(v) / static_cast<float>(h) +
+                          0.05f * std::sin(0.05f * static_cast<float>(u));
+      const bool hole = (u / 7 + v / 5) % 23 == 0;
+      const auto col = static_cast<std::uint8_t>((u + 3 * v) % 256);
+      c.push_back(hole ? kNan : du * depth, dv * depth, depth, col, 7, static_cast<std::uint8_t>(v % 256));
+    }
+  }
+  c.width = w, c.height = h;
+  c.sensor_origin = {0.f, 0.f, 0.f};
+  return c;
+}
+
+// From 65,536 points the voxel pass runs on the whole team, each thread summing its share of
+// the voxels over all the points: a depth frame (runs along rows and down columns cross the
+// threads' blocks of voxels) and random clouds, organized and not, keep the reference's points
+// and centroids on 1, 2 and 3 threads.
+TEST(PreprocessReference, ATeamSumsTheVoxelsOfLargeCloudsAsOneThread) {
+  PreprocessParams p = paperParams();
+  const PointCloud frame = depthFrame(400, 200);
+  const PointCloud organized = randomCloud(31, 80000, 400, true);
+  const PointCloud unorganized = randomCloud(32, 70000, 0, false);
+  for (const auto* c : {&frame, &organized, &unorganized}) {
+    ASSERT_GT(c->size(), 65536u);
+    double margin = 0;
+    const PointCloud want = refPreprocess(*c, p, margin);
+    ASSERT_GT(want.size(), 1000u);
+    EXPECT_GT(margin, 1e-9) << "a point lies within rounding of the outlier threshold";
+    PointCloud out;
+    for (const int threads : {1, 2, 3}) {
+      setThreads(threads);
+      SCOPED_TRACE(std::to_string(threads) + " thread(s), " + std::to_string(c->size()) +
+                   " points" + (c->isOrganized() ? ", organized" : ""));
+      preprocess(*c, p, out);
+      expectSameCloud(out, want);
+    }
+  }
+  setThreads(2);
+}
+
 // The mean distance of every point of c to its k nearest others, each compared with every point
 // in double (the k-d tree computes in float from its own origin: on a cloud spanning hundreds of
 // metres it is off by 1e-4 relative).
