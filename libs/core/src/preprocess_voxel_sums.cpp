@@ -56,9 +56,10 @@ struct VoxelScratch {
 
 // The first point of in that passes (finite, kept by test), or in.size(); the finite points
 // before it added to finite.
+// (The non-finite points, a camera's rows above the horizon, skipped by firstFinite's vector
+// scan.)
 std::size_t firstPassing(const PointCloud& in, const RangeBoxTest* test, std::size_t& finite) {
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    if (!in.isFinite(i)) continue;
+  for (std::size_t i = firstFinite(in); i < in.size(); i = firstFinite(in, i + 1)) {
     if (test == nullptr || test->keeps(in.point(i))) return i;
     ++finite;
   }
@@ -111,8 +112,8 @@ class VoxelPass {
 
   // Points [b, e) of one row: their keys, then their sums (of an organized cloud: keys holds
   // the row's voxel keys and ids for the next row, above the previous row's; else all null).
-  // kTeam: each voxel's first and last point kept; false where a key overflows (the caller
-  // throws).
+  // kTeam: the keys given (the team computes them first), each voxel's first and last point
+  // kept. False where a key overflows (the caller throws).
   template <bool kTeam>
   bool row(std::size_t b, std::size_t e, std::uint64_t* keys, std::uint32_t* ids,
            const std::uint64_t* above_keys, const std::uint32_t* above_ids) {
@@ -121,7 +122,7 @@ class VoxelPass {
       if (s_.keys.size() < n) s_.keys.resize(n);
       keys = s_.keys.data();
     }
-    if (!voxelKeys(&in_.x[b], &in_.y[b], &in_.z[b], n, k_, keys, finite_)) return false;
+    if (!kTeam && !voxelKeys(&in_.x[b], &in_.y[b], &in_.z[b], n, k_, keys, finite_)) return false;
     const bool colour = in_.hasColor();
     const float *x = &in_.x[b], *y = &in_.y[b], *z = &in_.z[b];
     const std::uint8_t* rgb[3] = {colour ? &in_.r[b] : nullptr, colour ? &in_.g[b] : nullptr,
@@ -266,35 +267,71 @@ UPD_NOIPA CropCounts voxelizeWith(VoxelScratch& s, const PointCloud& in, const S
   return {st.finite_before + pass.finite(), pass.passed()};
 }
 
-// What the threads of a team share: the cloud's keys, each thread's scratch, voxel count and
-// (of those no earlier thread has) the place of its first in the output.
+// What the threads of a team share: the cloud's keys, the cost of each row's sums (an
+// unorganized cloud: of each chunk of kTeamChunk points), the first point of each thread's
+// rows, each thread's scratch, voxel count and (of those no earlier thread has) the place of
+// its first in the output.
 struct Team {
   const PointCloud& in;
   const Start& st;
   std::uint64_t* keys;
+  std::vector<std::uint32_t>& cost;
+  std::vector<std::size_t>& starts;
   std::vector<VoxelScratch*>& scratch;
   std::vector<std::size_t>& voxels;
   std::vector<std::size_t>& offset;
+  std::size_t w;  // the row's length (an unorganized cloud: kTeamChunk)
 };
+constexpr std::size_t kTeamChunk = 4096;
 
-// The first point of thread me's rows (the share of a team of `team` splitting the rows from
-// the first passing point; an unorganized cloud: points), or the cloud's end for me = team.
-std::size_t shareStart(const Team& t, int team, int me) {
-  const std::size_t first = t.st.first, n = t.in.size();
-  if (me == 0) return first;
-  if (me == team) return n;
-  const std::size_t w = t.in.isOrganized() ? t.in.width : 1;
-  const std::size_t row0 = first / w, rows = (n + w - 1) / w - row0;
-  return std::max(first, (row0 + rows * static_cast<std::size_t>(me) / static_cast<std::size_t>(team)) * w);
+// The keys of thread me's share of the rows, and each row's cost; false where a key
+// overflows.
+bool teamKeys(const Team& t, int team, int me, std::size_t& finite) {
+  const std::size_t n = t.in.size(), w = t.w, row0 = t.st.first / w, rows = (n + w - 1) / w;
+  const std::size_t r0 = row0 + (rows - row0) * me / team, r1 = row0 + (rows - row0) * (me + 1) / team;
+  bool fits = true;
+  for (std::size_t row = r0; row < r1; ++row) {
+    const std::size_t b = std::max(t.st.first, row * w), e = std::min(n, (row + 1) * w);
+    fits &= voxelKeys(&t.in.x[b], &t.in.y[b], &t.in.z[b], e - b, t.st.k, t.keys + b, finite);
+    // The row's cost: its passing points, and 5 more for each run of points in one voxel (a
+    // key unlike the one before: a look-up, often a new voxel), the weight that balanced the
+    // threads best on the benchmark's frames (3: 2-9 % slower). (A key's top bit is set in
+    // kNoKey alone, and (d | -d) >> 63 is 1 where d is not 0: shifts, which vectorize.)
+    const std::uint64_t* k = t.keys + b;
+    std::uint64_t points = ~k[0] >> 63, runs = points;
+    for (std::size_t i = 1; i < e - b; ++i) {
+      const std::uint64_t pass = ~k[i] >> 63, d = k[i] ^ k[i - 1];
+      points += pass;
+      runs += pass & ((d | (0 - d)) >> 63);
+    }
+    t.cost[row] = static_cast<std::uint32_t>(points + 5 * runs);
+  }
+  return fits;
 }
 
-// Thread me's rows [b, e) summed into its scratch s (noipa, as voxelizeWith); false where a key
-// overflows.
-UPD_NOIPA bool sumShare(VoxelScratch& s, VoxelPass& pass, const Team& t, std::size_t b,
+// The first point of each thread's rows: rows of equal shares of the cost.
+void splitRows(const Team& t, int team) {
+  const std::size_t n = t.in.size(), w = t.w, row0 = t.st.first / w, rows = (n + w - 1) / w;
+  std::size_t total = 0;
+  for (std::size_t row = row0; row < rows; ++row) total += t.cost[row];
+  t.starts[0] = t.st.first;
+  std::size_t row = row0, sum = 0;
+  for (int u = 1; u < team; ++u) {
+    const std::size_t want = total * static_cast<std::size_t>(u) / static_cast<std::size_t>(team);
+    while (row < rows && sum + t.cost[row] <= want) sum += t.cost[row++];
+    t.starts[u] = std::max(t.st.first, std::min(n, row * w));
+  }
+  t.starts[team] = n;
+}
+
+// Thread me's rows [b, e) summed into its scratch s (noipa, as voxelizeWith), their keys
+// computed.
+UPD_NOIPA void sumShare(VoxelScratch& s, VoxelPass& pass, const Team& t, std::size_t b,
                         std::size_t e) {
   const PointCloud& in = t.in;
   if (!in.isOrganized()) {
-    return pass.row<true>(b, e, t.keys + b, nullptr, nullptr, nullptr);
+    pass.row<true>(b, e, t.keys + b, nullptr, nullptr, nullptr);
+    return;
   }
   const std::size_t w = in.width;
   for (int r = 0; r < 2; ++r) s.row_id[r].resize(w);
@@ -302,12 +339,9 @@ UPD_NOIPA bool sumShare(VoxelScratch& s, VoxelPass& pass, const Team& t, std::si
     const std::size_t cur = row & 1, above = cur ^ 1;
     const std::size_t rb = std::max(b, row * w), skip = rb - row * w;
     const bool top = rb == b;  // (the share's first row: the row above is another's)
-    if (!pass.row<true>(rb, std::min(e, (row + 1) * w), t.keys + rb, s.row_id[cur].data() + skip,
-                        top ? nullptr : t.keys + rb - w, s.row_id[above].data() + skip)) {
-      return false;
-    }
+    pass.row<true>(rb, std::min(e, (row + 1) * w), t.keys + rb, s.row_id[cur].data() + skip,
+                   top ? nullptr : t.keys + rb - w, s.row_id[above].data() + skip);
   }
-  return true;
 }
 
 // The voxels [v0, v1) of thread `later` that an earlier thread also has: their points added to
@@ -339,15 +373,19 @@ void mergeInto(const Team& t, int later, std::size_t v0, std::size_t v1) {
   }
 }
 
-// This thread's part of a team's voxelize with its scratch s: the sums of its rows, then its
-// share of each later thread's voxels merged, in turn. Returns the points its rows passed, the
-// finite ones through finite; fits false where a key overflows.
+// This thread's part of a team's voxelize with its scratch s: its share of the keys, then the
+// sums of its rows, then its share of each later thread's voxels merged, in turn. Returns the
+// points its rows passed, the finite ones of its keys through finite; fits false where a key
+// overflows.
 std::size_t sumTeamVoxels(VoxelScratch& s, const Team& t, int team, int me, std::size_t& finite,
                           bool& fits) {
+  fits = teamKeys(t, team, me, finite);
   prepareMap(s);
+#pragma omp barrier
+#pragma omp single
+  splitRows(t, team);
   VoxelPass pass(s, t.in, t.st.ref, t.st.k, t.st.voxel_m);
-  fits = sumShare(s, pass, t, shareStart(t, team, me), shareStart(t, team, me + 1));
-  finite += pass.finite();
+  sumShare(s, pass, t, t.starts[me], t.starts[me + 1]);
   t.scratch[me] = &s;
   t.voxels[me] = pass.voxels();
   if (s.merged.size() < pass.voxels()) s.merged.resize(s.voxels.size());
@@ -385,19 +423,24 @@ CropCounts voxelizeTeam(const PointCloud& in, const Start& st, PointCloud& out) 
               kNoKey);
   }
   thread_local std::vector<VoxelScratch*> scratch;
-  thread_local std::vector<std::size_t> voxels, offset;
-  const Team t{in, st, master.keys.data(), scratch, voxels, offset};
+  thread_local std::vector<std::size_t> voxels, offset, starts;
+  thread_local std::vector<std::uint32_t> cost;
+  const std::size_t w = in.isOrganized() ? in.width : kTeamChunk;
+  cost.resize((in.size() + w - 1) / w);
+  const Team t{in, st, master.keys.data(), cost, starts, scratch, voxels, offset, w};
   std::size_t finite = st.finite_before, passed = 0;
   bool fits = true;
   const int most = std::min(openmp::maxThreads(), 64);
   scratch.assign(most, nullptr), voxels.assign(most, 0), offset.assign(most, 0);
+  starts.assign(most + 1, 0);
 #pragma omp parallel num_threads(most) reduction(+ : finite, passed) reduction(&& : fits)
   {
     const int team = openmp::teamSize(), me = openmp::threadIndex();
     passed += sumTeamVoxels(teamScratch(), t, team, me, finite, fits);
 #pragma omp single
     {
-      // (t's vectors, not scratch, voxels and offset: those name this thread's thread_local.)
+      // (t's vectors, not scratch, voxels and offset: those name this thread's thread_local.
+      // So do the team's other uses of them, through t.)
       std::size_t total = 0;
       for (int u = 0; u < team; ++u) {
         t.offset[u] = total;
