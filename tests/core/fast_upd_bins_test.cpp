@@ -5,8 +5,8 @@
 // and the result is the same bit for bit on one thread and two. Image rows crossing cells in
 // runs of every length (one point to several vectors of 8), NaN holes and invalid normals
 // inside runs, stripe and chunk boundaries in the middle of a run. Also the chunks every stage
-// deals out (equal shares of the finite points), and the whole fast UPD the same bit for bit
-// on 1, 2 and 3 threads. Fixed seeds.
+// deals out (equal shares of the finite points), and the whole fast UPD and the grid normals
+// the same bit for bit on 1, 2 and 3 threads. Fixed seeds.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -16,10 +16,14 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 #include <vector>
 
 #include "../../libs/core/src/fast_upd_internal.h"
+#include "synthetic.h"
+#include "upd/core/fast_normals.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -236,6 +240,44 @@ TEST(FastUpd, ResultDoesNotDependOnTheThreadCount) {
           << "threads " << t + 1;
     }
   }
+}
+
+// The grid normals of an unorganized cloud (its binning on the team from 16,384 points), with
+// NaN points: the same normals and curvatures bit for bit on 1, 2 and 3 threads; a cloud
+// spanning more than 2^20 radii is refused by name on two threads as on one.
+TEST(FastNormalsGrid, ResultDoesNotDependOnTheThreadCount) {
+  PointCloud c = test::makeRandomCloud(40000, 21, 2.f);
+  for (std::size_t i = 5; i < c.size(); i += 997) c.y[i] = std::numeric_limits<float>::quiet_NaN();
+  c.sensor_origin = Eigen::Vector3f(0, 0, 3);
+  NormalParams p;
+  p.radius_m = 0.08;
+  std::vector<Normals> results;
+  for (const int threads : {1, 2, 3}) {
+    setThreads(threads);
+    results.push_back(computeNormalsGrid(c, p, Eigen::Vector3f::UnitZ()));
+  }
+  const Normals& one = results[0];
+  ASSERT_GT(c.size() - one.invalid, c.size() / 2);
+  for (std::size_t t = 1; t < results.size(); ++t) {
+    EXPECT_EQ(results[t].invalid, one.invalid);
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      ASSERT_EQ(results[t].isValid(i), one.isValid(i)) << "threads " << t + 1 << ", point " << i;
+      if (!one.isValid(i)) continue;
+      ASSERT_EQ(results[t].normal(i), one.normal(i)) << "threads " << t + 1 << ", point " << i;
+      ASSERT_EQ(results[t].curvature[i], one.curvature[i]) << "threads " << t + 1;
+    }
+  }
+  c.x[30000] = 1e6f;  // (1e6 m / 0.08 m: beyond the keys' 2^20 cells)
+  for (const int threads : {1, 2}) {
+    setThreads(threads);
+    try {
+      computeNormalsGrid(c, p, Eigen::Vector3f::UnitZ());
+      ADD_FAILURE() << "a cloud beyond the keys' range was accepted on " << threads << " thread(s)";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("NormalParams.radius_m"), std::string::npos) << e.what();
+    }
+  }
+  setThreads(2);
 }
 
 }  // namespace

@@ -183,14 +183,18 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
     hi[a] = std::numeric_limits<std::int32_t>::min();
   }
   std::size_t n_finite = 0;
+  bool fits = true;
+  // (In static shares on the team: each point's cell by itself, the box by min and max.)
+#pragma omp parallel for if (N > 16384) schedule(static) reduction(min : lo[:3]) \
+    reduction(max : hi[:3]) reduction(+ : n_finite) reduction(&& : fits)
   for (std::size_t i = first; i < N; ++i) {
     if (!cloud.isFinite(i)) continue;
     const Eigen::Vector3d p = (cloud.point(i).cast<double>() - ref) * inv;
     const std::int64_t c[3] = {detail::floorToInt(p.x()), detail::floorToInt(p.y()),
                                detail::floorToInt(p.z())};
     if (!detail::keyFits(c[0], c[1], c[2])) {
-      throw std::invalid_argument("NormalParams.radius_m = " + std::to_string(radius_m) +
-                                  ": the cloud spans more than 2^20 radii along an axis");
+      fits = false;
+      continue;
     }
     std::int32_t* o = &cell_xyz[3 * i];
     for (int a = 0; a < 3; ++a) {
@@ -199,6 +203,10 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
     }
     cell_of[i] = 0;  // (finite: numbered below)
     ++n_finite;
+  }
+  if (!fits) {
+    throw std::invalid_argument("NormalParams.radius_m = " + std::to_string(radius_m) +
+                                ": the cloud spans more than 2^20 radii along an axis");
   }
   g.xyz.resize(3 * n_finite);
   g.n_cells = 0;
@@ -226,6 +234,7 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   const std::size_t n = g.points.order.size();
   // (Slack for gatherAround's copies, 8 at a time; the candidate rows have kScanLanes = 8 more.)
   g.x.assign(n + 8, kFar), g.y.assign(n + 8, kFar), g.z.assign(n + 8, kFar);
+#pragma omp parallel for if (n > 16384) schedule(static)
   for (std::size_t s = 0; s < n; ++s) {
     const Eigen::Vector3f q =
         (cloud.point(g.points.order[s]).cast<double>() - ref).cast<float>();
