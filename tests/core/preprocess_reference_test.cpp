@@ -6,7 +6,8 @@
 // in coordinates relative to an anchor point, the k-d tree in the cloud's), which decides no
 // point here (none lies within that rounding of the threshold; checked). On real frames, random
 // clouds with NaNs and lone points, organized and not, and tiny and empty clouds; the same
-// output for one thread and two.
+// output for one thread and two (and three, on clouds large enough for the voxel pass to split
+// their rows between the threads).
 #include <gtest/gtest.h>
 
 #include <algorithm>
