@@ -36,15 +36,14 @@ struct VoxelScratch {
   CellMap map;
   std::vector<VoxelSums> voxels;
   std::vector<std::uint64_t> voxel_keys;   // the keys the map holds, by voxel id
-  std::vector<std::uint32_t> voxel_first;  // (in a team) the first and last point of each
-  std::vector<std::uint32_t> voxel_last;   // voxel, and whether an earlier thread has it
+  // (In a team:) each voxel's first and last point, and whether an earlier thread has it.
+  std::vector<std::uint32_t> voxel_first, voxel_last;
   std::vector<char> merged;
   std::size_t held = 0;                    // (their number)
   std::size_t expected = 0;                // the voxels the map is sized for
   std::vector<std::uint64_t> row_key[2];   // the voxel key and id of each column, last two rows
   std::vector<std::uint32_t> row_id[2];
-  std::vector<std::uint64_t> keys;  // the keys of the points of one row (unorganized: a chunk);
-                                    // in a team, the master's: the keys of the whole cloud
+  std::vector<std::uint64_t> keys;  // the keys of the points of one row (unorganized: a chunk)
 };
 
 [[noreturn]] void throwSpan(double voxel_m) {
@@ -416,18 +415,17 @@ VoxelScratch& teamScratch() {
 // voxelize by the OpenMP team (at most 64 threads), for clouds of fewer than 2^32 points.
 CropCounts voxelizeTeam(const PointCloud& in, const Start& st, PointCloud& out) {
   const std::size_t first = st.first;
-  VoxelScratch& master = teamScratch();
-  if (master.keys.size() < in.size()) master.keys.resize(in.size());
+  thread_local std::vector<std::uint64_t> keys;  // (of the whole cloud)
+  if (keys.size() < in.size()) keys.resize(in.size());
   if (in.isOrganized()) {  // (the first row's columns before first: the row above the next)
-    std::fill(master.keys.begin() + first / in.width * in.width, master.keys.begin() + first,
-              kNoKey);
+    std::fill(keys.begin() + first / in.width * in.width, keys.begin() + first, kNoKey);
   }
   thread_local std::vector<VoxelScratch*> scratch;
   thread_local std::vector<std::size_t> voxels, offset, starts;
   thread_local std::vector<std::uint32_t> cost;
   const std::size_t w = in.isOrganized() ? in.width : kTeamChunk;
   cost.resize((in.size() + w - 1) / w);
-  const Team t{in, st, master.keys.data(), cost, starts, scratch, voxels, offset, w};
+  const Team t{in, st, keys.data(), cost, starts, scratch, voxels, offset, w};
   std::size_t finite = st.finite_before, passed = 0;
   bool fits = true;
   const int most = std::min(openmp::maxThreads(), 64);
