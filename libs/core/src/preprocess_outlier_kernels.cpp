@@ -147,15 +147,17 @@ __attribute__((target("avx2,popcnt"))) std::size_t narrowAvx2(float* cand, std::
 }
 
 // The square roots of the lanes of v[0, NV) summed in double, 4 lanes at a time (the lanes at
-// -inf, dropped or padding, add 0), and the 4 sums added in pairs.
+// -inf, dropped or padding, add 0), and the 4 sums added in pairs. (The roots in float, 8 at a
+// time: their rounding, 2^-24 of the distance, is that of the float squared distances they are
+// taken of.)
 template <std::size_t NV>
 __attribute__((target("avx2"))) inline double sumRoots(const __m256 (&v)[NV]) {
   const __m256 zero = _mm256_setzero_ps();
   __m256d sum = _mm256_setzero_pd();
   for (std::size_t i = 0; i < NV; ++i) {
-    const __m256 d = _mm256_max_ps(v[i], zero);
-    sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(d))));
-    sum = _mm256_add_pd(sum, _mm256_sqrt_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(d, 1))));
+    const __m256 r = _mm256_sqrt_ps(_mm256_max_ps(v[i], zero));
+    sum = _mm256_add_pd(sum, _mm256_cvtps_pd(_mm256_castps256_ps128(r)));
+    sum = _mm256_add_pd(sum, _mm256_cvtps_pd(_mm256_extractf128_ps(r, 1)));
   }
   // ((l0 + l1) + (l2 + l3), in registers: no aligned stack array, no realigned frame.)
   const __m128d pairs =
