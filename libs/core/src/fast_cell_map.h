@@ -278,38 +278,4 @@ void listByCell(std::size_t n_items, std::size_t n_cells, CellOfItem&& cell, Cel
   }
 }
 
-/// Cell ids over the box of occupied cells [lo, hi] widened by margin cells on every side, x
-/// fastest (kNoIndex where empty): a cell and its neighbours by one load each, at offsets fixed
-/// per table, instead of a hash look-up each. reset() declines (false, the table left empty)
-/// where the box would hold more than kCellsPerPoint cells per point (far lone points widen it):
-/// the caller then uses the hash (CellGrid).
-struct DenseCellTable {
-  static constexpr std::size_t kCellsPerPoint = 32;
-  std::vector<std::uint32_t> ids;
-  std::int64_t lo[3] = {0, 0, 0};
-  std::int64_t sy = 0, sz = 0;  // strides of y and z
-
-  bool reset(const std::int32_t (&box_lo)[3], const std::int32_t (&box_hi)[3], int margin,
-             std::size_t n_points) {
-    ids.clear();
-    std::int64_t dim[3];
-    double volume = 1;
-    for (int a = 0; a < 3; ++a) {
-      dim[a] = std::int64_t{box_hi[a]} - box_lo[a] + 1 + 2 * margin;
-      volume *= static_cast<double>(dim[a]);
-    }
-    if (volume > static_cast<double>(kCellsPerPoint * n_points + 4096)) return false;
-    ids.assign(static_cast<std::size_t>(volume), kNoIndex);
-    for (int a = 0; a < 3; ++a) lo[a] = std::int64_t{box_lo[a]} - margin;
-    sy = dim[0], sz = dim[0] * dim[1];
-    return true;
-  }
-  std::size_t index(std::int64_t cx, std::int64_t cy, std::int64_t cz) const {
-    return static_cast<std::size_t>((cx - lo[0]) + (cy - lo[1]) * sy + (cz - lo[2]) * sz);
-  }
-  std::int64_t offset(std::int64_t dx, std::int64_t dy, std::int64_t dz) const {
-    return dx + dy * sy + dz * sz;
-  }
-};
-
 }  // namespace upd::core::detail

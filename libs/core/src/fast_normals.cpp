@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fast_cell_map.h"
+#include "fast_cell_ranks.h"
 #include "fast_normals_internal.h"
 #include "upd/core/fast_normals.h"
 
@@ -139,17 +140,18 @@ using detail::Moments;
 
 // The finite points binned into cells of edge radius_m (the neighbours of a point lie in the 27
 // cells around its own), grouped by cell and kept relative to the first finite point, as
-// coordinate arrays. The cells are numbered in order of first sight and found by a dense table
-// of ids over their box widened by one cell (one load per neighbour cell at an offset fixed per
-// grid); where the table declines the box (far lone points) by the hash grid, with the same
-// ids.
+// coordinate arrays. The cells are numbered by rank in their box widened by one cell and found
+// by its table of one bit per cell (a load and a population count per neighbour cell, at an
+// offset fixed per grid); where the table declines the box (far lone points), numbered in order
+// of first sight and found by the hash grid.
 struct RadiusGrid {
-  detail::CellGrid grid;       // ids by hash, where the dense table is off
+  detail::CellGrid grid;       // ids by hash, where the rank table is off
   std::vector<std::int32_t> xyz;  // 3 per cell, in id order
   std::size_t n_cells = 0;
   bool has_dense = false;
-  detail::DenseCellTable dense;  // cell ids over the box widened by one cell
-  std::array<std::int64_t, 27> dense_offsets{};  // the 27 cells around one, d = dx + 3 dy + 9 dz
+  detail::RankedCells dense;  // the cells by rank over the box widened by one cell
+  detail::TeamCellCounts team_counts;  // (listByCellTeam's)
+  std::array<std::int64_t, 9> dense_rows{};  // the rows of 3 cells around one: dy + 3 dz, at dx -1
   detail::CellLists points;    // cloud indices by cell
   std::uint32_t max_cell_points = 0;  // the most points in a cell
   std::vector<float> x, y, z;  // by cell: relative to the first finite point (then kFar slack)
@@ -157,16 +159,75 @@ struct RadiusGrid {
   std::size_t denseIndex(const std::int32_t* c) const { return dense.index(c[0], c[1], c[2]); }
 };
 
-// The dense table over the box [lo, hi] widened by one cell and its 27 offsets, or false where
-// the table declines the box.
+// The rank table over the box [lo, hi] widened by one cell (nothing marked) and the offsets of
+// the 9 rows of 3 cells around a cell, or false where the table declines the box.
 bool makeDense(RadiusGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&hi)[3],
                std::size_t n_points) {
   if (!g.dense.reset(lo, hi, 1, n_points)) return false;
-  for (int d = 0; d < 27; ++d) {
-    g.dense_offsets[static_cast<std::size_t>(d)] =
-        g.dense.offset(d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1);
+  for (int r = 0; r < 9; ++r) {
+    g.dense_rows[static_cast<std::size_t>(r)] = g.dense.offset(-1, r % 3 - 1, r / 3 - 1);
   }
   return true;
+}
+
+// The most points in a cell and the grid's point rows sized (slack for gatherAround's copies,
+// 8 at a time; the candidate rows have kScanLanes = 8 more), once the points are listed by cell.
+void sizeRows(RadiusGrid& g) {
+  g.max_cell_points = g.points.mostInACell();
+  const std::size_t n = g.points.order.size();
+  g.x.assign(n + 8, kFar), g.y.assign(n + 8, kFar), g.z.assign(n + 8, kFar);
+}
+
+// Grid points [s0, s1) (cloud points of the cells in id order) copied, relative to ref.
+void copyByCell(const PointCloud& cloud, const Eigen::Vector3d& ref, RadiusGrid& g,
+                std::size_t s0, std::size_t s1) {
+  for (std::size_t s = s0; s < s1; ++s) {
+    const Eigen::Vector3f q =
+        (cloud.point(g.points.order[s]).cast<double>() - ref).cast<float>();
+    g.x[s] = q.x(), g.y[s] = q.y(), g.z[s] = q.z();
+  }
+}
+
+// Where the cells are numbered by rank: the cells of the finite points (cell_of not kNoIndex;
+// their cells' coordinates in cell_xyz, 3 per point) marked, the points listed by cell and
+// copied, on the team from 16,384 points (the same grid on any number of threads).
+void rankAndCopy(const PointCloud& cloud, std::size_t first, const Eigen::Vector3d& ref,
+                 const std::int32_t* cell_xyz, std::vector<std::uint32_t>& cell_of,
+                 RadiusGrid& g) {
+  const std::size_t N = cloud.size(), n = N - first;
+  const auto index = [&](std::size_t i) {
+    const std::int32_t* c = &cell_xyz[3 * i];
+    return g.dense.index(c[0], c[1], c[2]);
+  };
+  // (The non-finite points marked at the first finite point's cell: one already marked.)
+  const std::size_t first_index = index(first);
+#pragma omp parallel if (n > 16384)
+  {
+    g.dense.buildTeam(n, [&](std::size_t f) {
+      return cell_of[first + f] == kNoIndex ? first_index : index(first + f);
+    });
+#pragma omp for schedule(static)
+    for (std::size_t i = first; i < N; ++i) {
+      if (cell_of[i] != kNoIndex) cell_of[i] = g.dense.id(index(i));
+    }
+    detail::listByCellTeam(
+        N, g.dense.size(), [&](std::size_t i) { return cell_of[i]; }, g.points, g.team_counts);
+#pragma omp single
+    {
+      g.n_cells = g.dense.size();
+      g.xyz.resize(3 * g.n_cells);
+      sizeRows(g);
+    }
+#pragma omp for schedule(static) nowait
+    for (std::size_t c = 0; c < g.n_cells; ++c) {
+      const std::int32_t* from = &cell_xyz[3 * g.points.order[g.points.start[c]]];
+      std::memcpy(&g.xyz[3 * c], from, 3 * sizeof(std::int32_t));
+    }
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    const std::size_t m = g.points.order.size();
+    copyByCell(cloud, ref, g, detail::RankedCells::share(m, team, me),
+               detail::RankedCells::share(m, team, me + 1));
+  }
 }
 
 void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, RadiusGrid& g) {
@@ -208,38 +269,22 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
     throw std::invalid_argument("NormalParams.radius_m = " + std::to_string(radius_m) +
                                 ": the cloud spans more than 2^20 radii along an axis");
   }
-  g.xyz.resize(3 * n_finite);
-  g.n_cells = 0;
   g.has_dense = makeDense(g, lo, hi, n_finite);
-  if (!g.has_dense) g.grid = detail::CellGrid(N / 8 + 64);
+  if (g.has_dense) {
+    rankAndCopy(cloud, first, ref, cell_xyz.get(), cell_of, g);
+    return;
+  }
+  g.grid = detail::CellGrid(N / 8 + 64);
   for (std::size_t i = first; i < N; ++i) {
     if (cell_of[i] == kNoIndex) continue;
     const std::int32_t* c = &cell_xyz[3 * i];
-    if (g.has_dense) {
-      std::uint32_t& id = g.dense.ids[g.denseIndex(c)];
-      if (id == kNoIndex) {
-        id = static_cast<std::uint32_t>(g.n_cells);
-        std::memcpy(&g.xyz[3 * g.n_cells++], c, 3 * sizeof(std::int32_t));
-      }
-      cell_of[i] = id;
-    } else {
-      cell_of[i] = g.grid.insert(c[0], c[1], c[2]);
-    }
+    cell_of[i] = g.grid.insert(c[0], c[1], c[2]);
   }
-  if (!g.has_dense) g.xyz = g.grid.coords(), g.n_cells = g.grid.size();
-  g.xyz.resize(3 * g.n_cells);
+  g.xyz = g.grid.coords(), g.n_cells = g.grid.size();
   detail::listByCell(
       N, g.n_cells, [&](std::size_t i) { return cell_of[i]; }, g.points);
-  g.max_cell_points = g.points.mostInACell();
-  const std::size_t n = g.points.order.size();
-  // (Slack for gatherAround's copies, 8 at a time; the candidate rows have kScanLanes = 8 more.)
-  g.x.assign(n + 8, kFar), g.y.assign(n + 8, kFar), g.z.assign(n + 8, kFar);
-#pragma omp parallel for if (n > 16384) schedule(static)
-  for (std::size_t s = 0; s < n; ++s) {
-    const Eigen::Vector3f q =
-        (cloud.point(g.points.order[s]).cast<double>() - ref).cast<float>();
-    g.x[s] = q.x(), g.y[s] = q.y(), g.z[s] = q.z();
-  }
+  sizeRows(g);
+  copyByCell(cloud, ref, g, 0, g.points.order.size());
 }
 
 // The ids of the occupied cells among the 27 around cell c, in the order d = dx + 3 dy + 9 dz.
@@ -247,10 +292,14 @@ int cellsAround(const RadiusGrid& g, std::size_t c, std::array<std::uint32_t, 27
   int n_around = 0;
   const std::int32_t* xyz = &g.xyz[3 * c];
   if (g.has_dense) {
-    const std::uint32_t* at = g.dense.ids.data() + g.denseIndex(xyz);
-    for (int d = 0; d < 27; ++d) {
-      const std::uint32_t id = at[g.dense_offsets[static_cast<std::size_t>(d)]];
-      if (id != kNoIndex) around[static_cast<std::size_t>(n_around++)] = id;
+    // (By rows of 3 along x: one population count a row.)
+    const std::size_t at = g.denseIndex(xyz);
+    for (const std::int64_t row : g.dense_rows) {
+      std::uint32_t ids[3];
+      g.dense.threeIds(at + static_cast<std::size_t>(row), ids);
+      for (const std::uint32_t id : ids) {
+        if (id != kNoIndex) around[static_cast<std::size_t>(n_around++)] = id;
+      }
     }
     return n_around;
   }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fast_cell_map.h"
+#include "fast_cell_ranks.h"
 #include "fast_simd.h"
 #include "upd/core/kdtree.h"
 #include "upd/core/preprocess.h"
@@ -58,22 +59,24 @@ struct PointGrid {
     return cells.find(cx, cy, cz);
   }
 
-  // The cell ids over the occupied cells' box widened by kDenseMargin cells on every side, and
-  // the shells' cell offsets in it, nearest first: a shell's cells by one load each instead of a
-  // hash look-up. Off (has_dense false) where the table declines the box.
+  // The occupied cells by rank over their box widened by kDenseMargin cells on every side, and
+  // the shells' cell offsets in it, nearest first: a shell's cells by a load and a population
+  // count each instead of a hash look-up. Off (has_dense false) where the table declines the
+  // box.
   static constexpr int kDenseMargin = 3;
   bool has_dense = false;
-  detail::DenseCellTable dense;
+  detail::RankedCells dense;
+  detail::TeamCellCounts team_counts;  // (listByCellTeam's)
   std::array<std::vector<std::int64_t>, 4> dense_offsets;  // by ring (0 .. 3)
-  // The cells' coordinates, 3 per cell in id order (the ids in order of first sight, as the
-  // hash's CellGrid numbers them).
+  // The cells' coordinates, 3 per cell in id order (the ids by rank in the box, or where the
+  // table is off in order of first sight, as the hash's CellGrid numbers them).
   std::vector<std::int32_t> cell_xyz;
   std::size_t n_cells = 0;
   const std::int32_t* xyz(std::size_t c) const { return &cell_xyz[3 * c]; }
 };
 
-// The cells' dense table (empty) and its shells' offsets over the box [lo, hi] widened by
-// kDenseMargin; false (has_dense off) where the table declines the box.
+// The cells' rank table (nothing marked) and its shells' offsets over the box [lo, hi] widened
+// by kDenseMargin; false (has_dense off) where the table declines the box.
 const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring);
 bool makeDense(PointGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&hi)[3],
                std::size_t n_points) {
@@ -85,6 +88,60 @@ bool makeDense(PointGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&h
     for (const auto& d : shellOffsets(ring)) o.push_back(g.dense.offset(d[0], d[1], d[2]));
   }
   return true;
+}
+
+// Grid points [j0, j1) (cloud points of the cells in id order) copied from the cloud, relative to
+// the anchor, with their cloud indices.
+void copyByCell(const PointCloud& in, const std::vector<std::uint32_t>& finite, PointGrid& g,
+                std::size_t j0, std::size_t j1) {
+  for (std::size_t j = j0; j < j1; ++j) {
+    const std::uint32_t i = finite[g.by_cell.order[j]];
+    g.x[j] = in.x[i] - g.ox, g.y[j] = in.y[i] - g.oy, g.z[j] = in.z[i] - g.oz;
+    g.index[j] = i;
+  }
+}
+
+// The grid's start, the most points in a cell and its point rows sized (kCopyLanes of slack:
+// BlockPoints::fill copies 8 at a time), once the points are listed by cell.
+void sizeRows(PointGrid& g, std::size_t n_finite) {
+  g.start.assign(g.by_cell.start.begin(), g.by_cell.start.end());
+  g.max_cell_points = g.by_cell.mostInACell();
+  const std::size_t rows = n_finite + kCopyLanes;
+  g.x.resize(rows), g.y.resize(rows), g.z.resize(rows);
+  for (std::size_t j = n_finite; j < rows; ++j) g.x[j] = g.y[j] = g.z[j] = kFarPoint;
+  g.index.resize(n_finite);
+}
+
+// Where the grid's cells are numbered by rank: the cells marked, the points listed by cell and
+// copied, on the team from kTeamPoints points (the same grid on any number of threads).
+void rankAndCopy(const PointCloud& in, const std::vector<std::uint32_t>& finite, PointGrid& g) {
+  constexpr std::size_t kTeamPoints = 16384;
+  const std::size_t n = finite.size();
+  std::vector<std::uint32_t>& cell_of = g.cell_of;
+  const detail::CellCoords& k = g.coords;
+  const auto index = [&](std::size_t f) { return g.dense.index(k.x[f], k.y[f], k.z[f]); };
+#pragma omp parallel if (n >= kTeamPoints)
+  {
+    g.dense.buildTeam(n, index);
+#pragma omp for schedule(static)
+    for (std::size_t f = 0; f < n; ++f) cell_of[f] = g.dense.id(index(f));
+    detail::listByCellTeam(
+        n, g.dense.size(), [&](std::size_t f) { return cell_of[f]; }, g.by_cell, g.team_counts);
+#pragma omp single
+    {
+      g.n_cells = g.dense.size();
+      g.cell_xyz.resize(3 * g.n_cells);
+      sizeRows(g, n);
+    }
+#pragma omp for schedule(static) nowait
+    for (std::size_t c = 0; c < g.n_cells; ++c) {
+      const std::uint32_t f = g.by_cell.order[g.start[c]];
+      g.cell_xyz[3 * c] = k.x[f], g.cell_xyz[3 * c + 1] = k.y[f], g.cell_xyz[3 * c + 2] = k.z[f];
+    }
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    copyByCell(in, finite, g, detail::RankedCells::share(n, team, me),
+               detail::RankedCells::share(n, team, me + 1));
+  }
 }
 
 // Bins the finite points at edge h; false when a point lies beyond the keys' range.
@@ -99,41 +156,22 @@ bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, d
   std::int32_t lo[3], hi[3];
   g.coords.box(lo, hi);
   if (!detail::keyFits(lo[0], lo[1], lo[2]) || !detail::keyFits(hi[0], hi[1], hi[2])) return false;
-  if (makeDense(g, lo, hi, finite.size())) {  // (ids by the dense table: no hash)
-    g.cell_xyz.clear();
-    std::uint32_t n_cells = 0;
-    for (std::size_t f = 0; f < finite.size(); ++f) {
-      const std::int32_t cx = g.coords.x[f], cy = g.coords.y[f], cz = g.coords.z[f];
-      std::uint32_t& id = g.dense.ids[g.dense.index(cx, cy, cz)];
-      if (id == detail::kNoIndex) id = n_cells++, g.cell_xyz.insert(g.cell_xyz.end(), {cx, cy, cz});
-      cell_of[f] = id;
-    }
-    g.n_cells = n_cells;
-  } else {
-    g.cells.clear(finite.size() / 4 + 64);
-    const auto coords = [&](std::size_t f, std::int64_t(&c)[3]) {
-      c[0] = g.coords.x[f], c[1] = g.coords.y[f], c[2] = g.coords.z[f];
-      return true;
-    };
-    detail::binCells(0, finite.size(), coords, g.cells, cell_of.data());  // (every cell fits)
-    g.cell_xyz.assign(g.cells.coords().begin(), g.cells.coords().end());
-    g.n_cells = g.cells.size();
+  if (makeDense(g, lo, hi, finite.size())) {
+    rankAndCopy(in, finite, g);
+    return true;
   }
-  detail::CellLists& by_cell = g.by_cell;
+  g.cells.clear(finite.size() / 4 + 64);
+  const auto coords = [&](std::size_t f, std::int64_t(&c)[3]) {
+    c[0] = g.coords.x[f], c[1] = g.coords.y[f], c[2] = g.coords.z[f];
+    return true;
+  };
+  detail::binCells(0, finite.size(), coords, g.cells, cell_of.data());  // (every cell fits)
+  g.cell_xyz.assign(g.cells.coords().begin(), g.cells.coords().end());
+  g.n_cells = g.cells.size();
   detail::listByCell(
-      finite.size(), g.n_cells, [&](std::size_t f) { return cell_of[f]; }, by_cell);
-  g.start.assign(by_cell.start.begin(), by_cell.start.end());
-  g.max_cell_points = by_cell.mostInACell();
-  // (kCopyLanes of slack: BlockPoints::fill copies 8 at a time.)
-  const std::size_t rows = finite.size() + kCopyLanes;
-  g.x.resize(rows), g.y.resize(rows), g.z.resize(rows);
-  for (std::size_t j = finite.size(); j < rows; ++j) g.x[j] = g.y[j] = g.z[j] = kFarPoint;
-  g.index.resize(finite.size());
-  for (std::size_t j = 0; j < finite.size(); ++j) {
-    const std::uint32_t i = finite[by_cell.order[j]];
-    g.x[j] = in.x[i] - g.ox, g.y[j] = in.y[i] - g.oy, g.z[j] = in.z[i] - g.oz;
-    g.index[j] = i;
-  }
+      finite.size(), g.n_cells, [&](std::size_t f) { return cell_of[f]; }, g.by_cell);
+  sizeRows(g, finite.size());
+  copyByCell(in, finite, g, 0, finite.size());
   return true;
 }
 
@@ -343,9 +381,9 @@ class CellSearch {
   void shell(int ring, std::vector<std::uint32_t>& out) const {
     out.clear();
     if (g_->has_dense) {
-      const std::uint32_t* at = g_->dense.ids.data() + g_->dense.index(cx_, cy_, cz_);
+      const std::size_t at = g_->dense.index(cx_, cy_, cz_);
       for (const std::int64_t o : g_->dense_offsets[static_cast<std::size_t>(ring)]) {
-        const std::uint32_t c = at[o];
+        const std::uint32_t c = g_->dense.id(at + static_cast<std::size_t>(o));
         if (c != detail::kNoIndex) out.push_back(c);
       }
       return;
