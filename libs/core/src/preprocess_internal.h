@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "fast_cell_ranks.h"
 #include "upd/core/point_cloud.h"
 #include "upd/core/preprocess.h"
 
@@ -138,17 +139,19 @@ void cellCoordsDensePlain(const float* x, const float* y, const float* z, std::s
 void minMax(const std::int32_t* v, std::size_t n, std::int32_t& lo, std::int32_t& hi);
 
 /// The outlier filter's grid cells of a cloud's finite points (the calling thread's buffers).
+/// Each step runs on the team from kTeamPoints points, with the one-thread result.
 struct CellCoords {
+  static constexpr std::size_t kTeamPoints = 16384;
   std::vector<std::int32_t> x, y, z;  ///< by finite point
-  std::vector<std::uint64_t> bits;    ///< (countCells' bitmap)
+  RankedCells marked;                 ///< (countCells' table)
 
   /// The cells of the points finite (not empty) of in at edge 1 / inv_h, anchored at the first.
   void compute(const PointCloud& in, const std::vector<std::uint32_t>& finite, double inv_h);
   /// Their box [lo, hi] (in cells).
   void box(std::int32_t (&lo)[3], std::int32_t (&hi)[3]) const;
-  /// The number of distinct cells, the box being [lo, hi] and fitting the keys: by a bitmap
-  /// over the box (gridCellEdge's first guess has about one cell of the box per point), by a
-  /// hash where the box is too large for one.
+  /// The number of distinct cells, the box being [lo, hi] and fitting the keys: by a table of a
+  /// bit per cell over the box (gridCellEdge's first guess has about one cell of the box per
+  /// point), by a hash where the box is too large for one.
   std::size_t countCells(const std::int32_t (&lo)[3], const std::int32_t (&hi)[3]);
 };
 

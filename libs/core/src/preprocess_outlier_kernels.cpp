@@ -9,6 +9,7 @@
 
 #include "fast_cell_map.h"
 #include "preprocess_internal.h"
+#include "upd/core/openmp.h"
 #include "upd/core/vector_clones.h"
 
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -436,39 +437,48 @@ void CellCoords::compute(const PointCloud& in, const std::vector<std::uint32_t>&
   const std::size_t n = finite.size();
   x.resize(n), y.resize(n), z.resize(n);
   const std::uint32_t f0 = finite.front();
-  if (n == in.size()) {  // (finite is then 0, 1, ..., n - 1)
-    cellCoordsDense(in.x.data(), in.y.data(), in.z.data(), n, in.x[f0], in.y[f0], in.z[f0], inv_h,
-                    x.data(), y.data(), z.data());
-  } else {
-    cellCoords(in.x.data(), in.y.data(), in.z.data(), finite.data(), n, in.x[f0], in.y[f0],
-               in.z[f0], inv_h, x.data(), y.data(), z.data());
+  const bool dense = n == in.size();  // (finite is then 0, 1, ..., n - 1)
+  // (In static shares on the team: each point's cell by itself.)
+#pragma omp parallel if (n > kTeamPoints)
+  {
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    const std::size_t b = RankedCells::share(n, team, me), e = RankedCells::share(n, team, me + 1);
+    if (dense) {
+      cellCoordsDense(in.x.data() + b, in.y.data() + b, in.z.data() + b, e - b, in.x[f0],
+                      in.y[f0], in.z[f0], inv_h, x.data() + b, y.data() + b, z.data() + b);
+    } else {
+      cellCoords(in.x.data(), in.y.data(), in.z.data(), finite.data() + b, e - b, in.x[f0],
+                 in.y[f0], in.z[f0], inv_h, x.data() + b, y.data() + b, z.data() + b);
+    }
   }
 }
 
 void CellCoords::box(std::int32_t (&lo)[3], std::int32_t (&hi)[3]) const {
+  const std::size_t n = x.size();
   const std::vector<std::int32_t>* axis[3] = {&x, &y, &z};
-  for (int a = 0; a < 3; ++a) minMax(axis[a]->data(), axis[a]->size(), lo[a], hi[a]);
+  std::int32_t l[3], h[3];
+  for (int a = 0; a < 3; ++a) {
+    l[a] = std::numeric_limits<std::int32_t>::max(), h[a] = std::numeric_limits<std::int32_t>::min();
+  }
+#pragma omp parallel if (n > kTeamPoints) reduction(min : l[:3]) reduction(max : h[:3])
+  {
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    const std::size_t b = RankedCells::share(n, team, me), e = RankedCells::share(n, team, me + 1);
+    for (int a = 0; a < 3 && e > b; ++a) {
+      std::int32_t share_lo = 0, share_hi = 0;
+      minMax(axis[a]->data() + b, e - b, share_lo, share_hi);
+      l[a] = std::min(l[a], share_lo), h[a] = std::max(h[a], share_hi);
+    }
+  }
+  for (int a = 0; a < 3; ++a) lo[a] = l[a], hi[a] = h[a];
 }
 
 std::size_t CellCoords::countCells(const std::int32_t (&lo)[3], const std::int32_t (&hi)[3]) {
   const std::size_t n = x.size();
-  std::int64_t dim[3];
-  double volume = 1;
-  for (int a = 0; a < 3; ++a) {
-    dim[a] = std::int64_t{hi[a]} - lo[a] + 1;
-    volume *= static_cast<double>(dim[a]);
-  }
-  if (volume <= static_cast<double>(64 * n + 65536)) {
-    bits.assign(static_cast<std::size_t>(volume) / 64 + 1, 0);
-    std::size_t count = 0;
-    for (std::size_t f = 0; f < n; ++f) {
-      const auto b = static_cast<std::size_t>((x[f] - lo[0]) + (y[f] - lo[1]) * dim[0] +
-                                              (z[f] - lo[2]) * dim[0] * dim[1]);
-      const std::uint64_t bit = std::uint64_t{1} << (b % 64);
-      count += (bits[b / 64] & bit) == 0 ? 1 : 0;
-      bits[b / 64] |= bit;
-    }
-    return count;
+  if (marked.reset(lo, hi, 0, n)) {
+#pragma omp parallel if (n > kTeamPoints)
+    marked.buildTeam(n, [&](std::size_t f) { return marked.index(x[f], y[f], z[f]); });
+    return marked.size();
   }
   CellMap cells(n / 4 + 64);
   for (std::size_t f = 0; f < n; ++f) {

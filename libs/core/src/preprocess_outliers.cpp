@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <vector>
 
 #include "fast_cell_map.h"
@@ -278,13 +279,19 @@ const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
 // k + 1 the blocks hold ~210 points: each 5-10 % more instructions on voxelized frames.)
 double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k,
                     detail::CellCoords& coords) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (const std::uint32_t i : finite) {
-    const Eigen::Vector3d p = in.point(i).cast<double>();
-    lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+  const std::size_t n = finite.size();
+  // (On the team from kTeamPoints: the box by min and max, the same on any number of threads.)
+#pragma omp parallel for if (n > detail::CellCoords::kTeamPoints) schedule(static) \
+    reduction(min : lo[:3]) reduction(max : hi[:3])
+  for (std::size_t f = 0; f < n; ++f) {
+    const std::uint32_t i = finite[f];
+    const double p[3] = {in.x[i], in.y[i], in.z[i]};
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
   }
-  const Eigen::Vector3d ext = (hi - lo).cwiseMax(1e-3);
+  const Eigen::Vector3d ext =
+      (Eigen::Vector3d(hi[0], hi[1], hi[2]) - Eigen::Vector3d(lo[0], lo[1], lo[2])).cwiseMax(1e-3);
   // First guess: the points filling the bounding box; then one correction from the measured
   // points per occupied cell, as for a surface (count ~ h^2).
   double h = std::cbrt(ext.prod() / static_cast<double>(finite.size()));
@@ -541,8 +548,13 @@ UPD_NOIPA void meanNeighbourDistances(const PointCloud& in, int k,
                                       PointGrid& g) {
   mean_dist.assign(in.size(), std::numeric_limits<double>::quiet_NaN());
   finite.clear();
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    if (in.isFinite(i)) finite.push_back(static_cast<std::uint32_t>(i));
+  if (in.countFinite() == in.size()) {  // (as the voxel grid's centroids: by a vector scan)
+    finite.resize(in.size());
+    std::iota(finite.begin(), finite.end(), 0u);
+  } else {
+    for (std::size_t i = 0; i < in.size(); ++i) {
+      if (in.isFinite(i)) finite.push_back(static_cast<std::uint32_t>(i));
+    }
   }
   if (finite.empty()) return;
   const std::size_t want = static_cast<std::size_t>(k) + 1;  // the point itself comes first
