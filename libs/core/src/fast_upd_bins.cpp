@@ -311,19 +311,28 @@ std::size_t countStripes(const PointCloud& cloud, const Normals& normals, const 
   return valid;
 }
 
-// The team's threads count contiguous shares of the sampled stripes, each into a grid of its
-// own; the cells are then their union (a few thousand: the points are what costs).
+// The team's threads count runs of the sampled stripes, taken in turn (the image's rows differ
+// in cost: the far ones change cells more often), each into a grid of its own; the cells are
+// then their union (a few thousand: the points are what costs). The count and the cells do not
+// depend on how the stripes are shared.
 CellCount countCells(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
                      std::size_t first, std::size_t step) {
   const std::size_t n_stripes = (cloud.size() - first + step * kStripe - 1) / (step * kStripe);
-  std::vector<CellGrid> grids(static_cast<std::size_t>(openmp::maxThreads()));
+  const auto most = static_cast<std::size_t>(openmp::maxThreads());
+  std::vector<CellGrid> grids(most);
+  // (About 16 runs a thread; a run's first stripe starts from no cell: one insertion more.)
+  const std::size_t per_run = std::max<std::size_t>(1, n_stripes / (16 * most));
+  const auto n_runs = static_cast<std::ptrdiff_t>((n_stripes + per_run - 1) / per_run);
   std::size_t valid = 0;
 #pragma omp parallel reduction(+ : valid)
   {
-    const auto team = static_cast<std::size_t>(openmp::teamSize());
     const auto me = static_cast<std::size_t>(openmp::threadIndex());
-    valid += countStripes(cloud, normals, lat, first, step, n_stripes * me / team,
-                          n_stripes * (me + 1) / team, grids[me]);
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t r = 0; r < n_runs; ++r) {
+      const std::size_t j0 = static_cast<std::size_t>(r) * per_run;
+      valid += countStripes(cloud, normals, lat, first, step, j0,
+                            std::min(n_stripes, j0 + per_run), grids[me]);
+    }
   }
   CellGrid& all = grids[0];
   for (std::size_t t = 1; t < grids.size(); ++t) {
