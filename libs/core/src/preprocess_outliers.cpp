@@ -16,6 +16,7 @@
 #include "fast_simd.h"
 #include "upd/core/kdtree.h"
 #include "upd/core/preprocess.h"
+#include "upd/core/vector_clones.h"
 
 #include "preprocess_internal.h"
 
@@ -113,6 +114,14 @@ void sizeRows(PointGrid& g, std::size_t n_finite) {
   g.index.resize(n_finite);
 }
 
+// The ids of the cells of points [b, e) (their coordinates in k) into cell_of. (Cloned: on
+// x86-64-v3 and up GCC makes countBits one POPCNT.)
+UPD_VECTOR_CLONES
+void rankedIds(const detail::RankedCells& ranks, const detail::CellCoords& k, std::size_t b,
+               std::size_t e, std::uint32_t* cell_of) {
+  for (std::size_t f = b; f < e; ++f) cell_of[f] = ranks.id(ranks.index(k.x[f], k.y[f], k.z[f]));
+}
+
 // Where the grid's cells are numbered by rank: the cells marked, the points listed by cell and
 // copied, on the team from kTeamPoints points (the same grid on any number of threads).
 void rankAndCopy(const PointCloud& in, const std::vector<std::uint32_t>& finite, PointGrid& g) {
@@ -124,8 +133,10 @@ void rankAndCopy(const PointCloud& in, const std::vector<std::uint32_t>& finite,
 #pragma omp parallel if (n >= kTeamPoints)
   {
     g.dense.buildTeam(n, index);
-#pragma omp for schedule(static)
-    for (std::size_t f = 0; f < n; ++f) cell_of[f] = g.dense.id(index(f));
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    rankedIds(g.dense, k, detail::RankedCells::share(n, team, me),
+              detail::RankedCells::share(n, team, me + 1), cell_of.data());
+#pragma omp barrier
     detail::listByCellTeam(
         n, g.dense.size(), [&](std::size_t f) { return cell_of[f]; }, g.by_cell, g.team_counts);
 #pragma omp single
@@ -139,7 +150,6 @@ void rankAndCopy(const PointCloud& in, const std::vector<std::uint32_t>& finite,
       const std::uint32_t f = g.by_cell.order[g.start[c]];
       g.cell_xyz[3 * c] = k.x[f], g.cell_xyz[3 * c + 1] = k.y[f], g.cell_xyz[3 * c + 2] = k.z[f];
     }
-    const int team = openmp::teamSize(), me = openmp::threadIndex();
     copyByCell(in, finite, g, detail::RankedCells::share(n, team, me),
                detail::RankedCells::share(n, team, me + 1));
   }
@@ -272,6 +282,17 @@ const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
   return table[static_cast<std::size_t>(ring)];
 }
 
+// The occupied cells at the offsets of a shell around the cell at index at of the rank table,
+// in the offsets' order, appended to out. (Cloned, as rankedIds.)
+UPD_VECTOR_CLONES
+void rankedShell(const detail::RankedCells& ranks, std::size_t at,
+                 const std::vector<std::int64_t>& offsets, std::vector<std::uint32_t>& out) {
+  for (const std::int64_t o : offsets) {
+    const std::uint32_t c = ranks.id(at + static_cast<std::size_t>(o));
+    if (c != detail::kNoIndex) out.push_back(c);
+  }
+}
+
 // The cell edge: about (k + 1) / 2 points per occupied cell. On a surface the k + 1 nearest of a
 // point then lie within about 0.8 of a cell's edge, inside the 3 x 3 x 3 block around its cell
 // (~120 points on a voxelized Kinect frame) for all but a few per cent of the points, which look
@@ -388,11 +409,8 @@ class CellSearch {
   void shell(int ring, std::vector<std::uint32_t>& out) const {
     out.clear();
     if (g_->has_dense) {
-      const std::size_t at = g_->dense.index(cx_, cy_, cz_);
-      for (const std::int64_t o : g_->dense_offsets[static_cast<std::size_t>(ring)]) {
-        const std::uint32_t c = g_->dense.id(at + static_cast<std::size_t>(o));
-        if (c != detail::kNoIndex) out.push_back(c);
-      }
+      rankedShell(g_->dense, g_->dense.index(cx_, cy_, cz_),
+                  g_->dense_offsets[static_cast<std::size_t>(ring)], out);
       return;
     }
     // (Away from the keys' bounds, as nearly always, the keys are the cell's plus an offset,
