@@ -189,56 +189,19 @@ void copyByCell(const PointCloud& cloud, const Eigen::Vector3d& ref, RadiusGrid&
   }
 }
 
-// The ids of the cells of points [b, e) with one (cell_of not kNoIndex), their coordinates in
-// cell_xyz (3 a point), into cell_of. (Cloned, as rankedAround.)
-UPD_VECTOR_CLONES
-void rankedIds(const detail::RankedCells& ranks, const std::int32_t* cell_xyz, std::size_t b,
-               std::size_t e, std::uint32_t* cell_of) {
-  for (std::size_t i = b; i < e; ++i) {
-    const std::int32_t* c = &cell_xyz[3 * i];
-    if (cell_of[i] != kNoIndex) cell_of[i] = ranks.id(ranks.index(c[0], c[1], c[2]));
-  }
-}
-
 // Where the cells are numbered by rank: the cells of the finite points (cell_of not kNoIndex;
 // their cells' coordinates in cell_xyz, 3 per point) marked, the points listed by cell and
 // copied, on the team from 16,384 points (the same grid on any number of threads).
 void rankAndCopy(const PointCloud& cloud, std::size_t first, const Eigen::Vector3d& ref,
                  const std::int32_t* cell_xyz, std::vector<std::uint32_t>& cell_of,
                  RadiusGrid& g) {
-  const std::size_t N = cloud.size(), n = N - first;
-  const auto index = [&](std::size_t i) {
-    const std::int32_t* c = &cell_xyz[3 * i];
-    return g.dense.index(c[0], c[1], c[2]);
-  };
-  // (The non-finite points marked at the first finite point's cell: one already marked.)
-  const std::size_t first_index = index(first);
-#pragma omp parallel if (n > 16384)
-  {
-    g.dense.buildTeam(n, [&](std::size_t f) {
-      return cell_of[first + f] == kNoIndex ? first_index : index(first + f);
-    });
-    const int team = openmp::teamSize(), me = openmp::threadIndex();
-    rankedIds(g.dense, cell_xyz, first + detail::RankedCells::share(n, team, me),
-              first + detail::RankedCells::share(n, team, me + 1), cell_of.data());
-#pragma omp barrier
-    detail::listByCellTeam(
-        N, g.dense.size(), [&](std::size_t i) { return cell_of[i]; }, g.points, g.team_counts);
-#pragma omp single
-    {
-      g.n_cells = g.dense.size();
-      g.xyz.resize(3 * g.n_cells);
-      sizeRows(g);
-    }
-#pragma omp for schedule(static) nowait
-    for (std::size_t c = 0; c < g.n_cells; ++c) {
-      const std::int32_t* from = &cell_xyz[3 * g.points.order[g.points.start[c]]];
-      std::memcpy(&g.xyz[3 * c], from, 3 * sizeof(std::int32_t));
-    }
-    const std::size_t m = g.points.order.size();
-    copyByCell(cloud, ref, g, detail::RankedCells::share(m, team, me),
-               detail::RankedCells::share(m, team, me + 1));
-  }
+  const std::size_t N = cloud.size();
+  const detail::CellRows rows{cell_xyz, cell_xyz + 1, cell_xyz + 2, 3};
+#pragma omp parallel if (N - first > 16384)
+  detail::rankListAndCopyTeam(
+      g.dense, rows, N, cell_of.data(), g.points, g.team_counts, g.xyz,
+      [&](std::size_t n_cells) { g.n_cells = n_cells, sizeRows(g); },
+      [&](std::size_t s0, std::size_t s1) { copyByCell(cloud, ref, g, s0, s1); });
 }
 
 void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, RadiusGrid& g) {

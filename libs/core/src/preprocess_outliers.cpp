@@ -1,7 +1,8 @@
 // The statistical outlier filter's neighbour search, meanNeighbourDistances: the mean distance
-// of every point to its k nearest, by a grid of cells (PointGrid: its cells found in a dense
-// table over their box, or by the hash where that box is sparse) where that settles them, by
-// comparing with every point for the few left, and by the k-d tree when many are left.
+// of every point to its k nearest, by a grid of cells (PointGrid, preprocess_outlier_grid.h:
+// its cells found by rank in a table of a bit per cell over their box, or by the hash where that
+// box is sparse) where that settles them, by comparing with every point for the few left, and
+// by the k-d tree when many are left.
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
@@ -19,172 +20,16 @@
 #include "upd/core/vector_clones.h"
 
 #include "preprocess_internal.h"
+#include "preprocess_outlier_grid.h"
 
 namespace upd::core {
 
 namespace {
 
-// Coordinates of the padding: their distances are huge and never kept.
-constexpr float kFarPoint = 1e18f;
-// The slack of the rows for copyRunByEights.
-constexpr std::size_t kCopyLanes = 8;
-
-// The finite points binned into cubic cells of edge h (anchored at the first finite point, as
-// the fast UPD's lattice): cell ids from the CellGrid, and the points' coordinates relative
-// to the anchor sorted by cell (counting sort), with their cloud indices.
-struct PointGrid {
-  double h = 1, inv_h = 1;
-  float ox = 0, oy = 0, oz = 0;  // anchor
-  detail::CellGrid cells;
-  std::vector<std::uint32_t> start;  // n_cells + 1
-  std::uint32_t max_cell_points = 0;  // the most points in a cell
-  std::vector<float> x, y, z;        // by cell (then kCopyLanes of slack)
-  std::vector<std::uint32_t> index;  // by cell: the cloud's index
-  std::vector<std::uint32_t> cell_of;  // (buildGrid's buffers)
-  detail::CellLists by_cell;
-  detail::CellCoords coords;
-
-  // Squared distance from (qx, qy, qz) to the box of cell c (0 inside).
-  float boxDistance2(std::uint32_t c, float qx, float qy, float qz) const {
-    const float q[3] = {qx, qy, qz};
-    float d2 = 0.f;
-    for (int a = 0; a < 3; ++a) {
-      const auto lo = static_cast<float>(xyz(c)[a] * h);
-      const auto hi = static_cast<float>((xyz(c)[a] + 1) * h);
-      const float d = q[a] < lo ? lo - q[a] : (q[a] > hi ? q[a] - hi : 0.f);
-      d2 += d * d;
-    }
-    // (Shrunk by a rounding margin: a cell is skipped only when it is certainly farther.)
-    return d2 * (1.f - 1e-5f);
-  }
-  std::uint32_t find(std::int64_t cx, std::int64_t cy, std::int64_t cz) const {
-    return cells.find(cx, cy, cz);
-  }
-
-  // The occupied cells by rank over their box widened by kDenseMargin cells on every side, and
-  // the shells' cell offsets in it, nearest first: a shell's cells by a load and a population
-  // count each instead of a hash look-up. Off (has_dense false) where the table declines the
-  // box.
-  static constexpr int kDenseMargin = 3;
-  bool has_dense = false;
-  detail::RankedCells dense;
-  detail::TeamCellCounts team_counts;  // (listByCellTeam's)
-  std::array<std::vector<std::int64_t>, 4> dense_offsets;  // by ring (0 .. 3)
-  // The cells' coordinates, 3 per cell in id order (the ids by rank in the box, or where the
-  // table is off in order of first sight, as the hash's CellGrid numbers them).
-  std::vector<std::int32_t> cell_xyz;
-  std::size_t n_cells = 0;
-  const std::int32_t* xyz(std::size_t c) const { return &cell_xyz[3 * c]; }
-};
-
-// The cells' rank table (nothing marked) and its shells' offsets over the box [lo, hi] widened
-// by kDenseMargin; false (has_dense off) where the table declines the box.
-const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring);
-bool makeDense(PointGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&hi)[3],
-               std::size_t n_points) {
-  g.has_dense = g.dense.reset(lo, hi, PointGrid::kDenseMargin, n_points);
-  if (!g.has_dense) return false;
-  for (int ring = 0; ring <= PointGrid::kDenseMargin; ++ring) {
-    std::vector<std::int64_t>& o = g.dense_offsets[static_cast<std::size_t>(ring)];
-    o.clear();
-    for (const auto& d : shellOffsets(ring)) o.push_back(g.dense.offset(d[0], d[1], d[2]));
-  }
-  return true;
-}
-
-// Grid points [j0, j1) (cloud points of the cells in id order) copied from the cloud, relative to
-// the anchor, with their cloud indices.
-void copyByCell(const PointCloud& in, const std::vector<std::uint32_t>& finite, PointGrid& g,
-                std::size_t j0, std::size_t j1) {
-  for (std::size_t j = j0; j < j1; ++j) {
-    const std::uint32_t i = finite[g.by_cell.order[j]];
-    g.x[j] = in.x[i] - g.ox, g.y[j] = in.y[i] - g.oy, g.z[j] = in.z[i] - g.oz;
-    g.index[j] = i;
-  }
-}
-
-// The grid's start, the most points in a cell and its point rows sized (kCopyLanes of slack:
-// BlockPoints::fill copies 8 at a time), once the points are listed by cell.
-void sizeRows(PointGrid& g, std::size_t n_finite) {
-  g.start.assign(g.by_cell.start.begin(), g.by_cell.start.end());
-  g.max_cell_points = g.by_cell.mostInACell();
-  const std::size_t rows = n_finite + kCopyLanes;
-  g.x.resize(rows), g.y.resize(rows), g.z.resize(rows);
-  for (std::size_t j = n_finite; j < rows; ++j) g.x[j] = g.y[j] = g.z[j] = kFarPoint;
-  g.index.resize(n_finite);
-}
-
-// The ids of the cells of points [b, e) (their coordinates in k) into cell_of. (Cloned: on
-// x86-64-v3 and up GCC makes countBits one POPCNT.)
-UPD_VECTOR_CLONES
-void rankedIds(const detail::RankedCells& ranks, const detail::CellCoords& k, std::size_t b,
-               std::size_t e, std::uint32_t* cell_of) {
-  for (std::size_t f = b; f < e; ++f) cell_of[f] = ranks.id(ranks.index(k.x[f], k.y[f], k.z[f]));
-}
-
-// Where the grid's cells are numbered by rank: the cells marked, the points listed by cell and
-// copied, on the team from kTeamPoints points (the same grid on any number of threads).
-void rankAndCopy(const PointCloud& in, const std::vector<std::uint32_t>& finite, PointGrid& g) {
-  constexpr std::size_t kTeamPoints = 16384;
-  const std::size_t n = finite.size();
-  std::vector<std::uint32_t>& cell_of = g.cell_of;
-  const detail::CellCoords& k = g.coords;
-  const auto index = [&](std::size_t f) { return g.dense.index(k.x[f], k.y[f], k.z[f]); };
-#pragma omp parallel if (n >= kTeamPoints)
-  {
-    g.dense.buildTeam(n, index);
-    const int team = openmp::teamSize(), me = openmp::threadIndex();
-    rankedIds(g.dense, k, detail::RankedCells::share(n, team, me),
-              detail::RankedCells::share(n, team, me + 1), cell_of.data());
-#pragma omp barrier
-    detail::listByCellTeam(
-        n, g.dense.size(), [&](std::size_t f) { return cell_of[f]; }, g.by_cell, g.team_counts);
-#pragma omp single
-    {
-      g.n_cells = g.dense.size();
-      g.cell_xyz.resize(3 * g.n_cells);
-      sizeRows(g, n);
-    }
-#pragma omp for schedule(static) nowait
-    for (std::size_t c = 0; c < g.n_cells; ++c) {
-      const std::uint32_t f = g.by_cell.order[g.start[c]];
-      g.cell_xyz[3 * c] = k.x[f], g.cell_xyz[3 * c + 1] = k.y[f], g.cell_xyz[3 * c + 2] = k.z[f];
-    }
-    copyByCell(in, finite, g, detail::RankedCells::share(n, team, me),
-               detail::RankedCells::share(n, team, me + 1));
-  }
-}
-
-// Bins the finite points at edge h; false when a point lies beyond the keys' range.
-bool buildGrid(const PointCloud& in, const std::vector<std::uint32_t>& finite, double h,
-               PointGrid& g) {
-  g.h = h, g.inv_h = 1.0 / h;
-  const std::uint32_t f0 = finite.front();
-  g.ox = in.x[f0], g.oy = in.y[f0], g.oz = in.z[f0];
-  std::vector<std::uint32_t>& cell_of = g.cell_of;
-  cell_of.resize(finite.size());
-  g.coords.compute(in, finite, g.inv_h);
-  std::int32_t lo[3], hi[3];
-  g.coords.box(lo, hi);
-  if (!detail::keyFits(lo[0], lo[1], lo[2]) || !detail::keyFits(hi[0], hi[1], hi[2])) return false;
-  if (makeDense(g, lo, hi, finite.size())) {
-    rankAndCopy(in, finite, g);
-    return true;
-  }
-  g.cells.clear(finite.size() / 4 + 64);
-  const auto coords = [&](std::size_t f, std::int64_t(&c)[3]) {
-    c[0] = g.coords.x[f], c[1] = g.coords.y[f], c[2] = g.coords.z[f];
-    return true;
-  };
-  detail::binCells(0, finite.size(), coords, g.cells, cell_of.data());  // (every cell fits)
-  g.cell_xyz.assign(g.cells.coords().begin(), g.cells.coords().end());
-  g.n_cells = g.cells.size();
-  detail::listByCell(
-      finite.size(), g.n_cells, [&](std::size_t f) { return cell_of[f]; }, g.by_cell);
-  sizeRows(g, finite.size());
-  copyByCell(in, finite, g, 0, finite.size());
-  return true;
-}
+using detail::kCopyLanes;
+using detail::kFarPoint;
+using detail::PointGrid;
+using detail::shellOffsets;
 
 // Squared distances from (qx, qy, qz) to the n points (x, y, z)[j], into out.
 UPD_VECTOR_CLONES
@@ -257,31 +102,6 @@ struct BlockPoints {
   }
 };
 
-// The cell offsets at Chebyshev distance ring (0 .. 3), sorted by their distance.
-const std::vector<std::array<std::int32_t, 3>>& shellOffsets(int ring) {
-  static const auto table = [] {
-    std::array<std::vector<std::array<std::int32_t, 3>>, 4> t;
-    for (std::int32_t r = 0; r < 4; ++r) {
-      for (std::int32_t dz = -r; dz <= r; ++dz) {
-        for (std::int32_t dy = -r; dy <= r; ++dy) {
-          for (std::int32_t dx = -r; dx <= r; ++dx) {
-            if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) == r) {
-              t[static_cast<std::size_t>(r)].push_back({dx, dy, dz});
-            }
-          }
-        }
-      }
-      std::stable_sort(t[static_cast<std::size_t>(r)].begin(), t[static_cast<std::size_t>(r)].end(),
-                       [](const auto& a, const auto& b) {
-                         return a[0] * a[0] + a[1] * a[1] + a[2] * a[2] <
-                                b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
-                       });
-    }
-    return t;
-  }();
-  return table[static_cast<std::size_t>(ring)];
-}
-
 // The occupied cells at the offsets of a shell around the cell at index at of the rank table,
 // in the offsets' order, appended to out. (Cloned, as rankedIds.)
 UPD_VECTOR_CLONES
@@ -291,41 +111,6 @@ void rankedShell(const detail::RankedCells& ranks, std::size_t at,
     const std::uint32_t c = ranks.id(at + static_cast<std::size_t>(o));
     if (c != detail::kNoIndex) out.push_back(c);
   }
-}
-
-// The cell edge: about (k + 1) / 2 points per occupied cell. On a surface the k + 1 nearest of a
-// point then lie within about 0.8 of a cell's edge, inside the 3 x 3 x 3 block around its cell
-// (~120 points on a voxelized Kinect frame) for all but a few per cent of the points, which look
-// at the 5 x 5 x 5 block. (With (k + 1) / 3 points more points need the wider block; with
-// k + 1 the blocks hold ~210 points: each 5-10 % more instructions on voxelized frames.)
-double gridCellEdge(const PointCloud& in, const std::vector<std::uint32_t>& finite, int k,
-                    detail::CellCoords& coords) {
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
-  const std::size_t n = finite.size();
-  // (On the team from kTeamPoints: the box by min and max, the same on any number of threads.)
-#pragma omp parallel for if (n > detail::CellCoords::kTeamPoints) schedule(static) \
-    reduction(min : lo[:3]) reduction(max : hi[:3])
-  for (std::size_t f = 0; f < n; ++f) {
-    const std::uint32_t i = finite[f];
-    const double p[3] = {in.x[i], in.y[i], in.z[i]};
-    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], p[a]), hi[a] = std::max(hi[a], p[a]);
-  }
-  const Eigen::Vector3d ext =
-      (Eigen::Vector3d(hi[0], hi[1], hi[2]) - Eigen::Vector3d(lo[0], lo[1], lo[2])).cwiseMax(1e-3);
-  // First guess: the points filling the bounding box; then one correction from the measured
-  // points per occupied cell, as for a surface (count ~ h^2).
-  double h = std::cbrt(ext.prod() / static_cast<double>(finite.size()));
-  coords.compute(in, finite, 1.0 / h);
-  std::int32_t c_lo[3], c_hi[3];
-  coords.box(c_lo, c_hi);
-  if (!detail::keyFits(c_lo[0], c_lo[1], c_lo[2]) || !detail::keyFits(c_hi[0], c_hi[1], c_hi[2])) {
-    return h;  // (buildGrid refuses it too: k-d tree)
-  }
-  const double per_cell =
-      static_cast<double>(finite.size()) / static_cast<double>(coords.countCells(c_lo, c_hi));
-  const double target = static_cast<double>(k + 1) / 2.0;
-  return h * std::clamp(std::sqrt(target / per_cell), 0.125, 8.0);
 }
 
 // The searches of one thread, cell by cell: the points of a cell share their blocks (the cells
