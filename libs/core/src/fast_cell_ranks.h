@@ -2,9 +2,9 @@
 // grouping of items by cell (listByCell) on the OpenMP team, for the outlier filter's grid and
 // the grid normals. Both give the same result on any number of threads.
 //
-// The functions named "team" are called by every thread of a team, inside a parallel region (or
-// by one thread outside any); they synchronize the team themselves and return when their result
-// is complete.
+// The functions whose names end in Team are called by every thread of a team, inside a parallel
+// region (or by one thread outside any); they synchronize the team themselves and return when
+// their result is complete.
 #pragma once
 
 #include <cstddef>
@@ -241,6 +241,7 @@ void rankListAndCopyTeam(RankedCells& ranks, const CellRows& rows, std::size_t n
   }
   const std::size_t m = lists.order.size();
   copy(RankedCells::share(m, team, me), RankedCells::share(m, team, me + 1));
+#pragma omp barrier
 }
 
 }  // namespace upd::core::detail

@@ -258,10 +258,15 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   detail::listByCell(
       N, g.n_cells, [&](std::size_t i) { return cell_of[i]; }, g.points);
   sizeRows(g);
-  copyByCell(cloud, ref, g, 0, g.points.order.size());
+  const std::size_t n = g.points.order.size();
+#pragma omp parallel if (n > 16384)
+  {
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    copyByCell(cloud, ref, g, detail::RankedCells::share(n, team, me),
+               detail::RankedCells::share(n, team, me + 1));
+  }
 }
 
-// The ids of the occupied cells among the 27 around cell c, in the order d = dx + 3 dy + 9 dz.
 // cellsAround by the rank table, around the cell at index at: by rows of 3 along x, one
 // population count a row. (Cloned: on x86-64-v3 and up GCC makes countBits one POPCNT.)
 UPD_VECTOR_CLONES
@@ -277,6 +282,7 @@ int rankedAround(const RadiusGrid& g, std::size_t at, std::array<std::uint32_t, 
   return n_around;
 }
 
+// The ids of the occupied cells among the 27 around cell c, in the order d = dx + 3 dy + 9 dz.
 int cellsAround(const RadiusGrid& g, std::size_t c, std::array<std::uint32_t, 27>& around) {
   int n_around = 0;
   const std::int32_t* xyz = &g.xyz[3 * c];
