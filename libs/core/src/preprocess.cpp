@@ -23,6 +23,68 @@ void PreprocessParams::validate() const {
                "outlier_std_mul", outlier_std_mul, "must be >= 0");
 }
 
+namespace detail {
+
+namespace {
+
+// The kept points of c's [b, e) into out from its point at (out may be c: a point then moves
+// only to a place already read).
+void copyKept(const PointCloud& c, const std::vector<char>& keep, std::size_t b, std::size_t e,
+              std::size_t at, PointCloud& out) {
+  const bool colour = c.hasColor();
+  for (std::size_t i = b; i < e; ++i) {
+    if (!keep[i]) continue;
+    out.x[at] = c.x[i], out.y[at] = c.y[i], out.z[at] = c.z[i];
+    if (colour) out.r[at] = c.r[i], out.g[at] = c.g[i], out.b[at] = c.b[i];
+    ++at;
+  }
+}
+
+}  // namespace
+
+void compactInPlace(PointCloud& c, const std::vector<char>& keep) {
+  const bool colour = c.hasColor();
+  const std::size_t n = c.size();
+  const int most = std::min(openmp::maxThreads(), 64);
+  if (n <= 16384 || most == 1) {  // (in place: a point moves only to a place already read)
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < n; ++i) m += keep[i] ? 1 : 0;
+    copyKept(c, keep, 0, n, 0, c);
+    c.x.resize(m), c.y.resize(m), c.z.resize(m);
+    if (colour) c.r.resize(m), c.g.resize(m), c.b.resize(m);
+    c.width = m, c.height = 1;
+    return;
+  }
+  // On the team: each thread counts the kept points of its static share, then copies them,
+  // after those of the shares before, into the calling thread's scratch cloud, whose buffers
+  // then trade places with c's (both keep their capacity from call to call).
+  thread_local PointCloud scratch_cloud;
+  thread_local std::vector<std::size_t> kept_counts;
+  PointCloud& scratch = scratch_cloud;  // (the calling thread's, named in the region)
+  std::vector<std::size_t>& before = kept_counts;
+  before.assign(static_cast<std::size_t>(most) + 1, 0);
+#pragma omp parallel num_threads(most)
+  {
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    const std::size_t b = n * me / team, e = n * (me + 1) / team;
+    std::size_t kept = 0;
+    for (std::size_t i = b; i < e; ++i) kept += keep[i] ? 1 : 0;
+    before[static_cast<std::size_t>(me) + 1] = kept;
+#pragma omp barrier
+#pragma omp single
+    {
+      for (int t = 0; t < team; ++t) before[t + 1] += before[t];
+      scratch.resize(before[team], colour);
+    }
+    copyKept(c, keep, b, e, before[static_cast<std::size_t>(me)], scratch);
+  }
+  c.x.swap(scratch.x), c.y.swap(scratch.y), c.z.swap(scratch.z);
+  if (colour) c.r.swap(scratch.r), c.g.swap(scratch.g), c.b.swap(scratch.b);
+  c.width = c.x.size(), c.height = 1;
+}
+
+}  // namespace detail
+
 namespace {
 
 // Keeps the points where keep[i]: an organized cloud keeps its layout (others become NaN),

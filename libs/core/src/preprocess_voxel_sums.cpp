@@ -18,10 +18,36 @@
 #include "fast_cell_map.h"
 #include "preprocess_internal.h"
 #include "upd/core/openmp.h"
+#include "upd/core/vector_clones.h"
 
 namespace upd::core::detail {
 
 namespace {
+
+// A Bloom filter of one hash over the keys a thread's map holds (in a team): a later thread asks
+// it before it looks a voxel up in that map. Most of its voxels are not there, and each probe of
+// the other thread's map would miss the cache (another core filled it).
+class SeenKeys {
+ public:
+  void clear() { bits_.assign(kWords, 0); }
+  void add(std::uint64_t key) {
+    const std::size_t i = slot(key);
+    bits_[i >> 6] |= std::uint64_t{1} << (i & 63);
+  }
+  bool mayHold(std::uint64_t key) const {
+    const std::size_t i = slot(key);
+    return ((bits_[i >> 6] >> (i & 63)) & 1) != 0;
+  }
+
+ private:
+  // (64 KB: ~3 % false positives at a Kinect frame's ~16,000 voxels a thread.)
+  static constexpr int kBits = 19;
+  static constexpr std::size_t kWords = (std::size_t{1} << kBits) / 64;
+  static std::size_t slot(std::uint64_t key) {
+    return static_cast<std::size_t>((key * 0xD6E8FEB86659FD93ull) >> (64 - kBits));
+  }
+  std::vector<std::uint64_t> bits_;
+};
 
 // Per voxel: the sums of the points relative to the anchor, of the colours (exact: below 2^32
 // for any voxel of fewer than 2^24 points), and the count.
@@ -39,6 +65,8 @@ struct VoxelScratch {
   // (In a team:) each voxel's first and last point, and whether an earlier thread has it.
   std::vector<std::uint32_t> voxel_first, voxel_last;
   std::vector<char> merged;
+  std::vector<std::uint32_t> own;          // (those not merged, whose centroids it stores)
+  SeenKeys seen;                           // (in a team:) a bit for every key the map holds
   std::size_t held = 0;                    // (their number)
   std::size_t expected = 0;                // the voxels the map is sized for
   std::vector<std::uint64_t> row_key[2];   // the voxel key and id of each column, last two rows
@@ -65,21 +93,70 @@ std::size_t firstPassing(const PointCloud& in, const RangeBoxTest* test, std::si
   return in.size();
 }
 
-// The centroid of the voxel a (anchored at ref) into out's point at.
-inline void storeCentroid(const VoxelSums& a, const Eigen::Vector3d& ref, bool colour,
-                          PointCloud& out, std::size_t at) {
-  const Eigen::Vector3d c = ref + Eigen::Vector3d(a.sx, a.sy, a.sz) / a.n;
-  out.x[at] = static_cast<float>(c.x());
-  out.y[at] = static_cast<float>(c.y());
-  out.z[at] = static_cast<float>(c.z());
-  if (colour) {
-    // (lround's value: the quotient lies at least 1 / (2 n) from a half, far beyond its
-    // rounding, and is not negative.)
-    const auto avg = [&](std::uint32_t sum) {
-      return static_cast<std::uint8_t>(static_cast<double>(sum) / a.n + 0.5);
-    };
-    out.r[at] = avg(a.r), out.g[at] = avg(a.g), out.b[at] = avg(a.b);
+// Where centroids go: out's points from at.
+struct CentroidsOut {
+  float *x, *y, *z;
+  std::uint8_t *r, *g, *b;  // (null: no colour)
+};
+
+CentroidsOut centroidsOut(PointCloud& out, std::size_t at) {
+  const bool colour = out.hasColor();
+  return {out.x.data() + at, out.y.data() + at, out.z.data() + at,
+          colour ? out.r.data() + at : nullptr, colour ? out.g.data() + at : nullptr,
+          colour ? out.b.data() + at : nullptr};
+}
+
+// The centroids of the voxels a[ids[j]] (kListed; else a[j]), j in [0, n), anchored at ref, into
+// out's points j: each coordinate the sum over the count plus the anchor's, each colour the
+// mean rounded (lround's value: the quotient lies at least 1 / (2 n) from a half, far beyond its
+// rounding, and is not negative). Blocks of voxels are copied out of their sums first, so that
+// the divisions run in a loop over plain arrays, which a vector unit does 4 or 8 at a time (the
+// same quotients bit for bit).
+template <bool kListed>
+__attribute__((always_inline)) inline void centroidsOf(const VoxelSums* a,
+                                                       const std::uint32_t* ids, std::size_t n,
+                                                       const double (&ref)[3],
+                                                       const CentroidsOut& out) {
+  constexpr std::size_t kBlock = 64;
+  double sum[3][kBlock], count[kBlock];
+  std::uint32_t rgb[3][kBlock];
+  const bool colour = out.r != nullptr;
+  float* __restrict xyz[3] = {out.x, out.y, out.z};
+  std::uint8_t* __restrict channel[3] = {out.r, out.g, out.b};
+  for (std::size_t j0 = 0; j0 < n; j0 += kBlock) {
+    const std::size_t m = std::min(kBlock, n - j0);
+    for (std::size_t k = 0; k < m; ++k) {
+      const VoxelSums& v = a[kListed ? ids[j0 + k] : j0 + k];
+      sum[0][k] = v.sx, sum[1][k] = v.sy, sum[2][k] = v.sz;
+      count[k] = v.n;
+      rgb[0][k] = v.r, rgb[1][k] = v.g, rgb[2][k] = v.b;
+    }
+    for (int c = 0; c < 3; ++c) {
+      float* __restrict o = xyz[c] + j0;
+      for (std::size_t k = 0; k < m; ++k) o[k] = static_cast<float>(ref[c] + sum[c][k] / count[k]);
+    }
+    if (!colour) continue;
+    for (int c = 0; c < 3; ++c) {
+      std::uint8_t* __restrict o = channel[c] + j0;
+      for (std::size_t k = 0; k < m; ++k) {
+        o[k] = static_cast<std::uint8_t>(static_cast<std::int32_t>(rgb[c][k] / count[k] + 0.5));
+      }
+    }
   }
+}
+
+// The centroids of the voxels a[0, n) (cloned for the vector units).
+UPD_VECTOR_CLONES
+void storeCentroids(const VoxelSums* a, std::size_t n, const double (&ref)[3],
+                    const CentroidsOut& out) {
+  centroidsOf<false>(a, nullptr, n, ref, out);
+}
+
+// The centroids of the voxels a[ids[0, n)].
+UPD_VECTOR_CLONES
+void storeListedCentroids(const VoxelSums* a, const std::uint32_t* ids, std::size_t n,
+                          const double (&ref)[3], const CentroidsOut& out) {
+  centroidsOf<true>(a, ids, n, ref, out);
 }
 
 // out resized to n centroids, unorganized.
@@ -191,7 +268,10 @@ class VoxelPass {
         if (kTeam) s_.voxel_first.resize(size), s_.voxel_last.resize(size);
       }
       s_.voxel_keys[n_voxels_] = key;
-      if (kTeam) s_.voxel_first[n_voxels_] = static_cast<std::uint32_t>(point);
+      if (kTeam) {
+        s_.voxel_first[n_voxels_] = static_cast<std::uint32_t>(point);
+        s_.seen.add(key);
+      }
       s_.voxels[n_voxels_++] = VoxelSums{};
       s_.held = n_voxels_;
     }
@@ -262,7 +342,8 @@ UPD_NOIPA CropCounts voxelizeWith(VoxelScratch& s, const PointCloud& in, const S
   }
   const bool colour = in.hasColor();
   resizeCentroids(pass.voxels(), colour, out);
-  for (std::size_t v = 0; v < pass.voxels(); ++v) storeCentroid(s.voxels[v], ref, colour, out, v);
+  const double anchor[3] = {ref.x(), ref.y(), ref.z()};
+  storeCentroids(s.voxels.data(), pass.voxels(), anchor, centroidsOut(out, 0));
   return {st.finite_before + pass.finite(), pass.passed()};
 }
 
@@ -374,6 +455,7 @@ void mergeInto(const Team& t, int later, std::size_t v0, std::size_t v1) {
     s.merged[v] = 0;
     for (int u = 0; u < later; ++u) {
       VoxelScratch& e = *t.scratch[u];
+      if (!e.seen.mayHold(key)) continue;
       const std::uint32_t id = e.map.find(key);
       if (id == kNoIndex) continue;
       VoxelSums& a = e.voxels[id];
@@ -399,6 +481,7 @@ std::size_t sumTeamVoxels(VoxelScratch& s, const Team& t, int team, int me, std:
                           bool& fits) {
   fits = teamKeys(t, team, me, finite);
   prepareMap(s);
+  s.seen.clear();
 #pragma omp barrier
 #pragma omp single
   splitRows(t, team);
@@ -418,12 +501,18 @@ std::size_t sumTeamVoxels(VoxelScratch& s, const Team& t, int team, int me, std:
 
 // This thread's voxels that no earlier thread has, their centroids into out from its offset.
 void storeTeamCentroids(const Team& t, int me, PointCloud& out) {
-  const VoxelScratch& s = *t.scratch[me];
-  const bool colour = t.in.hasColor();
-  std::size_t at = t.offset[me];
-  for (std::size_t v = 0; v < t.voxels[me]; ++v) {
-    if (me == 0 || !s.merged[v]) storeCentroid(s.voxels[v], t.st.ref, colour, out, at++);
+  VoxelScratch& s = *t.scratch[me];
+  const double anchor[3] = {t.st.ref.x(), t.st.ref.y(), t.st.ref.z()};
+  if (me == 0) {
+    storeCentroids(s.voxels.data(), t.voxels[me], anchor, centroidsOut(out, t.offset[me]));
+    return;
   }
+  s.own.clear();
+  for (std::size_t v = 0; v < t.voxels[me]; ++v) {
+    if (!s.merged[v]) s.own.push_back(static_cast<std::uint32_t>(v));
+  }
+  storeListedCentroids(s.voxels.data(), s.own.data(), s.own.size(), anchor,
+                       centroidsOut(out, t.offset[me]));
 }
 
 VoxelScratch& teamScratch() {
@@ -491,62 +580,6 @@ CropCounts voxelize(const PointCloud& in, double voxel_m, const RangeBoxTest* te
   }
   thread_local VoxelScratch s;
   return voxelizeWith(s, in, st, out);
-}
-
-namespace {
-// The kept points of c's [b, e) into out from its point at (out may be c: a point then moves
-// only to a place already read).
-void copyKept(const PointCloud& c, const std::vector<char>& keep, std::size_t b, std::size_t e,
-              std::size_t at, PointCloud& out) {
-  const bool colour = c.hasColor();
-  for (std::size_t i = b; i < e; ++i) {
-    if (!keep[i]) continue;
-    out.x[at] = c.x[i], out.y[at] = c.y[i], out.z[at] = c.z[i];
-    if (colour) out.r[at] = c.r[i], out.g[at] = c.g[i], out.b[at] = c.b[i];
-    ++at;
-  }
-}
-}  // namespace
-
-void compactInPlace(PointCloud& c, const std::vector<char>& keep) {
-  const bool colour = c.hasColor();
-  const std::size_t n = c.size();
-  const int most = std::min(openmp::maxThreads(), 64);
-  if (n <= 16384 || most == 1) {  // (in place: a point moves only to a place already read)
-    std::size_t m = 0;
-    for (std::size_t i = 0; i < n; ++i) m += keep[i] ? 1 : 0;
-    copyKept(c, keep, 0, n, 0, c);
-    c.x.resize(m), c.y.resize(m), c.z.resize(m);
-    if (colour) c.r.resize(m), c.g.resize(m), c.b.resize(m);
-    c.width = m, c.height = 1;
-    return;
-  }
-  // On the team: each thread counts the kept points of its static share, then copies them,
-  // after those of the shares before, into the calling thread's scratch cloud, whose buffers
-  // then trade places with c's (both keep their capacity from call to call).
-  thread_local PointCloud scratch_cloud;
-  thread_local std::vector<std::size_t> kept_counts;
-  PointCloud& scratch = scratch_cloud;  // (the calling thread's, named in the region)
-  std::vector<std::size_t>& before = kept_counts;
-  before.assign(static_cast<std::size_t>(most) + 1, 0);
-#pragma omp parallel num_threads(most)
-  {
-    const int team = openmp::teamSize(), me = openmp::threadIndex();
-    const std::size_t b = n * me / team, e = n * (me + 1) / team;
-    std::size_t kept = 0;
-    for (std::size_t i = b; i < e; ++i) kept += keep[i] ? 1 : 0;
-    before[static_cast<std::size_t>(me) + 1] = kept;
-#pragma omp barrier
-#pragma omp single
-    {
-      for (int t = 0; t < team; ++t) before[t + 1] += before[t];
-      scratch.resize(before[team], colour);
-    }
-    copyKept(c, keep, b, e, before[static_cast<std::size_t>(me)], scratch);
-  }
-  c.x.swap(scratch.x), c.y.swap(scratch.y), c.z.swap(scratch.z);
-  if (colour) c.r.swap(scratch.r), c.g.swap(scratch.g), c.b.swap(scratch.b);
-  c.width = c.x.size(), c.height = 1;
 }
 
 }  // namespace upd::core::detail
