@@ -235,9 +235,11 @@ FrameTiming timeFramePipeline(const Frame& f, const core::PipelineParams& params
 }
 
 std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const core::PipelineParams& params,
-                                                       int repeats, core::PipelineResult* last) {
+                                                       int repeats, core::PipelineResult* last,
+                                                       CoreProbe* probe) {
   FrameLoop one(f, params), two(f, params);
   for (int run = -1; run < repeats; ++run) {
+    if (probe && run >= 0) probe->sample();
     omp_set_num_threads(1);
     {
       const PinnedToThisCpu pin;

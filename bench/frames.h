@@ -56,9 +56,11 @@ FrameTiming timeFramePipeline(const Frame& f, const core::PipelineParams& params
 
 /// The same on one core and on two, frame by frame in turn: on a shared machine whose speed
 /// drifts, both medians then see the same conditions and their ratio is the second core's gain.
+/// With a probe, it is sampled beside each timed pair (the machine's own second core then).
 std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const core::PipelineParams& params,
                                                        int repeats,
-                                                       core::PipelineResult* last = nullptr);
+                                                       core::PipelineResult* last = nullptr,
+                                                       CoreProbe* probe = nullptr);
 
 /// Median time of f over repeats runs after one warm-up run [ms].
 double timeMedian(const std::function<void()>& f, int repeats);

@@ -37,6 +37,7 @@ struct StageMedians {
 // run); the stage medians of each into stages and two_stages.
 struct PaperTiming {
   double one_ms = kNaN, two_ms = kNaN;
+  double machine_speedup = kNaN;  // CoreProbe's, sampled beside each pair
   json stages, two_stages;
   std::size_t scored = 0;
 };
@@ -46,7 +47,9 @@ PaperTiming timePaperPipeline(const core::PointCloud& cloud, const core::Pipelin
   core::PipelineResult one, two;
   std::vector<double> t1, t2;
   StageMedians s1, s2;
+  CoreProbe probe;
   for (int run = -1; run < repeats; ++run) {
+    if (run >= 0) probe.sample();
     omp_set_num_threads(1);
     const core::Stopwatch w1;
     core::runPipeline(cloud, p, one);
@@ -61,6 +64,7 @@ PaperTiming timePaperPipeline(const core::PointCloud& cloud, const core::Pipelin
   }
   PaperTiming t;
   t.one_ms = median(t1), t.two_ms = median(t2);
+  t.machine_speedup = probe.speedup();
   t.stages = s1.toJson(), t.two_stages = s2.toJson();
   t.scored = one.cloud.size();
   return t;
@@ -103,6 +107,7 @@ json paperCase(const Frame& fr, const Options& o, Report& report) {
   c["two_core_ms"] = num(t.two_ms);
   c["two_core_stages"] = t.two_stages;
   c["two_core_speedup"] = num(t.one_ms / t.two_ms);
+  c["machine_two_core_speedup"] = num(t.machine_speedup);
   c["preprocess_share"] = num(pre / t.one_ms);
   double pcl_ms = kNaN;
   if (o.quick) {
@@ -119,9 +124,9 @@ json paperCase(const Frame& fr, const Options& o, Report& report) {
                 kMinPipelineTwoCoreSpeedup, false, "x");
   std::printf(
       "%-30s %7zu scored  ours %7.2f ms [pre %.2f, normals %.2f, UPD %.2f]  two cores %6.2f ms "
-      "(x%.2f)  PCL %8.1f ms",
+      "(x%.2f; machine x%.2f)  PCL %8.1f ms",
       fr.name.c_str(), t.scored, t.one_ms, pre, t.stages["normals_ms"].get<double>(),
-      t.stages["upd_ms"].get<double>(), t.two_ms, t.one_ms / t.two_ms, pcl_ms);
+      t.stages["upd_ms"].get<double>(), t.two_ms, t.one_ms / t.two_ms, t.machine_speedup, pcl_ms);
   if (std::isfinite(pcl_ms)) {
     const json& q = c["pcl"];
     std::printf(" [voxel %.1f, SOR %.1f, normals %.1f, UPD %.1f]  PCL/ours %.0fx",
@@ -143,7 +148,8 @@ json sensorRateCase(const Frame& fr, const Options& o, Report& report) {
   }
   const core::PipelineParams p = sensorRateParams(fr.up);
   core::PipelineResult result;
-  const auto [t1, t2] = timeOneAndTwoCores(fr, p, o.repeats, &result);
+  CoreProbe probe;
+  const auto [t1, t2] = timeOneAndTwoCores(fr, p, o.repeats, &result, &probe);
   std::vector<double> pcl_runs;
   omp_set_num_threads(1);
   for (int r = 0; r < std::max(3, o.repeats / 3); ++r) {
@@ -158,6 +164,7 @@ json sensorRateCase(const Frame& fr, const Options& o, Report& report) {
   c["two_core_ms"] = num(t2.total_ms);
   c["two_core_stages"] = t2.stages;
   c["two_core_speedup"] = num(t1.total_ms / t2.total_ms);
+  c["machine_two_core_speedup"] = num(probe.speedup());
   c["pcl_integral_normals_ms"] = num(pcl);
   c["ratio_ours_over_pcl_integral"] = num(t1.total_ms / pcl);
   c["agreement"] = a.toJson();
@@ -170,10 +177,12 @@ json sensorRateCase(const Frame& fr, const Options& o, Report& report) {
   report.target(n + ", same label vs exact", a.same_label, kMinSameLabel, false, "");
   std::printf(
       "%-30s ours %6.2f ms [normals %.2f, UPD %.2f, labels %.2f, map %.2f]  two cores %6.2f ms "
-      "(x%.2f)  PCL integral normals %6.2f ms  ours/PCL %.2fx  |dz| %.4f  labels %.2f%%\n",
+      "(x%.2f; machine x%.2f)  PCL integral normals %6.2f ms  ours/PCL %.2fx  |dz| %.4f  "
+      "labels %.2f%%\n",
       fr.name.c_str(), t1.total_ms, t1.stages["normals_ms"].get<double>(),
       t1.stages["upd_ms"].get<double>(), t1.stages["classify_ms"].get<double>(),
-      t1.stages["map_update_ms"].get<double>(), t2.total_ms, t1.total_ms / t2.total_ms, pcl,
+      t1.stages["map_update_ms"].get<double>(), t2.total_ms, t1.total_ms / t2.total_ms,
+      probe.speedup(), pcl,
       t1.total_ms / pcl, a.mean_abs_dzeta, 100 * a.same_label);
   std::fflush(stdout);
   return c;

@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -50,6 +51,57 @@ double copyBandwidthGBs() {
   }
   return best;
 }
+
+namespace {
+
+// iters steps of four independent multiply-add chains, the sum of their ends (compute alone:
+// no loads or stores in the loop).
+double multiplyAddChains(std::int64_t iters, double seed) {
+  double a = seed, b = seed + 0.25, c = seed + 0.5, d = seed + 0.75;
+  for (std::int64_t i = 0; i < iters; ++i) {
+    a = a * 0.9999999 + 1e-7;
+    b = b * 0.9999998 + 2e-7;
+    c = c * 0.9999997 + 3e-7;
+    d = d * 0.9999996 + 4e-7;
+  }
+  return a + b + c + d;
+}
+
+// The probe's work: kProbeRounds parallel regions of kProbeSteps steps each, split over the
+// team (~2 ms on one thread at a few GHz, in regions as short as the pipelines' stages: ~24 a
+// frame of 5-15 ms).
+constexpr int kProbeRounds = 24;
+constexpr std::int64_t kProbeSteps = std::int64_t(1) << 16;
+volatile double probe_sink = 0;
+
+// The probe's work on the current number of threads [ms].
+double timeProbe() {
+  double ends[64] = {};
+  const core::Stopwatch watch;
+  for (int round = 0; round < kProbeRounds; ++round) {
+#pragma omp parallel
+    {
+      const int team = omp_get_num_threads(), me = omp_get_thread_num();
+      if (me < 64) ends[me] += multiplyAddChains(kProbeSteps / team, probe_sink + me);
+    }
+  }
+  const double ms = watch.elapsedMs();
+  double sum = 0;
+  for (const double e : ends) sum += e;
+  probe_sink = sum;
+  return ms;
+}
+
+}  // namespace
+
+void CoreProbe::sample() {
+  omp_set_num_threads(1);
+  one_ms_.push_back(timeProbe());
+  omp_set_num_threads(2);
+  two_ms_.push_back(timeProbe());
+}
+
+double CoreProbe::speedup() const { return median(one_ms_) / median(two_ms_); }
 
 namespace {
 
