@@ -38,7 +38,7 @@ json frameTimingCase(const Frame& fr, const Options& o, Report& report, core::Pi
   report.target(fr.name + ": frame pipeline, one core (median)", t1.total_ms, kFrameBudgetMs,
                 true, "ms");
   report.target(fr.name + ": second core speedup", t1.total_ms / t2.total_ms, kMinTwoCoreSpeedup,
-                false, "x");
+                false, "x", machineNote(probe.speedup()));
   std::printf(
       "%-30s %7zu px %7zu scored  one core %7.2f ms  two cores %7.2f ms (x%.2f; machine x%.2f)  "
       "[normals %.2f, UPD %.2f, labels %.2f, map %.2f ms]\n",

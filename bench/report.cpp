@@ -103,6 +103,12 @@ void CoreProbe::sample() {
 
 double CoreProbe::speedup() const { return median(one_ms_) / median(two_ms_); }
 
+std::string machineNote(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "(machine x%.2f)", s);
+  return text;
+}
+
 namespace {
 
 std::string cpuModel() {
@@ -146,14 +152,16 @@ int finish(Report& report, const Options& o, double bandwidth) {
   json tj = json::array();
   std::size_t met = 0;
   for (const Target& t : report.targets) {
-    std::printf("  [%s] %-62s %10.4g %s %-6g %s\n", t.met() ? " met  " : "NOT MET", t.name.c_str(),
-                t.value, t.upper_bound ? "<=" : ">=", t.limit, t.unit.c_str());
+    std::printf("  [%s] %-62s %10.4g %s %-6g %s%s%s\n", t.met() ? " met  " : "NOT MET",
+                t.name.c_str(), t.value, t.upper_bound ? "<=" : ">=", t.limit, t.unit.c_str(),
+                t.note.empty() ? "" : " ", t.note.c_str());
     tj.push_back({{"name", t.name},
                   {"value", num(t.value)},
                   {"limit", t.limit},
                   {"bound", t.upper_bound ? "<=" : ">="},
                   {"unit", t.unit},
                   {"met", t.met()}});
+    if (!t.note.empty()) tj.back()["note"] = t.note;
     met += t.met() ? 1 : 0;
   }
   std::printf("%zu of %zu targets met; memory-bandwidth floor of a frame %.2f ms\n", met,

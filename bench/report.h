@@ -49,6 +49,7 @@ struct Target {
   double limit = kNaN;
   bool upper_bound = true;  // value <= limit (else value >= limit)
   std::string unit;
+  std::string note;  // printed after it (the machine's own second core beside ours)
   bool met() const {
     return std::isfinite(value) && (upper_bound ? value <= limit : value >= limit);
   }
@@ -61,8 +62,8 @@ class Report {
   std::vector<Target> targets;
 
   void target(const std::string& name, double value, double limit, bool upper,
-              const std::string& unit) {
-    targets.push_back({name, value, limit, upper, unit});
+              const std::string& unit, const std::string& note = "") {
+    targets.push_back({name, value, limit, upper, unit, note});
   }
 };
 
@@ -77,6 +78,9 @@ double peakRssMb();
 
 /// Sustained copy bandwidth of this machine [GB/s] (read + write counted), for the floor.
 double copyBandwidthGBs();
+
+/// "machine xS": CoreProbe's speedup s, for a target's note.
+std::string machineNote(double s);
 
 /// What this machine's second core gives at the moment, as a peer for the pipelines' second
 /// core: work of compute alone (independent multiply-adds, no memory, no serial part) in 24
