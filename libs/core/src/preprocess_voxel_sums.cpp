@@ -364,6 +364,39 @@ struct Team {
 };
 constexpr std::size_t kTeamChunk = 4096;
 
+// (x | -x) >> 63: 1 where x is not 0 (shifts, which vectorize).
+inline std::uint64_t nonZero(std::uint64_t x) { return (x | (0 - x)) >> 63; }
+
+// The cost of summing a row of n keys k (not empty), up the row above's or null: its passing
+// points, 5 more for each run of points in one voxel (a key unlike the one before), and 10 more
+// for each run whose key is not the one above either (with no row above, every run: the hash
+// map's look-ups, where the new voxels are). Weighed on the benchmark's frames by each thread's
+// time on its rows: the longer of the two 0.8-1.15 ms with runs alone, 0.8-1.09 with the
+// look-ups too (1.0 and 0.91 on average). (A key's top bit is set in kNoKey alone. Cloned: 4 or 8
+// keys a vector on AVX2 / AVX-512, where the baseline's SSE2 takes 2.)
+UPD_VECTOR_CLONES
+std::uint64_t rowCost(const std::uint64_t* __restrict k, const std::uint64_t* __restrict up,
+                      std::size_t n) {
+  std::uint64_t points = ~k[0] >> 63, runs = points, looks = points;
+  if (up) {
+    looks &= nonZero(k[0] ^ up[0]);
+    for (std::size_t i = 1; i < n; ++i) {
+      const std::uint64_t pass = ~k[i] >> 63, start = pass & nonZero(k[i] ^ k[i - 1]);
+      points += pass;
+      runs += start;
+      looks += start & nonZero(k[i] ^ up[i]);
+    }
+  } else {
+    for (std::size_t i = 1; i < n; ++i) {
+      const std::uint64_t pass = ~k[i] >> 63, start = pass & nonZero(k[i] ^ k[i - 1]);
+      points += pass;
+      runs += start;
+    }
+    looks = runs;
+  }
+  return points + 5 * runs + 10 * looks;
+}
+
 // The keys of thread me's share of the rows, and each row's cost; false where a key
 // overflows.
 bool teamKeys(const Team& t, int team, int me, std::size_t& finite) {
@@ -373,37 +406,10 @@ bool teamKeys(const Team& t, int team, int me, std::size_t& finite) {
   for (std::size_t row = r0; row < r1; ++row) {
     const std::size_t b = std::max(t.st.first, row * w), e = std::min(n, (row + 1) * w);
     fits &= voxelKeys(&t.in.x[b], &t.in.y[b], &t.in.z[b], e - b, t.st.k, t.keys + b, finite);
-    // The row's cost: its passing points, 5 more for each run of points in one voxel (a key
-    // unlike the one before), and 10 more for each run whose key is not the one above either
-    // (of an organized cloud, below the share's first row: the hash map's look-ups, where the
-    // new voxels are). Weighed on the benchmark's frames by each thread's time on its rows: the
-    // longer of the two 0.8-1.15 ms with runs alone, 0.8-1.09 with the look-ups too (1.0 and
-    // 0.91 on average). (A key's top bit is set in kNoKey alone, and (d | -d) >> 63 is 1 where d
-    // is not 0: shifts, which vectorize.)
-    const std::uint64_t* k = t.keys + b;
-    std::uint64_t points = ~k[0] >> 63, runs = points, looks = points;
-    const auto differ = [](std::uint64_t key, std::uint64_t other) {
-      const std::uint64_t d = key ^ other;
-      return (d | (0 - d)) >> 63;
-    };
-    if (t.in.isOrganized() && row > r0) {  // (the row above: this thread's keys)
-      const std::uint64_t* up = k - w;
-      looks &= differ(k[0], up[0]);
-      for (std::size_t i = 1; i < e - b; ++i) {
-        const std::uint64_t pass = ~k[i] >> 63, start = pass & differ(k[i], k[i - 1]);
-        points += pass;
-        runs += start;
-        looks += start & differ(k[i], up[i]);
-      }
-    } else {
-      for (std::size_t i = 1; i < e - b; ++i) {
-        const std::uint64_t pass = ~k[i] >> 63, start = pass & differ(k[i], k[i - 1]);
-        points += pass;
-        runs += start;
-      }
-      looks = runs;
-    }
-    t.cost[row] = static_cast<std::uint32_t>(points + 5 * runs + 10 * looks);
+    // (Of an organized cloud, below the share's first row: the row above is this thread's.)
+    const bool above = t.in.isOrganized() && row > r0;
+    t.cost[row] = static_cast<std::uint32_t>(
+        rowCost(t.keys + b, above ? t.keys + b - w : nullptr, e - b));
   }
   return fits;
 }
