@@ -115,7 +115,7 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
 
   const detail::Bins bins = detail::binFrame(f);
   const std::size_t n_cells = bins.sums.size();
-  detail::LatticeIndex index;
+  detail::LatticeIndex& index = buf.index;
   detail::indexLattice(bins, f.m, index, buf.cell_nodes);
   detail::computeCellRows(bins.sums, buf.rows);
   detail::computeNodeSums(index, bins, buf.rows.data(), f.m, buf.node_sums);

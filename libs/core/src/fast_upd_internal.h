@@ -181,6 +181,7 @@ struct FastUpdBuffers {
   std::vector<NodeSums> node_sums;        // per node
   std::vector<CellPoly> polys;            // per cell
   CellPoints points;
+  LatticeIndex index;                     // the nodes and blocks
 };
 
 // --- Stages (in the order computeUpdFast runs them) ---

@@ -292,7 +292,7 @@ void indexLattice(const Bins& bins, int m, LatticeIndex& index,
   const std::int32_t* cell_xyz = bins.grid.coords().data();
   // Nodes: the 8 corners of every occupied cell.
   cell_nodes.resize(8 * n_cells);
-  index.nodes = CellGrid(4 * n_cells);
+  index.nodes.clear(4 * n_cells);  // (its table and coordinates kept from the last frame)
   index.nodes.reserve(4 * n_cells);
   for (std::size_t c = 0; c < n_cells; ++c) {
     for (int o = 0; o < 8; ++o) {
@@ -304,7 +304,7 @@ void indexLattice(const Bins& bins, int m, LatticeIndex& index,
   // Blocks of B^3 cells; cells and nodes grouped by block (counting sort).
   const std::int32_t B = m + 1;
   index.B = B;
-  index.blocks = CellGrid(n_cells / 8 + 64);
+  index.blocks.clear(n_cells / 8 + 64);
   const auto blockOf = [&](const std::int32_t* xyz) {
     return index.blocks.insert(floorDiv(xyz[0], B), floorDiv(xyz[1], B), floorDiv(xyz[2], B));
   };
