@@ -99,7 +99,7 @@ Binned bin(const Scene& s, const UpdParams& params, int threads) {
   Binned out;
   out.cell_of.assign(s.cloud.size(), kNoIndex);
   f.cell_of = out.cell_of.data();
-  out.bins = detail::binFrame(f);
+  detail::binFrame(f, out.bins);
   out.lat = f.lat;
   setThreads(2);
   return out;

@@ -113,7 +113,8 @@ void computeUpdFast(const PointCloud& cloud, const Normals& normals, const UpdPa
   buf.cell_of.resize(n_pts);
   f.cell_of = buf.cell_of.data();
 
-  const detail::Bins bins = detail::binFrame(f);
+  detail::binFrame(f, buf.bins);
+  const detail::Bins& bins = buf.bins;
   const std::size_t n_cells = bins.sums.size();
   detail::LatticeIndex& index = buf.index;
   detail::indexLattice(bins, f.m, index, buf.cell_nodes);

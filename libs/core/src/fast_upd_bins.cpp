@@ -198,12 +198,27 @@ bool binRange(const PointCloud& cloud, const Normals& normals, const Lattice& la
   return fits;
 }
 
-// Bins the points of every chunk (binRange), then merges the chunks' cells in chunk order;
-// cell_of[i] is then point i's cell in the result.
-Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
-               const PointChunks& chunks, double radius_m, std::uint32_t* cell_of) {
+// Empties b for about as many cells as it held (its table and arrays kept).
+void clearBins(Bins& b) {
+  b.grid.clear(std::max<std::size_t>(b.grid.size(), 64));
+  b.sums.clear();
+}
+
+// The per-chunk bins and the merge's id maps, kept from frame to frame (no tables built and
+// grown again every frame).
+struct ChunkBins {
+  std::vector<Bins> bins;
+  std::vector<std::vector<std::uint32_t>> remap;
+};
+
+// Bins the points of every chunk (binRange), then merges the chunks' cells in chunk order into
+// out; cell_of[i] is then point i's cell in out.
+void binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& lat,
+               const PointChunks& chunks, double radius_m, std::uint32_t* cell_of, Bins& out) {
   const auto n_chunks = static_cast<std::ptrdiff_t>(chunks.count);
-  std::vector<Bins> chunk_bins(chunks.count);
+  static thread_local ChunkBins kept;
+  ChunkBins& cb = kept;  // (the calling thread's, named in the regions)
+  if (cb.bins.size() < chunks.count) cb.bins.resize(chunks.count), cb.remap.resize(chunks.count);
   int all_fit = 1;
   // A dynamic schedule over the chunks (equal numbers of finite points): a chunk's cost still
   // varies with its points' runs (far points cross cells more often), and with static shares
@@ -215,11 +230,11 @@ Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& l
   for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
     const auto cu = static_cast<std::size_t>(c);
     static thread_local StripeBuffers stripes;  // (this thread's: named inside the region)
-    all_fit &=
-        binRange(cloud, normals, lat, chunks.begin(cu), chunks.end(cu), chunk_bins[cu], cell_of,
-                 stripes)
-            ? 1
-            : 0;
+    clearBins(cb.bins[cu]);
+    all_fit &= binRange(cloud, normals, lat, chunks.begin(cu), chunks.end(cu), cb.bins[cu],
+                        cell_of, stripes)
+                   ? 1
+                   : 0;
   }
   if (!all_fit) {
     throw std::invalid_argument(
@@ -227,27 +242,33 @@ Bins binPoints(const PointCloud& cloud, const Normals& normals, const Lattice& l
         ": the cloud spans more than 2^20 fast-path lattice cells along an axis; use a "
         "range cut-off, a larger radius or fewer fast_cells_per_radius");
   }
-  Bins bins = std::move(chunk_bins[0]);
-  std::vector<std::vector<std::uint32_t>> remap(chunks.count);
-  for (std::size_t c = 1; c < chunks.count; ++c) {
-    const Bins& cb = chunk_bins[c];
-    remap[c].resize(cb.sums.size());
-    for (std::size_t j = 0; j < cb.sums.size(); ++j) {
-      const std::int32_t* xyz = cb.grid.xyz(j);
-      const std::uint32_t id = bins.cellOf(xyz[0], xyz[1], xyz[2]);
-      bins.sums[id].add(cb.sums[j]);
-      remap[c][j] = id;
+  // The first chunk's cells first, in its order: their ids in out are the chunk's own, and
+  // their sums its sums as they are.
+  clearBins(out);
+  for (std::size_t c = 0; c < chunks.count; ++c) {
+    const Bins& b = cb.bins[c];
+    std::vector<std::uint32_t>& remap = cb.remap[c];
+    remap.resize(b.sums.size());
+    for (std::size_t j = 0; j < b.sums.size(); ++j) {
+      const std::int32_t* xyz = b.grid.xyz(j);
+      const std::uint32_t id = out.cellOf(xyz[0], xyz[1], xyz[2]);
+      if (c == 0) {
+        out.sums[id] = b.sums[j];
+      } else {
+        out.sums[id].add(b.sums[j]);
+      }
+      remap[j] = id;
     }
   }
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t c = 0; c < n_chunks; ++c) {
     if (c == 0) continue;  // (from 0: the same shares as the binning)
     const auto cu = static_cast<std::size_t>(c);
+    const std::uint32_t* remap = cb.remap[cu].data();
     for (std::size_t i = chunks.begin(cu); i < chunks.end(cu); ++i) {
-      if (cell_of[i] != kNoIndex) cell_of[i] = remap[cu][cell_of[i]];
+      if (cell_of[i] != kNoIndex) cell_of[i] = remap[cell_of[i]];
     }
   }
-  return bins;
 }
 
 // The occupied cells of lattice lat and the points with a valid normal in them (binRange's
@@ -386,7 +407,7 @@ int latticeCells(const FastFrame& f) {
 
 }  // namespace
 
-Bins binFrame(FastFrame& f) {
+void binFrame(FastFrame& f, Bins& out) {
   const double radius_m = f.params.radius_m;
   // A finer lattice where the points are dense (fast_cells_per_point): the node work grows
   // with the cells, so it stays a fixed share of the per-point work. Decided by counting the
@@ -398,7 +419,7 @@ Bins binFrame(FastFrame& f) {
       f.lat.inv_cell = static_cast<float>(f.m / radius_m);
     }
   }
-  return binPoints(f.cloud, f.normals, f.lat, f.chunks, radius_m, f.cell_of);
+  binPoints(f.cloud, f.normals, f.lat, f.chunks, radius_m, f.cell_of, out);
 }
 
 }  // namespace upd::core::detail

@@ -181,14 +181,16 @@ struct FastUpdBuffers {
   std::vector<NodeSums> node_sums;        // per node
   std::vector<CellPoly> polys;            // per cell
   CellPoints points;
+  Bins bins;                              // the cells and their sums
   LatticeIndex index;                     // the nodes and blocks
 };
 
 // --- Stages (in the order computeUpdFast runs them) ---
 
 // fast_upd_bins.cpp: bins the frame's points (f.cell_of) at f.m cells per d_m, then at a finer
-// lattice where the points are dense (fast_cells_per_point), updating f.m and f.lat.
-Bins binFrame(FastFrame& f);
+// lattice where the points are dense (fast_cells_per_point), updating f.m and f.lat; the cells
+// into out (emptied first).
+void binFrame(FastFrame& f, Bins& out);
 
 // fast_upd_nodes.cpp
 void indexLattice(const Bins& bins, int m, LatticeIndex& index,
