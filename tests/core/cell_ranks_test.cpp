@@ -3,7 +3,7 @@
 // occupied cells before it in the box, an empty cell has none, the ids of three neighbours along
 // x at once are those of one at a time (also where they straddle two words of the table); a box
 // of too many cells per point is declined; the team's lists are the one-thread counting sort's,
-// item for item. Fixed seeds.
+// item for item; the team's coordinates of every id are its cell's. Fixed seeds.
 #include "../../libs/core/src/fast_cell_ranks.h"
 
 #include <gtest/gtest.h>
@@ -57,6 +57,46 @@ TEST(RankedCells, IdsAreTheOccupiedCellsBeforeInTheBoxOnAnyTeam) {
         std::uint32_t three[3];
         r.threeIds(b, three);
         for (std::size_t k = 0; k < 3; ++k) ASSERT_EQ(three[k], r.id(b + k)) << "cell " << b + k;
+      }
+    }
+  }
+}
+
+TEST(RankedCells, TheTeamGivesEveryIdItsCellsCoordinates) {
+  // (A box of negative coordinates, without and with a margin: cellAt undoes index.)
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<std::int32_t> x(-40, -3), y(-7, 12), z(-300, -290);
+  for (const int margin : {0, 2}) {
+    for (const std::size_t n : {0u, 1u, 50u, 4000u}) {
+      detail::RankedCells r;
+      const std::int32_t lo[3] = {-40, -7, -300}, hi[3] = {-3, 12, -290};
+      ASSERT_TRUE(r.reset(lo, hi, margin, 4000));
+      std::vector<std::int32_t> cells;
+      for (std::size_t i = 0; i < n; ++i) cells.insert(cells.end(), {x(rng), y(rng), z(rng)});
+      for (const int threads : {1, 2, 3}) {
+        SCOPED_TRACE(std::to_string(n) + " points, margin " + std::to_string(margin) + ", " +
+                     std::to_string(threads) + " thread(s)");
+        std::vector<std::int32_t> xyz;
+#pragma omp parallel num_threads(threads)
+        {
+          r.buildTeam(n, [&](std::size_t i) {
+            return r.index(cells[3 * i], cells[3 * i + 1], cells[3 * i + 2]);
+          });
+#pragma omp single
+          xyz.assign(3 * r.size(), 0);
+          r.cellsTeam(xyz.data());
+        }
+        for (std::size_t i = 0; i < n; ++i) {  // every marked cell: its id's coordinates
+          const std::uint32_t id = r.id(r.index(cells[3 * i], cells[3 * i + 1], cells[3 * i + 2]));
+          ASSERT_NE(id, kNoIndex);
+          for (int a = 0; a < 3; ++a) ASSERT_EQ(xyz[3 * id + a], cells[3 * i + a]) << "cell " << i;
+        }
+        for (std::uint32_t id = 0; id < r.size(); ++id) {  // and every id is a marked cell's
+          ASSERT_EQ(r.id(r.index(xyz[3 * id], xyz[3 * id + 1], xyz[3 * id + 2])), id);
+          std::int32_t back[3];
+          r.cellAt(r.index(xyz[3 * id], xyz[3 * id + 1], xyz[3 * id + 2]), back);
+          for (int a = 0; a < 3; ++a) ASSERT_EQ(back[a], xyz[3 * id + a]);
+        }
       }
     }
   }

@@ -242,6 +242,65 @@ TEST(FastUpd, ResultDoesNotDependOnTheThreadCount) {
   }
 }
 
+// Every cell's 8 corners named by index's ids: each id's coordinates are that corner's, and the
+// ids are one per distinct corner, 0 to the count.
+void expectCornerNodes(const detail::Bins& bins, const detail::LatticeIndex& index,
+                       const std::vector<std::uint32_t>& cell_nodes) {
+  std::map<Key, std::uint32_t> node_of;
+  const std::size_t n_cells = bins.sums.size();
+  ASSERT_EQ(cell_nodes.size(), 8 * n_cells);
+  for (std::size_t c = 0; c < n_cells; ++c) {
+    for (int o = 0; o < 8; ++o) {
+      const std::int32_t* cell = bins.grid.xyz(c);
+      const Key corner{cell[0] + (o & 1), cell[1] + ((o >> 1) & 1), cell[2] + ((o >> 2) & 1)};
+      const std::uint32_t v = cell_nodes[8 * c + o];
+      ASSERT_LT(v, index.nodeCount()) << "cell " << c << ", corner " << o;
+      const std::int32_t* xyz = index.nodeXyz(v);
+      ASSERT_EQ(Key(xyz[0], xyz[1], xyz[2]), corner) << "cell " << c << ", corner " << o;
+      const auto [it, inserted] = node_of.emplace(corner, v);
+      ASSERT_EQ(it->second, v) << "one corner, two ids";
+    }
+  }
+  EXPECT_EQ(node_of.size(), index.nodeCount());
+}
+
+// The lattice's nodes by rank (on 1, 2 and 3 threads: the same ids) and by the hash name the
+// same corners; a far cell makes the box too sparse for the rank table, and the index is then
+// the hash's.
+TEST(FastUpdNodes, RankAndHashNameEveryCellsCorners) {
+  UpdParams params;
+  params.radius_m = 0.5;
+  params.fast_cells_per_radius = 5;
+  Binned b = bin(makeScene(640, 480, 4), params, 2);
+  const std::size_t n_cells = b.bins.sums.size();
+  ASSERT_GT(n_cells, 1000u);
+  const std::int32_t* cells = b.bins.grid.coords().data();
+  std::vector<std::uint32_t> first;
+  for (const int threads : {1, 2, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " thread(s)");
+    setThreads(threads);
+    detail::LatticeIndex index;
+    std::vector<std::uint32_t> cell_nodes(8 * n_cells);
+    ASSERT_TRUE(detail::rankNodes(cells, n_cells, index, cell_nodes.data()));
+    expectCornerNodes(b.bins, index, cell_nodes);
+    if (first.empty()) first = cell_nodes;
+    EXPECT_EQ(cell_nodes, first);
+  }
+  setThreads(2);
+  detail::LatticeIndex hashed;
+  std::vector<std::uint32_t> hashed_nodes(8 * n_cells);
+  detail::hashNodes(cells, n_cells, hashed, hashed_nodes.data());
+  expectCornerNodes(b.bins, hashed, hashed_nodes);
+
+  b.bins.cellOf(cells[0] + 100000, cells[1], cells[2]);  // 10 km away
+  detail::LatticeIndex index;
+  std::vector<std::uint32_t> unused(8 * (n_cells + 1));
+  EXPECT_FALSE(detail::rankNodes(b.bins.grid.coords().data(), n_cells + 1, index, unused.data()));
+  std::vector<std::uint32_t> cell_nodes;
+  detail::indexLattice(b.bins, params.fast_cells_per_radius, index, cell_nodes);
+  expectCornerNodes(b.bins, index, cell_nodes);
+}
+
 // The grid normals of an unorganized cloud (its binning on the team from 16,384 points), with
 // NaN points: the same normals and curvatures bit for bit on 1, 2 and 3 threads; a cloud
 // spanning more than 2^20 radii is refused by name on two threads as on one.

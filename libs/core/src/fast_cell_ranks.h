@@ -82,6 +82,26 @@ class RankedCells {
     for (std::size_t k = 0; k < 3; ++k) out[k] = (three >> k) & 1 ? rank++ : kNoIndex;
   }
   std::size_t size() const { return n_cells_; }
+  /// The cell at index (the inverse of index()).
+  void cellAt(std::size_t index, std::int32_t* xyz) const {
+    const auto i = static_cast<std::int64_t>(index);
+    const std::int64_t in_plane = i % sz_;
+    xyz[0] = static_cast<std::int32_t>(in_plane % sy_ + lo_[0]);
+    xyz[1] = static_cast<std::int32_t>(in_plane / sy_ + lo_[1]);
+    xyz[2] = static_cast<std::int32_t>(i / sz_ + lo_[2]);
+  }
+  /// Team: the coordinates of every marked cell into xyz, 3 a cell in id order (size() cells);
+  /// each thread those of its static share of the words.
+  void cellsTeam(std::int32_t* xyz) const {
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    for (std::size_t w = share(words_.size(), team, me); w < share(words_.size(), team, me + 1);
+         ++w) {
+      std::uint32_t id = words_[w].before;
+      for (std::uint64_t bits = words_[w].bits; bits != 0; bits &= bits - 1, ++id) {
+        cellAt(64 * w + static_cast<std::size_t>(__builtin_ctzll(bits)), xyz + 3 * std::size_t{id});
+      }
+    }
+  }
 
   /// What index_of gives for an item without a cell.
   static constexpr std::size_t kSkip = ~std::size_t{0};

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fast_cell_map.h"
+#include "fast_cell_ranks.h"
 #include "fast_simd.h"
 #include "upd/core/fast_upd.h"
 
@@ -154,14 +155,21 @@ struct FastFrame {
 // The lattice nodes (the 8 corners of every occupied cell) and the blocks of B^3 cells, B = m +
 // 1, that group cells and nodes: every cell within d_m of a node lies in the 27 blocks around
 // the node's block.
+// The nodes are numbered by rank in a bit table over their box (on the team), or by the hash
+// where that box is too sparse for one (far lone points).
 struct LatticeIndex {
   std::int32_t B = 1;
-  CellGrid nodes;
+  RankedCells node_ranks;
+  std::vector<std::int32_t> ranked_node_xyz;  // 3 per node, by id: the ranked nodes'
+  CellGrid nodes;                             // the hashed nodes
+  const std::int32_t* node_xyz = nullptr;     // 3 per node, by id: either's
+  std::size_t n_nodes = 0;
   CellGrid blocks;
   std::vector<std::uint32_t> cell_block, node_block;
   CellLists block_cells, block_nodes;  // cells and nodes by block
 
-  std::size_t nodeCount() const { return nodes.size(); }
+  std::size_t nodeCount() const { return n_nodes; }
+  const std::int32_t* nodeXyz(std::size_t v) const { return node_xyz + 3 * v; }
   // The cells with valid normals in the 27 blocks around block b.
   void around(std::size_t b, const std::vector<CellSums>& sums,
               std::vector<std::uint32_t>& cells) const;
@@ -192,7 +200,14 @@ struct FastUpdBuffers {
 // into out (emptied first).
 void binFrame(FastFrame& f, Bins& out);
 
-// fast_upd_nodes.cpp
+// fast_upd_nodes.cpp: the nodes of the cells (cell_xyz, 3 a cell) into index and their ids into
+// cell_nodes (8 a cell, corner o at +1 along axis a where bit a of o is set), by rank on the
+// team (rankNodes: false, with nothing done, where their box is too sparse for the bit table)
+// or by the hash (hashNodes); then with the blocks (indexLattice, either way).
+bool rankNodes(const std::int32_t* cell_xyz, std::size_t n_cells, LatticeIndex& index,
+               std::uint32_t* cell_nodes);
+void hashNodes(const std::int32_t* cell_xyz, std::size_t n_cells, LatticeIndex& index,
+               std::uint32_t* cell_nodes);
 void indexLattice(const Bins& bins, int m, LatticeIndex& index,
                   std::vector<std::uint32_t>& cell_nodes);
 void computeCellRows(const std::vector<CellSums>& sums, std::vector<CellRow>& rows);
