@@ -1,6 +1,7 @@
 // The streaming rawlog reader on every rawlog of the shared data, on truncated and corrupt
 // copies, and on files written here in both layouts.
 #include "upd/mrpt_bridge/rawlog_reader.h"
+#include "rawlog_damage.h"
 #include "temp_dir.h"
 #include "test_data.h"
 
@@ -29,6 +30,8 @@ using upd::mrpt_bridge::RawlogLayout;
 using upd::mrpt_bridge::RawlogReader;
 namespace fs = std::filesystem;
 
+using upd::test::damageAtSecondObject;
+using upd::test::readFileBytes;
 using upd::test::TempDir;
 
 void writePrefix(const std::string& from, const fs::path& to, double fraction) {
@@ -360,11 +363,7 @@ TEST(RawlogReader, ImpossibleActionCountIsDamage) {
   TempDir tmp;
   const fs::path file = tmp.path() / "actions.rawlog";
   writeAroundActions(file, odometryWithModel(0, 300));
-  std::string bytes;
-  {
-    std::ifstream in(file, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
+  std::string bytes = readFileBytes(file);
   // The object header: the name's length with the high bit set, the name, the version 0.
   const std::string name = "mrpt::obs::CActionCollection";
   const std::string header = std::string(1, static_cast<char>(0x80 | name.size())) + name + '\0';
@@ -386,6 +385,44 @@ TEST(RawlogReader, ImpossibleActionCountIsDamage) {
     EXPECT_EQ(err.reason(), "corrupt CActionCollection: action count 4294967280 at byte " +
                                 std::to_string(count_at) + " (more than 4096 actions)");
   }
+}
+
+// An action estimated by scan matching carries its pose distribution (a CPosePDF) where odometry
+// carries its increment, and MRPT uses whatever object it reads there as one: an estimation
+// method corrupted to anything but odometry (found by fuzz_rawlog: 256, with the odometry's
+// CPose2D following) is damage before MRPT reads it, as is an unknown method. A real
+// scan-matching action is read as usual.
+TEST(RawlogReader, EstimationMethodWithoutItsPoseDistributionIsDamage) {
+  TempDir tmp;
+  const fs::path file = tmp.path() / "method.rawlog";
+  writeAroundActions(file, odometryWithModel(0, 300));
+  const std::string odometry = readFileBytes(file);
+  // The action's header (the name's length with the high bit set, the name, its version byte),
+  // then the method, an int32.
+  const std::string name = "mrpt::obs::CActionRobotMovement2D";
+  const auto at = odometry.find(std::string(1, static_cast<char>(0x80 | name.size())) + name);
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t method_at = at + 1 + name.size() + 1;
+  ASSERT_EQ(odometry.substr(method_at, 4), std::string(4, '\0'));
+  const std::string prefix =
+      "corrupt CActionRobotMovement2D (action 1 of 1 in a CActionCollection): ";
+  std::string bytes = odometry;
+  bytes.replace(method_at, 4, std::string("\x00\x01\x00\x00", 4));
+  EXPECT_EQ(damageAtSecondObject(file, bytes),
+            prefix + "unknown estimation method 256 (0 odometry, 1 scan matching)");
+  bytes.replace(method_at, 4, std::string("\x01\x00\x00\x00", 4));
+  EXPECT_EQ(damageAtSecondObject(file, bytes),
+            prefix + "a CPose2D where scan matching's pose distribution (a CPosePDF) belongs");
+
+  mrpt::obs::CActionRobotMovement2D matched;
+  matched.estimationMethod = mrpt::obs::CActionRobotMovement2D::emScan2DMatching;
+  auto pdf = mrpt::poses::CPosePDFGaussian::Create();
+  pdf->mean = mrpt::poses::CPose2D(0.4, 0.1, 0.05);
+  matched.poseChange = mrpt::containers::deepcopy_poly_ptr<mrpt::poses::CPosePDF::Ptr>(pdf);
+  mrpt::obs::CActionCollection acts;
+  acts.insert(matched);
+  writeAroundActions(file, acts);
+  EXPECT_EQ(damageAtSecondObject(file, readFileBytes(file)), "(read)");
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <iterator>
+#include <string>
 #include <stdexcept>
 #include <type_traits>
 
@@ -101,8 +103,28 @@ namespace {
 Parse checkMovement2D(Cursor& c, int version, std::string& why) {
   if (version < 4 || version > 7) return Parse::OtherLayout;
   std::int32_t method = 0;
-  // Not an odometry estimate (emOdometry = 0): a pose distribution object follows, left to MRPT.
-  if (!c.value(method) || method != 0) return Parse::OtherLayout;
+  if (!c.value(method)) return Parse::OtherLayout;
+  if (method != 0) {
+    // Not an odometry estimate (emOdometry = 0): scan matching (1), whose pose distribution
+    // object follows, left to MRPT; MRPT uses what it reads there as a CPosePDF without a check
+    // (another object, or none, ends the process).
+    if (method != 1) {
+      why = "unknown estimation method " + std::to_string(method) +
+            " (0 odometry, 1 scan matching)";
+      return Parse::Impossible;
+    }
+    ObjectHeader pdf;
+    if (!readHeader(c, pdf)) return Parse::OtherLayout;
+    static const char* const kPosePdfs[] = {"CPosePDFGaussian", "CPosePDFGaussianInf",
+                                            "CPosePDFParticles", "CPosePDFGrid", "CPosePDFSOG"};
+    if (std::find(std::begin(kPosePdfs), std::end(kPosePdfs), pdf.class_name) ==
+        std::end(kPosePdfs)) {
+      why = "a " + (pdf.class_name.empty() ? std::string("nameless object") : pdf.class_name) +
+            " where scan matching's pose distribution (a CPosePDF) belongs";
+      return Parse::Impossible;
+    }
+    return Parse::OtherLayout;
+  }
   ObjectHeader pose;
   if (!readHeader(c, pose) || pose.class_name != "CPose2D") return Parse::OtherLayout;
   if (pose.version == 0) {
