@@ -6,7 +6,9 @@
 // runs of every length (one point to several vectors of 8), NaN holes and invalid normals
 // inside runs, stripe and chunk boundaries in the middle of a run. Also the chunks every stage
 // deals out (equal shares of the finite points), and the whole fast UPD and the grid normals
-// the same bit for bit on 1, 2 and 3 threads. Fixed seeds.
+// the same bit for bit on 1, 2 and 3 threads; the lattice's nodes by rank and by the hash
+// name every cell's corners, and the blocks' floor division is the floor of the quotient. Fixed
+// seeds.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -238,6 +240,23 @@ TEST(FastUpd, ResultDoesNotDependOnTheThreadCount) {
       ASSERT_EQ(std::memcmp((r.*field).data(), (one.*field).data(), sizeof(float) * s.cloud.size()),
                 0)
           << "threads " << t + 1;
+    }
+  }
+}
+
+// The blocks' floor division without an integer division: floor(a / b) for negative and
+// positive coordinates, multiples of b among them, up to the keys' range.
+TEST(FastUpdNodes, FloorDividerIsTheFloorOfTheQuotient) {
+  for (const std::int32_t b : {1, 2, 5, 6, 9, 64}) {
+    const detail::FloorDivider div(b);
+    for (std::int64_t a = -3000; a <= 3000; ++a) {
+      ASSERT_EQ(div(static_cast<std::int32_t>(a)),
+                static_cast<std::int32_t>(std::floor(static_cast<double>(a) / b)))
+          << a << " / " << b;
+    }
+    for (const std::int32_t a : {-(1 << 21), -(1 << 21) + 1, (1 << 21) - 1, 1 << 21}) {
+      ASSERT_EQ(div(a), static_cast<std::int32_t>(std::floor(static_cast<double>(a) / b)))
+          << a << " / " << b;
     }
   }
 }

@@ -69,10 +69,25 @@ inline std::uint64_t keyOffset(std::int64_t dx, std::int64_t dy, std::int64_t dz
                                     dz * (std::int64_t(1) << 42));
 }
 
-/// Floor division for possibly negative lattice coordinates.
-inline std::int32_t floorDiv(std::int32_t a, std::int32_t b) {
-  const std::int32_t q = a / b;
-  return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
+/// floor(a / b) of possibly negative lattice coordinates for a fixed divisor b > 0, without an
+/// integer division: floor((a + 0.5) / b) in double, which lies 0.5 / b or more from a whole
+/// number, far more than the product's rounding.
+class FloorDivider {
+ public:
+  explicit FloorDivider(std::int32_t b) : inv_(1.0 / b) {}
+  std::int32_t operator()(std::int32_t a) const {
+    const double t = (a + 0.5) * inv_;
+    return static_cast<std::int32_t>(t) - (t < 0 ? 1 : 0);
+  }
+
+ private:
+  double inv_;
+};
+
+/// Coordinate a of corner o of the cell at xyz (the 8 corners: +1 along axis a where bit a of o
+/// is set).
+inline std::int32_t cornerCoord(const std::int32_t* xyz, int o, int a) {
+  return xyz[a] + ((o >> a) & 1);
 }
 
 class CellMap {

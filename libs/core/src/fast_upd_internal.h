@@ -159,17 +159,18 @@ struct FastFrame {
 // where that box is too sparse for one (far lone points).
 struct LatticeIndex {
   std::int32_t B = 1;
+  bool ranked = false;                        // the nodes by node_ranks, else by nodes
   RankedCells node_ranks;
   std::vector<std::int32_t> ranked_node_xyz;  // 3 per node, by id: the ranked nodes'
   CellGrid nodes;                             // the hashed nodes
-  const std::int32_t* node_xyz = nullptr;     // 3 per node, by id: either's
-  std::size_t n_nodes = 0;
   CellGrid blocks;
   std::vector<std::uint32_t> cell_block, node_block;
   CellLists block_cells, block_nodes;  // cells and nodes by block
 
-  std::size_t nodeCount() const { return n_nodes; }
-  const std::int32_t* nodeXyz(std::size_t v) const { return node_xyz + 3 * v; }
+  std::size_t nodeCount() const { return ranked ? node_ranks.size() : nodes.size(); }
+  const std::int32_t* nodeXyz(std::size_t v) const {
+    return ranked ? &ranked_node_xyz[3 * v] : nodes.xyz(v);
+  }
   // The cells with valid normals in the 27 blocks around block b.
   void around(std::size_t b, const std::vector<CellSums>& sums,
               std::vector<std::uint32_t>& cells) const;

@@ -290,9 +290,9 @@ void LatticeIndex::around(std::size_t b, const std::vector<CellSums>& sums,
 
 namespace {
 
-// The node at corner o (bit a: +1 along axis a) of the cell at xyz, as an index of ranks.
+// The node at corner o of the cell at xyz, as an index of ranks.
 inline std::size_t cornerIndex(const RankedCells& ranks, const std::int32_t* xyz, int o) {
-  return ranks.index(xyz[0] + (o & 1), xyz[1] + ((o >> 1) & 1), xyz[2] + ((o >> 2) & 1));
+  return ranks.index(cornerCoord(xyz, o, 0), cornerCoord(xyz, o, 1), cornerCoord(xyz, o, 2));
 }
 
 // The nodes of the cells [b, e) by rank into cell_nodes (8 a cell). (A function of its own,
@@ -310,6 +310,7 @@ void rankedCorners(const RankedCells& ranks, const std::int32_t* cell_xyz, std::
 // By rank in the bit table over the nodes' box: the same ids on any number of threads.
 bool rankNodes(const std::int32_t* cell_xyz, std::size_t n_cells, LatticeIndex& index,
                std::uint32_t* cell_nodes) {
+  index.ranked = false;
   if (n_cells == 0) return false;
   std::int32_t lo[3] = {cell_xyz[0], cell_xyz[1], cell_xyz[2]}, hi[3] = {lo[0], lo[1], lo[2]};
   for (std::size_t c = 1; c < n_cells; ++c) {
@@ -333,25 +334,23 @@ bool rankNodes(const std::int32_t* cell_xyz, std::size_t n_cells, LatticeIndex& 
     index.ranked_node_xyz.resize(3 * ranks.size());
     ranks.cellsTeam(index.ranked_node_xyz.data());
   }
-  index.node_xyz = index.ranked_node_xyz.data();
-  index.n_nodes = ranks.size();
+  index.ranked = true;
   return true;
 }
 
 // By the hash: ids in order of first sight.
 void hashNodes(const std::int32_t* cell_xyz, std::size_t n_cells, LatticeIndex& index,
                std::uint32_t* cell_nodes) {
+  index.ranked = false;
   index.nodes.clear(4 * n_cells);  // (its table and coordinates kept from the last frame)
   index.nodes.reserve(4 * n_cells);
   for (std::size_t c = 0; c < n_cells; ++c) {
+    const std::int32_t* xyz = &cell_xyz[3 * c];
     for (int o = 0; o < 8; ++o) {
-      cell_nodes[8 * c + o] =
-          index.nodes.insert(cell_xyz[3 * c] + (o & 1), cell_xyz[3 * c + 1] + ((o >> 1) & 1),
-                             cell_xyz[3 * c + 2] + ((o >> 2) & 1));
+      cell_nodes[8 * c + o] = index.nodes.insert(cornerCoord(xyz, o, 0), cornerCoord(xyz, o, 1),
+                                                 cornerCoord(xyz, o, 2));
     }
   }
-  index.node_xyz = index.nodes.coords().data();
-  index.n_nodes = index.nodes.size();
 }
 
 void indexLattice(const Bins& bins, int m, LatticeIndex& index,
@@ -362,22 +361,15 @@ void indexLattice(const Bins& bins, int m, LatticeIndex& index,
   if (!rankNodes(cell_xyz, n_cells, index, cell_nodes.data())) {
     hashNodes(cell_xyz, n_cells, index, cell_nodes.data());
   }
-  // Blocks of B^3 cells; cells and nodes grouped by block (counting sort). (floor(a / B) as
-  // floor((a + 0.5) / B), in double: that lies 0.5 / B or more from a whole number, far more
-  // than the product's rounding, and takes no integer division.)
+  // Blocks of B^3 cells; cells and nodes grouped by block (counting sort).
   const std::int32_t B = m + 1;
   index.B = B;
   index.blocks.clear(n_cells / 8 + 64);
-  const double inv_b = 1.0 / B;
+  const FloorDivider byB(B);
   const auto blockOf = [&](const std::int32_t* xyz) {
-    std::int32_t q[3];
-    for (int a = 0; a < 3; ++a) {
-      const double t = (xyz[a] + 0.5) * inv_b;
-      q[a] = static_cast<std::int32_t>(t) - (t < 0 ? 1 : 0);
-    }
-    return index.blocks.insert(q[0], q[1], q[2]);
+    return index.blocks.insert(byB(xyz[0]), byB(xyz[1]), byB(xyz[2]));
   };
-  const std::size_t n_nodes = index.n_nodes;
+  const std::size_t n_nodes = index.nodeCount();
   index.cell_block.resize(n_cells), index.node_block.resize(n_nodes);
   for (std::size_t c = 0; c < n_cells; ++c) index.cell_block[c] = blockOf(&cell_xyz[3 * c]);
   for (std::size_t v = 0; v < n_nodes; ++v) index.node_block[v] = blockOf(index.nodeXyz(v));
