@@ -1,10 +1,23 @@
 // Writes the fuzzers' generated seed corpora: small valid files of every cloud format (the
-// samples of the bad-input catalogue) and, for the pipeline, the generated scenes at a coarse
-// spacing as raw floats. scripts/fuzz.sh adds the seeds taken from ../shared/data.
-//   fuzz_seeds OUTDIR   ->  OUTDIR/{pcd,ply,xyz,kitti_bin,pipeline}/...
+// samples of the bad-input catalogue), for the pipeline the generated scenes at a coarse
+// spacing as raw floats, and for the rawlog reader a stream of the actions the recorded
+// rawlogs lack (scan matching with each pose distribution). scripts/fuzz.sh adds the seeds
+// taken from ../shared/data.
+//   fuzz_seeds OUTDIR   ->  OUTDIR/{pcd,ply,xyz,kitti_bin,pipeline,rawlog}/...
 #include "io/cloud_samples.h"
 
 #include "upd/sim/scenes.h"
+
+#include <mrpt/io/CFileOutputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservationComment.h>
+#include <mrpt/poses/CPosePDFGaussian.h>
+#include <mrpt/poses/CPosePDFGaussianInf.h>
+#include <mrpt/poses/CPosePDFGrid.h>
+#include <mrpt/poses/CPosePDFParticles.h>
+#include <mrpt/poses/CPosePDFSOG.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include <cstdio>
 #include <cstring>
@@ -32,6 +45,37 @@ std::string floats(const std::vector<samples::Xyz>& p, char flags) {
     samples::putLe(s, q.z);
   }
   return s;
+}
+
+// A plain rawlog object stream: an observation, then a collection of an odometry action and a
+// scan-matching action with each CPosePDF class, then an observation.
+void putActionsRawlog(const fs::path& dir) {
+  using mrpt::obs::CActionRobotMovement2D;
+  fs::create_directories(dir);
+  mrpt::obs::CActionCollection acts;
+  CActionRobotMovement2D odometry;
+  odometry.computeFromOdometry(mrpt::poses::CPose2D(0.3, 0.0, 0.05),
+                               CActionRobotMovement2D::TMotionModelOptions());
+  acts.insert(odometry);
+  const mrpt::poses::CPosePDF::Ptr pdfs[] = {
+      mrpt::poses::CPosePDFGaussian::Create(mrpt::poses::CPose2D(0.3, 0.1, 0.02)),
+      mrpt::poses::CPosePDFGaussianInf::Create(mrpt::poses::CPose2D(0.3, 0.1, 0.02)),
+      mrpt::poses::CPosePDFParticles::Create(4),
+      mrpt::poses::CPosePDFSOG::Create(2),
+      mrpt::poses::CPosePDFGrid::Create(-0.5, 0.5, -0.5, 0.5, 0.5, M_PI / 2, -M_PI, M_PI),
+  };
+  for (const auto& pdf : pdfs) {
+    CActionRobotMovement2D matched;
+    matched.estimationMethod = CActionRobotMovement2D::emScan2DMatching;
+    matched.poseChange = mrpt::containers::deepcopy_poly_ptr<mrpt::poses::CPosePDF::Ptr>(pdf);
+    acts.insert(matched);
+  }
+  mrpt::io::CFileOutputStream out((dir / "actions.rawlog").string());
+  auto ar = mrpt::serialization::archiveFrom(out);
+  mrpt::obs::CObservationComment first, last;
+  first.text = "before";
+  last.text = "after";
+  ar << first << acts << last;
 }
 
 }  // namespace
@@ -70,5 +114,6 @@ int main(int argc, char** argv) {
     }
     put(out / "pipeline", "scene_" + name, floats(p, 0));
   }
+  putActionsRawlog(out / "rawlog");
   return 0;
 }

@@ -13,6 +13,9 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
+#include <mrpt/poses/CPosePDFGrid.h>
+#include <mrpt/poses/CPosePDFParticles.h>
+#include <mrpt/poses/CPosePDFSOG.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <gtest/gtest.h>
@@ -423,6 +426,80 @@ TEST(RawlogReader, EstimationMethodWithoutItsPoseDistributionIsDamage) {
   acts.insert(matched);
   writeAroundActions(file, acts);
   EXPECT_EQ(damageAtSecondObject(file, readFileBytes(file)), "(read)");
+}
+
+// A scan-matching action carrying pose distribution pdf.
+mrpt::obs::CActionCollection scanMatched(const mrpt::poses::CPosePDF::Ptr& pdf) {
+  mrpt::obs::CActionRobotMovement2D matched;
+  matched.estimationMethod = mrpt::obs::CActionRobotMovement2D::emScan2DMatching;
+  matched.poseChange = mrpt::containers::deepcopy_poly_ptr<mrpt::poses::CPosePDF::Ptr>(pdf);
+  mrpt::obs::CActionCollection acts;
+  acts.insert(matched);
+  return acts;
+}
+
+// bytes with the 4 bytes at `at` replaced by v (little-endian).
+std::string withInt32(std::string bytes, std::size_t at, std::uint32_t v) {
+  for (int b = 0; b < 4; ++b) bytes[at + b] = static_cast<char>((v >> (8 * b)) & 0xFF);
+  return bytes;
+}
+
+// The sizes a scan-matching action's pose distribution makes MRPT allocate before it reads the
+// elements (particles, Gaussian modes, grid cells) are bounded, and a grid's cells must match
+// its sides (MRPT walks the sides when it takes the mean the reader asks for): each corrupt
+// size is damage with a one-line reason naming the distribution, the field and its byte; the
+// intact distributions read.
+TEST(RawlogReader, ScanMatchingPoseDistributionSizesAreCheckedBeforeMrptAllocates) {
+  TempDir tmp;
+  const fs::path file = tmp.path() / "pdf.rawlog";
+  const std::string prefix =
+      "corrupt CActionRobotMovement2D (action 1 of 1 in a CActionCollection): ";
+  // The byte after the class name and version byte of the distribution in bytes.
+  const auto bodyOf = [](const std::string& bytes, const std::string& name) {
+    const auto at = bytes.find("mrpt::poses::" + name);
+    EXPECT_NE(at, std::string::npos) << name;
+    return at + std::string("mrpt::poses::").size() + name.size() + 1;
+  };
+
+  auto particles = mrpt::poses::CPosePDFParticles::Create(5);
+  particles->resetDeterministic(mrpt::math::TPose2D(0.3, 0.1, 0.02));
+  writeAroundActions(file, scanMatched(particles));
+  std::string bytes = readFileBytes(file);
+  EXPECT_EQ(damageAtSecondObject(file, bytes), "(read)");
+  std::size_t n_at = bodyOf(bytes, "CPosePDFParticles");
+  EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, n_at, 200000000u)),
+            prefix + "corrupt CPosePDFParticles: particle count 200000000 at byte " +
+                std::to_string(n_at) + " (more than 100000 particles)");
+
+  auto sog = mrpt::poses::CPosePDFSOG::Create(2);
+  writeAroundActions(file, scanMatched(sog));
+  bytes = readFileBytes(file);
+  EXPECT_EQ(damageAtSecondObject(file, bytes), "(read)");
+  n_at = bodyOf(bytes, "CPosePDFSOG");
+  EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, n_at, 0xFFFFFFF0u)),
+            prefix + "corrupt CPosePDFSOG: mode count 4294967280 at byte " +
+                std::to_string(n_at) + " (more than 100000 modes)");
+
+  // 5 x 5 x 5 cells.
+  auto grid = mrpt::poses::CPosePDFGrid::Create(-1.0, 1.0, -1.0, 1.0, 0.5, M_PI / 2, -M_PI, M_PI);
+  ASSERT_EQ(grid->getSizeX(), 5u);
+  ASSERT_EQ(grid->getSizeY(), 5u);
+  ASSERT_EQ(grid->getSizePhi(), 5u);
+  writeAroundActions(file, scanMatched(grid));
+  bytes = readFileBytes(file);
+  EXPECT_EQ(damageAtSecondObject(file, bytes), "(read)");
+  const std::size_t sides_at = bodyOf(bytes, "CPosePDFGrid") + 8 * sizeof(double);
+  const std::size_t count_at = sides_at + 7 * sizeof(std::int32_t);
+  EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, count_at, 124u)),
+            prefix + "corrupt CPosePDFGrid: 124 cells at byte " + std::to_string(count_at) +
+                " for sides 5 x 5 x 5");
+  EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, count_at, 1u << 30)),
+            prefix + "corrupt CPosePDFGrid: cell count 1073741824 at byte " +
+                std::to_string(count_at) + " (more than 16777216 cells)");
+  // A side grown to 40000: MRPT would walk 40000 x 5 x 5 cells of a 125-cell table.
+  EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, sides_at, 40000u)),
+            prefix + "corrupt CPosePDFGrid: sides 40000 x 5 x 5 with 25 cells a layer, at byte " +
+                std::to_string(sides_at));
 }
 
 }  // namespace

@@ -97,6 +97,60 @@ bool withinBound(const char* field, std::uint64_t value, std::uint64_t at, std::
 
 namespace {
 
+// A scan-matching action's pose distribution, its header read: the sizes MRPT allocates by
+// before it reads the elements (CPosePDFParticles' particles, CPosePDFSOG's modes,
+// CPosePDFGrid's cells), and a grid's cells against its sides, which MRPT indexes them by when
+// it takes the mean. The elements themselves are left to MRPT (OtherLayout), as are the fixed
+// layouts of the Gaussians.
+Parse checkPosePdf(Cursor& c, const ObjectHeader& pdf, std::string& why) {
+  const std::uint64_t at = c.position();
+  if ((pdf.class_name == "CPosePDFParticles" && pdf.version <= 1) ||
+      (pdf.class_name == "CPosePDFSOG" && pdf.version <= 2)) {
+    const bool particles = pdf.class_name == "CPosePDFParticles";
+    std::uint32_t n = 0;
+    if (!c.value(n)) return Parse::OtherLayout;
+    if (!withinBound(particles ? "particle count" : "mode count", n, at, kMaxPosePdfElements,
+                     particles ? "particles" : "modes", why)) {
+      why = "corrupt " + pdf.class_name + ": " + why;
+      return Parse::Impossible;
+    }
+    return Parse::OtherLayout;
+  }
+  if (pdf.class_name != "CPosePDFGrid" || pdf.version != 0) return Parse::OtherLayout;
+  c.skip(8 * sizeof(double));  // the bounds and resolutions
+  const std::uint64_t sides_at = c.position();
+  std::int32_t side[4] = {};  // x, y, phi, and x * y
+  for (std::int32_t& v : side) {
+    if (!c.value(v)) return Parse::OtherLayout;
+  }
+  c.skip(3 * sizeof(std::int32_t));  // the left indices
+  const std::uint64_t count_at = c.position();
+  std::uint32_t count = 0;
+  if (!c.value(count)) return Parse::OtherLayout;
+  const auto cells = [](const std::int32_t* s) {
+    return static_cast<std::uint64_t>(s[0]) * static_cast<std::uint64_t>(s[1]) *
+           static_cast<std::uint64_t>(s[2]);
+  };
+  if (side[0] < 0 || side[1] < 0 || side[2] < 0 ||
+      static_cast<std::int64_t>(side[0]) * side[1] != side[3]) {
+    why = "corrupt CPosePDFGrid: sides " + std::to_string(side[0]) + " x " +
+          std::to_string(side[1]) + " x " + std::to_string(side[2]) + " with " +
+          std::to_string(side[3]) + " cells a layer, at byte " + std::to_string(sides_at);
+    return Parse::Impossible;
+  }
+  if (!withinBound("cell count", count, count_at, kMaxPoseGridCells, "cells", why)) {
+    why = "corrupt CPosePDFGrid: " + why;
+    return Parse::Impossible;
+  }
+  if (count != cells(side)) {
+    why = "corrupt CPosePDFGrid: " + std::to_string(count) + " cells at byte " +
+          std::to_string(count_at) + " for sides " + std::to_string(side[0]) + " x " +
+          std::to_string(side[1]) + " x " + std::to_string(side[2]);
+    return Parse::Impossible;
+  }
+  return Parse::OtherLayout;
+}
+
 // CActionRobotMovement2D::serializeFrom of MRPT 2.5.8, versions 4-7, up to its end flag: an
 // odometry estimate carries its raw increment (a CPose2D object) and the motion model MRPT rebuilds
 // the distribution from while reading.
@@ -123,7 +177,7 @@ Parse checkMovement2D(Cursor& c, int version, std::string& why) {
             " where scan matching's pose distribution (a CPosePDF) belongs";
       return Parse::Impossible;
     }
-    return Parse::OtherLayout;
+    return checkPosePdf(c, pdf, why);
   }
   ObjectHeader pose;
   if (!readHeader(c, pose) || pose.class_name != "CPose2D") return Parse::OtherLayout;

@@ -30,6 +30,11 @@ namespace upd::mrpt_bridge::detail {
 /// Most particles a CActionRobotMovement2D may ask MRPT to draw (MRPT's default is 300; a
 /// particle costs ~40 bytes and a few Gaussian draws: 10^5 take milliseconds).
 constexpr std::uint32_t kMaxOdometryParticles = 100000;
+/// Most particles or Gaussian modes of a scan-matching action's pose distribution
+/// (CPosePDFParticles, CPosePDFSOG): MRPT allocates them all before reading the first.
+constexpr std::uint32_t kMaxPosePdfElements = 100000;
+/// Most cells of a CPosePDFGrid (2^24 doubles, 128 MiB).
+constexpr std::uint64_t kMaxPoseGridCells = std::uint64_t{1} << 24;
 /// Most actions in one CActionCollection (a robot writes one or two per step).
 constexpr std::uint32_t kMaxActionsPerCollection = 4096;
 /// Most observations in one CSensoryFrame (a robot writes one per sensor and step).
