@@ -245,9 +245,9 @@ std::string damageReason(const TempDir& tmp, const std::string& object, std::siz
 }
 
 // MRPT decodes an image's JPEG with libjpeg's default error handler, which ends the process on a
-// fatal error (found by fuzz_rawlog: an unknown marker after the image data), and allocates what
-// the JPEG's header states (libjpeg itself refuses more than 65,500 a side): both are damage at the
-// object, found before MRPT decodes it.
+// fatal error (found by fuzz_rawlog: an unknown marker after the image data; a JPEG cut by the
+// end of the stream), and allocates what the JPEG's header states (libjpeg itself refuses more
+// than 65,500 a side): all are damage at the object, found before MRPT decodes it.
 TEST(RawlogPrecheck, JpegThatWouldEndTheProcessIsDamage) {
   TempDir tmp;
   const bool jpeg_off = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
@@ -282,6 +282,15 @@ TEST(RawlogPrecheck, JpegThatWouldEndTheProcessIsDamage) {
             "corrupt CObservationStereoImages: image JPEG at byte " +
                 std::to_string(head + jpeg_at) +
                 ": its header says 268435456 pixels (more than 16777216)");
+  // The stream ends inside the JPEG's header (found by fuzz_rawlog: a 3D scan's JPEG image cut
+  // by the end of the file, which MRPT decoded as far as it went, and libjpeg ended the
+  // process: "JPEG datastream contains no image").
+  const std::string cut = good.substr(0, jpeg_at + 100);
+  EXPECT_EQ(damageReason(tmp, cut, &head),
+            "corrupt CObservationStereoImages: image JPEG of " + std::to_string(jpeg_bytes) +
+                " bytes at byte " + std::to_string(head + jpeg_at) +
+                " is cut short by the end of the stream (MRPT would decode the part there is; "
+                "its JPEG reader ends the process on a cut header)");
   EXPECT_EQ(damageReason(tmp, good, &head), "(read)");
 }
 

@@ -163,7 +163,15 @@ Parse colourImage(Cursor& c, int version, std::string& why) {
     }
     // MRPT hands libjpeg a buffer of bytes + 10.
     std::vector<std::uint8_t> jpeg(std::size_t{bytes} + 10, 0);
-    if (!c.bytes(jpeg.data(), bytes)) return kOther;  // cut: MRPT reports it
+    if (!c.bytes(jpeg.data(), bytes)) {
+      // MRPT reads what there is without a complaint (a short read is no error to CArchive)
+      // and decodes it: a JPEG cut in its header ends the process in libjpeg.
+      why = "image JPEG of " + std::to_string(bytes) + " bytes at byte " +
+            std::to_string(bytes_at + 4) +
+            " is cut short by the end of the stream (MRPT would decode the part there is; its "
+            "JPEG reader ends the process on a cut header)";
+      return kImpossible;
+    }
     std::uint64_t pixels = 0;
     const std::string failure = jpegFailure(jpeg.data(), jpeg.size(), &pixels);
     if (pixels > kMaxImagePixels) {
