@@ -294,6 +294,35 @@ TEST(RawlogPrecheck, JpegThatWouldEndTheProcessIsDamage) {
   EXPECT_EQ(damageReason(tmp, good, &head), "(read)");
 }
 
+// The frames of MRPT before version 2 carry an ID (and in version 0 a timestamp) before their
+// count: that count is bounded as version 2's (found by fuzz_rawlog: a version-0 frame whose
+// count, read past the timestamp, was 744,571,766 made MRPT allocate 12 GB of observation
+// pointers); a version-0 frame's null observation, whose timestamp MRPT would set through the
+// null pointer, is damage; sound old frames read.
+TEST(RawlogPrecheck, OldSensoryFramesAreCheckedAsTheCurrentOne) {
+  TempDir tmp;
+  mrpt::obs::CObservationComment comment;
+  comment.text = "old frame";
+  const std::string obs = serialized(comment);
+  const std::string name = "\x8D" "CSensoryFrame";
+  const std::string id = u32(7), stamp(8, '\x01'), end = "\x88";
+  const std::string v0 = name + '\x00' + id + stamp, v1 = name + '\x01' + id;
+  std::size_t head = 0;
+  EXPECT_EQ(damageReason(tmp, v0 + u32(1) + obs + end, &head), "(read)");
+  EXPECT_EQ(damageReason(tmp, v1 + u32(1) + obs + end, &head), "(read)");
+  const std::string huge = u32(744571766u);
+  EXPECT_EQ(damageReason(tmp, v0 + huge + obs + end, &head),
+            "corrupt CSensoryFrame: observation count 744571766 at byte " +
+                std::to_string(head + v0.size()) + " (more than 4096 observations)");
+  EXPECT_EQ(damageReason(tmp, v1 + huge + obs + end, &head),
+            "corrupt CSensoryFrame: observation count 744571766 at byte " +
+                std::to_string(head + v1.size()) + " (more than 4096 observations)");
+  const std::string null_obs = std::string("\x87" "nullptr") + end;
+  EXPECT_EQ(damageReason(tmp, v0 + u32(2) + null_obs + obs + end, &head),
+            "corrupt CSensoryFrame: observation 1 of 2 is a null object (MRPT sets a version-0 "
+            "frame's timestamp through each)");
+}
+
 // Sizes at their bounds are read by MRPT as usual (a 2D scan of 1,000,000 rays).
 TEST(RawlogPrecheck, SizesAtTheBoundAreRead) {
   auto s = mrpt::obs::CObservation2DRangeScan::Create();

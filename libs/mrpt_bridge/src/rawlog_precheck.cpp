@@ -246,9 +246,13 @@ Parse checkActions(Cursor& c, int version, std::string& why) {
   return c.endFlag() ? Parse::Read : Parse::OtherLayout;
 }
 
-// CSensoryFrame::serializeFrom, version 2: a count, then the observation objects.
+// CSensoryFrame::serializeFrom, versions 0-2: before version 2 the frame's ID, in version 0
+// its timestamp (which MRPT then sets on every observation, through its pointer); a count;
+// the observation objects.
 Parse checkFrame(Cursor& c, int version, std::string& why) {
-  if (version != 2) return Parse::OtherLayout;
+  if (version < 0 || version > 2) return Parse::OtherLayout;
+  if (version < 2) c.skip(sizeof(std::uint32_t));  // the ID
+  if (version == 0) c.skip(sizeof(std::int64_t));  // the timestamp
   const std::uint64_t at = c.position();
   std::uint32_t count = 0;
   if (!c.value(count)) return Parse::OtherLayout;
@@ -259,6 +263,12 @@ Parse checkFrame(Cursor& c, int version, std::string& why) {
   for (std::uint32_t i = 0; i < count; ++i) {
     ObjectHeader obs;
     if (!readHeader(c, obs)) return Parse::OtherLayout;
+    if (version == 0 && obs.class_name == "nullptr") {
+      why = "corrupt CSensoryFrame: observation " + std::to_string(i + 1) + " of " +
+            std::to_string(count) +
+            " is a null object (MRPT sets a version-0 frame's timestamp through each)";
+      return Parse::Impossible;
+    }
     const Parse p = checkObservation(c, obs, why);
     if (p == Parse::Impossible) {
       why = "corrupt " + obs.class_name + " (observation " + std::to_string(i + 1) + " of " +
