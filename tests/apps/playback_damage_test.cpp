@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -296,15 +297,30 @@ TEST(PlaybackDamage, AnObjectClaimingAnImpossibleSizeIsDamageNotACrash) {
 // a mutated log) inserted between the frames of a simulated run: MRPT would draw 10^9 particles
 // while reading it (minutes). The reader checks those fields first: damage, as for a cut file,
 // with the maps of the frames before it; --strict writes nothing.
-TEST(PlaybackDamage, OdometryActionWithAnImpossibleParticleCountIsDamage) {
+// The plain rawlog of the fixture with acts inserted after the last object that holds an
+// observation but one (frames before and after it), into tmp; returns the file and, through j,
+// the index of the object the actions follow.
+fs::path withActionsInserted(const mrpt::obs::CActionCollection& acts, const test::TempDir& tmp,
+                             std::size_t& j) {
   const SimulatedRun& f = fixture();
-  // After the last object that holds an observation but one: frames before and after it.
-  std::size_t j = f.object_end.size() - 1;
+  j = f.object_end.size() - 1;
   while (f.obs_through[j] == f.obsBefore(j)) --j;
   --j;
   while (f.obs_through[j] == f.obsBefore(j)) --j;
-  ASSERT_GT(f.obs_through[j], 0u);
+  EXPECT_GT(f.obs_through[j], 0u);
+  mrpt::io::CMemoryStream mem;
+  mrpt::serialization::archiveFrom(mem) << acts;
+  const auto* data = static_cast<const char*>(mem.getRawBufferData());
+  const std::string plain = test::readFileBytes(f.plain);
+  const std::string bytes = plain.substr(0, f.object_end[j]) +
+                            std::string(data, data + mem.getTotalBytesCount()) +
+                            plain.substr(f.object_end[j]);
+  const fs::path rawlog = tmp.path() / "odometry.rawlog";
+  writeBytes(rawlog, bytes);
+  return rawlog;
+}
 
+TEST(PlaybackDamage, OdometryActionWithAnImpossibleParticleCountIsDamage) {
   using mrpt::obs::CActionRobotMovement2D;
   CActionRobotMovement2D act;
   act.estimationMethod = CActionRobotMovement2D::emOdometry;
@@ -314,17 +330,9 @@ TEST(PlaybackDamage, OdometryActionWithAnImpossibleParticleCountIsDamage) {
   act.motionModelConfiguration.thrunModel.nParticlesCount = 1007614517u;
   mrpt::obs::CActionCollection acts;
   acts.insert(act);
-  mrpt::io::CMemoryStream mem;
-  mrpt::serialization::archiveFrom(mem) << acts;
-  const auto* data = static_cast<const char*>(mem.getRawBufferData());
-  const std::string plain = test::readFileBytes(f.plain);
-  const std::string bytes = plain.substr(0, f.object_end[j]) +
-                            std::string(data, data + mem.getTotalBytesCount()) +
-                            plain.substr(f.object_end[j]);
-
   const test::TempDir tmp("particles");
-  const fs::path rawlog = tmp.path() / "odometry.rawlog";
-  writeBytes(rawlog, bytes);
+  std::size_t j = 0;
+  const fs::path rawlog = withActionsInserted(acts, tmp, j);
   const fs::path out = tmp.path() / "out";
   const CmdResult r = SimulatedRun::playback(rawlog, out);
   expectPartial(r, out, rawlog, j + 1);
@@ -336,6 +344,30 @@ TEST(PlaybackDamage, OdometryActionWithAnImpossibleParticleCountIsDamage) {
 
   const fs::path strict = tmp.path() / "strict";
   expectNothingWritten(SimulatedRun::playback(rawlog, strict, "--strict"), strict, rawlog);
+}
+
+// An odometry increment that is not finite (a flipped bit in a double) would make every later
+// pose NaN: before, the map's window refused the NaN robot position and the whole playback
+// failed with nothing written; now it is damage at the action, the maps of the frames before it
+// written (exit 3).
+TEST(PlaybackDamage, OdometryIncrementThatIsNotFiniteIsDamage) {
+  using mrpt::obs::CActionRobotMovement2D;
+  CActionRobotMovement2D act;
+  act.computeFromOdometry(mrpt::poses::CPose2D(std::nan(""), 0, 0),
+                          CActionRobotMovement2D::TMotionModelOptions());
+  mrpt::obs::CActionCollection acts;
+  acts.insert(act);
+  const test::TempDir tmp("nan_odometry");
+  std::size_t j = 0;
+  const fs::path rawlog = withActionsInserted(acts, tmp, j);
+  const fs::path out = tmp.path() / "out";
+  const CmdResult r = SimulatedRun::playback(rawlog, out);
+  expectPartial(r, out, rawlog, j + 1);
+  const std::string reason =
+      "corrupt CActionRobotMovement2D (action 1 of 1 in a CActionCollection): its pose change "
+      "(x, y, phi) = (nan, 0, 0) is not finite";
+  EXPECT_EQ(readJson(out / "summary.json")["damage"]["reason"], reason);
+  EXPECT_NE(r.output.find(reason), std::string::npos) << r.output;
 }
 
 }  // namespace

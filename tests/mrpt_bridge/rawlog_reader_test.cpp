@@ -9,6 +9,7 @@
 #include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -24,6 +25,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 namespace {
 
@@ -500,6 +502,46 @@ TEST(RawlogReader, ScanMatchingPoseDistributionSizesAreCheckedBeforeMrptAllocate
   EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, sides_at, 40000u)),
             prefix + "corrupt CPosePDFGrid: sides 40000 x 5 x 5 with 25 cells a layer, at byte " +
                 std::to_string(sides_at));
+}
+
+// A robot movement whose pose change is not finite is damage at its object, naming the action
+// and the values: the second action of a collection, and a bare 3D movement; a finite one reads.
+TEST(RawlogReader, MovementWithAPoseChangeNotFiniteIsDamage) {
+  TempDir tmp;
+  const fs::path file = tmp.path() / "nan.rawlog";
+  using mrpt::obs::CActionRobotMovement2D;
+  mrpt::obs::CActionCollection acts = odometryWithModel(0, 300);
+  CActionRobotMovement2D nan_odometry;
+  nan_odometry.computeFromOdometry(mrpt::poses::CPose2D(0.1, std::nan(""), 0.2),
+                                   CActionRobotMovement2D::TMotionModelOptions());
+  acts.insert(nan_odometry);
+  writeAroundActions(file, acts);
+  EXPECT_EQ(damageAtSecondObject(file, readFileBytes(file)),
+            "corrupt CActionRobotMovement2D (action 2 of 2 in a CActionCollection): its pose "
+            "change (x, y, phi) = (0.1, nan, 0.2) is not finite");
+
+  mrpt::obs::CActionRobotMovement3D moved;
+  moved.poseChange.mean = mrpt::poses::CPose3D(0.5, 0, std::numeric_limits<double>::infinity(),
+                                               0, 0, 0);
+  {
+    mrpt::io::CFileOutputStream out(file.string());
+    auto ar = mrpt::serialization::archiveFrom(out);
+    mrpt::obs::CObservationComment first;
+    first.text = "before";
+    ar << first << moved << first;
+  }
+  EXPECT_EQ(damageAtSecondObject(file, readFileBytes(file)),
+            "corrupt CActionRobotMovement3D: its pose change (x, y, z, yaw, pitch, roll) = (0.5, "
+            "0, inf, 0, 0, 0) is not finite");
+  moved.poseChange.mean = mrpt::poses::CPose3D(0.5, 0, 0.1, 0, 0, 0);
+  {
+    mrpt::io::CFileOutputStream out(file.string());
+    auto ar = mrpt::serialization::archiveFrom(out);
+    mrpt::obs::CObservationComment first;
+    first.text = "before";
+    ar << first << moved << first;
+  }
+  EXPECT_EQ(damageAtSecondObject(file, readFileBytes(file)), "(read)");
 }
 
 }  // namespace

@@ -16,10 +16,13 @@
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
+#include <cmath>
 #include <deque>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 namespace upd::mrpt_bridge {
 
@@ -111,6 +114,51 @@ std::string describeReadError(const std::string& what) {
   }
   if (chain.empty()) return msg;
   return "in " + chain + (msg.empty() ? std::string() : ": " + msg);
+}
+
+// Why a robot movement's pose change cannot be used (a coordinate not finite: the robot's pose
+// would be NaN from there on), or "" when it can or a is no movement.
+std::string unusableMovement(const mrpt::obs::CAction& a) {
+  std::vector<double> v;
+  std::string names;
+  if (const auto* m3 = dynamic_cast<const mrpt::obs::CActionRobotMovement3D*>(&a)) {
+    const mrpt::poses::CPose3D& p = m3->poseChange.mean;
+    v = {p.x(), p.y(), p.z(), p.yaw(), p.pitch(), p.roll()};
+    names = "(x, y, z, yaw, pitch, roll)";
+  } else if (const auto* m2 = dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(&a)) {
+    if (!m2->poseChange) return "";
+    const mrpt::poses::CPose2D p = m2->poseChange->getMeanVal();
+    v = {p.x(), p.y(), p.phi()};
+    names = "(x, y, phi)";
+  }
+  if (std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); })) return "";
+  std::ostringstream os;
+  os << "its pose change " << names << " = (";
+  for (std::size_t i = 0; i < v.size(); ++i) os << (i ? ", " : "") << v[i];
+  os << ") is not finite";
+  return os.str();
+}
+
+// unusableMovement for a top-level object: an action, or each action of a collection
+// ("corrupt CActionRobotMovement2D (action 2 of 3 in a CActionCollection): ...").
+std::string unusableMovements(const mrpt::serialization::CSerializable::Ptr& o) {
+  if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(o)) {
+    std::size_t i = 0;
+    for (const auto& a : *acts) {
+      ++i;
+      const std::string why = a ? unusableMovement(*a) : std::string();
+      if (!why.empty()) {
+        return "corrupt " + detail::shortClassName(*a) + " (action " + std::to_string(i) + " of " +
+               std::to_string(acts->size()) + " in a CActionCollection): " + why;
+      }
+    }
+    return "";
+  }
+  if (auto act = std::dynamic_pointer_cast<mrpt::obs::CAction>(o)) {
+    const std::string why = unusableMovement(*act);
+    return why.empty() ? why : "corrupt " + detail::shortClassName(*act) + ": " + why;
+  }
+  return "";
 }
 
 Eigen::Isometry3d planarIsometry(double x, double y, double phi) {
@@ -306,6 +354,8 @@ bool RawlogReader::next(RawlogEntry& entry) {
       d.fail(object_index, position, "corrupt or truncated (" + describeReadError(e.what()) + ")");
     }
     if (!impossible.empty()) d.fail(object_index, position, impossible);
+    const std::string unusable = unusableMovements(object);
+    if (!unusable.empty()) d.fail(object_index, position, unusable);
     ++d.stats.objects;
     d.handleObject(object, object_index);
   }
