@@ -298,12 +298,13 @@ TEST(PlaybackDamage, AnObjectClaimingAnImpossibleSizeIsDamageNotACrash) {
 // while reading it (minutes). The reader checks those fields first: damage, as for a cut file,
 // with the maps of the frames before it; --strict writes nothing.
 // The plain rawlog of the fixture with acts inserted after the last object that holds an
-// observation but one (frames before and after it), into tmp; returns the file and, through j,
-// the index of the object the actions follow.
-fs::path withActionsInserted(const mrpt::obs::CActionCollection& acts, const test::TempDir& tmp,
-                             std::size_t& j) {
+// observation but one (frames before and after it), written into tmp and played: the frames
+// before the actions are played and written (exit 3), and reason is the damage in the summary
+// and the output. Returns the rawlog.
+fs::path expectDamageAtInsertedActions(const mrpt::obs::CActionCollection& acts,
+                                       const test::TempDir& tmp, const std::string& reason) {
   const SimulatedRun& f = fixture();
-  j = f.object_end.size() - 1;
+  std::size_t j = f.object_end.size() - 1;
   while (f.obs_through[j] == f.obsBefore(j)) --j;
   --j;
   while (f.obs_through[j] == f.obsBefore(j)) --j;
@@ -317,6 +318,11 @@ fs::path withActionsInserted(const mrpt::obs::CActionCollection& acts, const tes
                             plain.substr(f.object_end[j]);
   const fs::path rawlog = tmp.path() / "odometry.rawlog";
   writeBytes(rawlog, bytes);
+  const fs::path out = tmp.path() / "out";
+  const CmdResult r = SimulatedRun::playback(rawlog, out);
+  expectPartial(r, out, rawlog, j + 1);
+  EXPECT_EQ(readJson(out / "summary.json")["damage"]["reason"], reason);
+  EXPECT_NE(r.output.find(reason), std::string::npos) << r.output;
   return rawlog;
 }
 
@@ -331,17 +337,10 @@ TEST(PlaybackDamage, OdometryActionWithAnImpossibleParticleCountIsDamage) {
   mrpt::obs::CActionCollection acts;
   acts.insert(act);
   const test::TempDir tmp("particles");
-  std::size_t j = 0;
-  const fs::path rawlog = withActionsInserted(acts, tmp, j);
-  const fs::path out = tmp.path() / "out";
-  const CmdResult r = SimulatedRun::playback(rawlog, out);
-  expectPartial(r, out, rawlog, j + 1);
-  const std::string reason =
+  const fs::path rawlog = expectDamageAtInsertedActions(
+      acts, tmp,
       "corrupt CActionRobotMovement2D (action 1 of 1 in a CActionCollection): unknown motion "
-      "model -256 (0 Gaussian, 1 Thrun; MRPT would draw its 1007614517 particles)";
-  EXPECT_EQ(readJson(out / "summary.json")["damage"]["reason"], reason);
-  EXPECT_NE(r.output.find(reason), std::string::npos) << r.output;
-
+      "model -256 (0 Gaussian, 1 Thrun; MRPT would draw its 1007614517 particles)");
   const fs::path strict = tmp.path() / "strict";
   expectNothingWritten(SimulatedRun::playback(rawlog, strict, "--strict"), strict, rawlog);
 }
@@ -358,16 +357,10 @@ TEST(PlaybackDamage, OdometryIncrementThatIsNotFiniteIsDamage) {
   mrpt::obs::CActionCollection acts;
   acts.insert(act);
   const test::TempDir tmp("nan_odometry");
-  std::size_t j = 0;
-  const fs::path rawlog = withActionsInserted(acts, tmp, j);
-  const fs::path out = tmp.path() / "out";
-  const CmdResult r = SimulatedRun::playback(rawlog, out);
-  expectPartial(r, out, rawlog, j + 1);
-  const std::string reason =
+  expectDamageAtInsertedActions(
+      acts, tmp,
       "corrupt CActionRobotMovement2D (action 1 of 1 in a CActionCollection): its pose change "
-      "(x, y, phi) = (nan, 0, 0) is not finite";
-  EXPECT_EQ(readJson(out / "summary.json")["damage"]["reason"], reason);
-  EXPECT_NE(r.output.find(reason), std::string::npos) << r.output;
+      "(x, y, phi) = (nan, 0, 0) is not finite");
 }
 
 }  // namespace
