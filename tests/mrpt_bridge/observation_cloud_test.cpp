@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <vector>
 
@@ -312,6 +313,23 @@ TEST(ObservationCloud, RangeScanWithOnlyPoints3DIsUnorganized) {
   mrpt::obs::CObservation3DRangeScan nothing;
   EXPECT_EQ(toCloud(nothing).skipped_reason,
             "CObservation3DRangeScan has neither a range image nor 3D points");
+}
+
+// A sensor pose that is not finite (a corrupt observation) skips the observation with a reason
+// and an empty cloud, instead of making the map's inputs NaN; a finite one converts.
+TEST(ObservationCloud, SensorPoseNotFiniteSkipsTheObservation) {
+  for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+    mrpt::obs::CObservation3DRangeScan scan = twoPointScan();
+    scan.sensorPose = mrpt::poses::CPose3D(0, bad, 1.0, 0, 0, 0);
+    const ObservationCloud oc = toCloud(scan);
+    EXPECT_EQ(oc.skipped_reason,
+              "CObservation3DRangeScan: its sensor pose on the robot is not finite");
+    EXPECT_TRUE(oc.cloud_in_robot.empty());
+    scan.sensorPose = mrpt::poses::CPose3D(0, 0, 1.0, 0, 0, bad);
+    EXPECT_FALSE(toCloud(scan).ok());
+    scan.sensorPose = mrpt::poses::CPose3D(0, 0, 1.0, 0, 0, 0);
+    EXPECT_TRUE(toCloud(scan).ok());
+  }
 }
 
 TEST(ObservationCloud, VelodyneGroundBelowTheSensor) {

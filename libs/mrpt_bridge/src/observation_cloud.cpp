@@ -556,6 +556,11 @@ void toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params,
   out.skipped_reason.clear();
   out.source_class = detail::shortClassName(obs);
   out.sensor_pose_on_robot = sensorPoseOnRobot(obs);
+  if (!out.sensor_pose_on_robot.matrix().allFinite()) {  // (a corrupt observation: NaN, Inf)
+    out.skipped_reason = out.source_class + ": its sensor pose on the robot is not finite";
+    empty();
+    return;
+  }
   if (const auto* o = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
     convertRangeScan(*o, params, out);
   } else if (const auto* pc = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {
