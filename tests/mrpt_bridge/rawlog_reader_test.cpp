@@ -303,8 +303,9 @@ mrpt::obs::CActionCollection odometryWithModel(int model, std::uint32_t particle
   return acts;
 }
 
-// A plain rawlog: an observation, the given actions, an observation.
-void writeAroundActions(const fs::path& file, const mrpt::obs::CActionCollection& acts) {
+// A plain rawlog: an observation, the given actions (a collection or a bare action), an
+// observation.
+void writeAroundActions(const fs::path& file, const mrpt::serialization::CSerializable& acts) {
   mrpt::io::CFileOutputStream out(file.string());
   auto ar = mrpt::serialization::archiveFrom(out);
   mrpt::obs::CObservationComment first, last;
@@ -504,9 +505,10 @@ TEST(RawlogReader, ScanMatchingPoseDistributionSizesAreCheckedBeforeMrptAllocate
                 std::to_string(sides_at));
 }
 
-// A robot movement whose pose change is not finite is damage at its object, naming the action
-// and the values: the second action of a collection, and a bare 3D movement; a finite one reads.
-TEST(RawlogReader, MovementWithAPoseChangeNotFiniteIsDamage) {
+// A robot movement whose pose change is not finite, or moves the robot more than a kilometre
+// between two observations, is damage at its object, naming the action and the values: the
+// second action of a collection, a bare 3D movement; a move of 999 m reads.
+TEST(RawlogReader, MovementNotFiniteOrBeyondAKilometreIsDamage) {
   TempDir tmp;
   const fs::path file = tmp.path() / "nan.rawlog";
   using mrpt::obs::CActionRobotMovement2D;
@@ -523,25 +525,18 @@ TEST(RawlogReader, MovementWithAPoseChangeNotFiniteIsDamage) {
   mrpt::obs::CActionRobotMovement3D moved;
   moved.poseChange.mean = mrpt::poses::CPose3D(0.5, 0, std::numeric_limits<double>::infinity(),
                                                0, 0, 0);
-  {
-    mrpt::io::CFileOutputStream out(file.string());
-    auto ar = mrpt::serialization::archiveFrom(out);
-    mrpt::obs::CObservationComment first;
-    first.text = "before";
-    ar << first << moved << first;
-  }
+  writeAroundActions(file, moved);
   EXPECT_EQ(damageAtSecondObject(file, readFileBytes(file)),
             "corrupt CActionRobotMovement3D: its pose change (x, y, z, yaw, pitch, roll) = (0.5, "
             "0, inf, 0, 0, 0) is not finite");
-  moved.poseChange.mean = mrpt::poses::CPose3D(0.5, 0, 0.1, 0, 0, 0);
-  {
-    mrpt::io::CFileOutputStream out(file.string());
-    auto ar = mrpt::serialization::archiveFrom(out);
-    mrpt::obs::CObservationComment first;
-    first.text = "before";
-    ar << first << moved << first;
+  for (const double z : {1000.5, 999.0}) {
+    moved.poseChange.mean = mrpt::poses::CPose3D(0, 0, z, 0, 0, 0);
+    writeAroundActions(file, moved);
+    EXPECT_EQ(damageAtSecondObject(file, readFileBytes(file)),
+              z > 1000 ? "corrupt CActionRobotMovement3D: its pose change moves the robot 1000.5 m "
+                         "(more than 1000 m between two observations)"
+                       : "(read)");
   }
-  EXPECT_EQ(damageAtSecondObject(file, readFileBytes(file)), "(read)");
 }
 
 }  // namespace

@@ -116,8 +116,13 @@ std::string describeReadError(const std::string& what) {
   return "in " + chain + (msg.empty() ? std::string() : ": " + msg);
 }
 
+// The longest move a robot makes between two observations [m]: beyond it a pose change is
+// corrupt (a flipped bit in a double), and would carry every later frame kilometres off the map.
+constexpr double kMaxMovementM = 1000.0;
+
 // Why a robot movement's pose change cannot be used (a coordinate not finite: the robot's pose
-// would be NaN from there on), or "" when it can or a is no movement.
+// would be NaN from there on; a move longer than kMaxMovementM), or "" when it can or a is no
+// movement.
 std::string unusableMovement(const mrpt::obs::CAction& a) {
   std::vector<double> v;
   std::string names;
@@ -131,8 +136,14 @@ std::string unusableMovement(const mrpt::obs::CAction& a) {
     v = {p.x(), p.y(), p.phi()};
     names = "(x, y, phi)";
   }
-  if (std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); })) return "";
   std::ostringstream os;
+  if (std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); })) {
+    const double move = std::hypot(v[0], v[1], v.size() == 6 ? v[2] : 0.0);
+    if (move <= kMaxMovementM) return "";
+    os << "its pose change moves the robot " << move << " m (more than " << kMaxMovementM
+       << " m between two observations)";
+    return os.str();
+  }
   os << "its pose change " << names << " = (";
   for (std::size_t i = 0; i < v.size(); ++i) os << (i ? ", " : "") << v[i];
   os << ") is not finite";
