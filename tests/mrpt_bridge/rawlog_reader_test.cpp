@@ -503,6 +503,19 @@ TEST(RawlogReader, ScanMatchingPoseDistributionSizesAreCheckedBeforeMrptAllocate
   EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, sides_at, 40000u)),
             prefix + "corrupt CPosePDFGrid: sides 40000 x 5 x 5 with 25 cells a layer, at byte " +
                 std::to_string(sides_at));
+  // The same grid as the second action of a collection, behind a Gaussian the pre-check leaves
+  // to MRPT (found by fuzz_rawlog): the reader checks the grid MRPT read before it takes the
+  // mean.
+  mrpt::obs::CActionCollection two = scanMatched(
+      mrpt::poses::CPosePDFGaussian::Create(mrpt::poses::CPose2D(0.3, 0.1, 0.02)));
+  two.insert(*scanMatched(grid).get(0));
+  writeAroundActions(file, two);
+  bytes = readFileBytes(file);
+  EXPECT_EQ(damageAtSecondObject(file, bytes), "(read)");
+  const std::size_t second_sides_at = bodyOf(bytes, "CPosePDFGrid") + 8 * sizeof(double);
+  EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, second_sides_at, 40000u)),
+            "corrupt CActionRobotMovement2D (action 2 of 2 in a CActionCollection): its "
+            "CPosePDFGrid holds 125 cells for sides 40000 x 5 x 5 (25 a layer)");
 }
 
 // A robot movement whose pose change is not finite, or moves the robot more than a kilometre

@@ -14,6 +14,7 @@
 #include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPosePDFGrid.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <algorithm>
@@ -120,9 +121,27 @@ std::string describeReadError(const std::string& what) {
 // corrupt (a flipped bit in a double), and would carry every later frame kilometres off the map.
 constexpr double kMaxMovementM = 1000.0;
 
-// Why a robot movement's pose change cannot be used (a coordinate not finite: the robot's pose
-// would be NaN from there on; a move longer than kMaxMovementM), or "" when it can or a is no
-// movement.
+// A CPosePDFGrid's cells against its sides, which MRPT indexes them by when it takes the mean
+// (reading far past them where they disagree). Its sizes are protected: reached through member
+// pointers named in a derived class.
+struct GridCells : mrpt::poses::CPosePDFGrid {
+  // "" when the grid's cells are its sides' product, else why not.
+  static std::string mismatch(const mrpt::poses::CPosePDFGrid& g) {
+    const std::size_t cells = (g.*(&GridCells::m_data)).size();
+    const std::size_t x = g.getSizeX(), y = g.getSizeY(), phi = g.getSizePhi();
+    const std::size_t layer = g.*(&GridCells::m_sizeXY);
+    std::size_t xy = 0, all = 0;
+    const bool fits = !__builtin_mul_overflow(x, y, &xy) && !__builtin_mul_overflow(xy, phi, &all);
+    if (x > 0 && y > 0 && phi > 0 && fits && layer == xy && cells == all) return "";
+    return "its CPosePDFGrid holds " + std::to_string(cells) + " cells for sides " +
+           std::to_string(x) + " x " + std::to_string(y) + " x " + std::to_string(phi) + " (" +
+           std::to_string(layer) + " a layer)";
+  }
+};
+
+// Why a robot movement's pose change cannot be used (a grid distribution whose cells do not
+// match its sides; a coordinate not finite: the robot's pose would be NaN from there on; a move
+// longer than kMaxMovementM), or "" when it can or a is no movement.
 std::string unusableMovement(const mrpt::obs::CAction& a) {
   std::vector<double> v;
   std::string names;
@@ -132,6 +151,10 @@ std::string unusableMovement(const mrpt::obs::CAction& a) {
     names = "(x, y, z, yaw, pitch, roll)";
   } else if (const auto* m2 = dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(&a)) {
     if (!m2->poseChange) return "";
+    if (const auto* g = dynamic_cast<const mrpt::poses::CPosePDFGrid*>(m2->poseChange.get())) {
+      const std::string why = GridCells::mismatch(*g);
+      if (!why.empty()) return why;
+    }
     const mrpt::poses::CPose2D p = m2->poseChange->getMeanVal();
     v = {p.x(), p.y(), p.phi()};
     names = "(x, y, phi)";
