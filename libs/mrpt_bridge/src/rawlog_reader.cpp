@@ -155,7 +155,12 @@ std::string unusableMovement(const mrpt::obs::CAction& a) {
       const std::string why = GridCells::mismatch(*g);
       if (!why.empty()) return why;
     }
-    const mrpt::poses::CPose2D p = m2->poseChange->getMeanVal();
+    mrpt::poses::CPose2D p;
+    try {
+      p = m2->poseChange->getMeanVal();
+    } catch (const std::exception& e) {  // (MRPT's averages throw on no samples)
+      return "its pose distribution has no mean (" + describeReadError(e.what()) + ")";
+    }
     v = {p.x(), p.y(), p.phi()};
     names = "(x, y, phi)";
   }
