@@ -17,6 +17,11 @@
 #include <mrpt/obs/CObservationImage.h>
 #include <mrpt/obs/CObservationStereoImages.h>
 #include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPosePDFGaussian.h>
+#include <mrpt/poses/CPosePDFGaussianInf.h>
+#include <mrpt/poses/CPosePDFGrid.h>
+#include <mrpt/poses/CPosePDFParticles.h>
+#include <mrpt/poses/CPosePDFSOG.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <gtest/gtest.h>
@@ -121,6 +126,19 @@ TEST(RawlogPrecheck, ObjectsMrptWritesAreWalkedToTheirEnd) {
     mrpt::obs::CActionCollection actions;
     mrpt::obs::CActionRobotMovement2D odometry;
     odometry.estimationMethod = mrpt::obs::CActionRobotMovement2D::emOdometry;
+    actions.insert(odometry);
+    // Scan matching with each pose distribution (the walk goes through each to the next).
+    const mrpt::poses::CPose2D mean(0.3, 0.1, 0.02);
+    const mrpt::poses::CPosePDF::Ptr pdfs[] = {
+        mrpt::poses::CPosePDFGaussian::Create(mean), mrpt::poses::CPosePDFGaussianInf::Create(mean),
+        mrpt::poses::CPosePDFParticles::Create(4), mrpt::poses::CPosePDFSOG::Create(2),
+        mrpt::poses::CPosePDFGrid::Create(-0.5, 0.5, -0.5, 0.5, 0.5, M_PI / 2, -M_PI, M_PI)};
+    for (const auto& pdf : pdfs) {
+      mrpt::obs::CActionRobotMovement2D matched;
+      matched.estimationMethod = mrpt::obs::CActionRobotMovement2D::emScan2DMatching;
+      matched.poseChange = mrpt::containers::deepcopy_poly_ptr<mrpt::poses::CPosePDF::Ptr>(pdf);
+      actions.insert(matched);
+    }
     actions.insert(odometry);
     const mrpt::serialization::CSerializable::Ptr bare[] = {scan2D(), scan3D(), greyImage(),
                                                             stereo()};

@@ -464,6 +464,17 @@ TEST(RawlogReader, ScanMatchingPoseDistributionSizesAreCheckedBeforeMrptAllocate
     return at + std::string("mrpt::poses::").size() + name.size() + 1;
   };
 
+  // Every distribution is walked through: what follows it is checked as well (an odometry
+  // action whose motion model would draw 2 * 10^9 particles, behind scan matching).
+  mrpt::obs::CActionCollection behind =
+      scanMatched(mrpt::poses::CPosePDFGaussian::Create(mrpt::poses::CPose2D(0.3, 0.1, 0.02)));
+  behind.insert(*odometryWithModel(1, 2000000000u).get(0));
+  writeAroundActions(file, behind);
+  EXPECT_EQ(damageAtSecondObject(file, readFileBytes(file)),
+            "corrupt CActionRobotMovement2D (action 2 of 2 in a CActionCollection): a motion "
+            "model of 2000000000 particles (more than 100000; MRPT draws every one while "
+            "reading the object)");
+
   auto particles = mrpt::poses::CPosePDFParticles::Create(5);
   particles->resetDeterministic(mrpt::math::TPose2D(0.3, 0.1, 0.02));
   writeAroundActions(file, scanMatched(particles));
@@ -503,11 +514,13 @@ TEST(RawlogReader, ScanMatchingPoseDistributionSizesAreCheckedBeforeMrptAllocate
   EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, sides_at, 40000u)),
             prefix + "corrupt CPosePDFGrid: sides 40000 x 5 x 5 with 25 cells a layer, at byte " +
                 std::to_string(sides_at));
-  // The same grid as the second action of a collection, behind a Gaussian the pre-check leaves
-  // to MRPT (found by fuzz_rawlog): the reader checks the grid MRPT read before it takes the
-  // mean.
-  mrpt::obs::CActionCollection two = scanMatched(
-      mrpt::poses::CPosePDFGaussian::Create(mrpt::poses::CPose2D(0.3, 0.1, 0.02)));
+  // The same grid as the second action of a collection, behind a 3D movement, whose layout
+  // the pre-check leaves to MRPT (found by fuzz_rawlog behind actions the walk then stopped
+  // at): the reader checks the grid MRPT read before it takes the mean.
+  mrpt::obs::CActionCollection two;
+  mrpt::obs::CActionRobotMovement3D moved;
+  moved.poseChange.mean = mrpt::poses::CPose3D(0.2, 0, 0, 0, 0, 0);
+  two.insert(moved);
   two.insert(*scanMatched(grid).get(0));
   writeAroundActions(file, two);
   bytes = readFileBytes(file);

@@ -97,13 +97,32 @@ bool withinBound(const char* field, std::uint64_t value, std::uint64_t at, std::
 
 namespace {
 
-// A scan-matching action's pose distribution, its header read: the sizes MRPT allocates by
-// before it reads the elements (CPosePDFParticles' particles, CPosePDFSOG's modes,
-// CPosePDFGrid's cells), and a grid's cells against its sides, which MRPT indexes them by when
-// it takes the mean. The elements themselves are left to MRPT (OtherLayout), as are the fixed
-// layouts of the Gaussians.
+// A CPose2D object (version 0: floats, 1: doubles) through its end flag.
+bool walkPose2D(Cursor& c) {
+  ObjectHeader pose;
+  if (!readHeader(c, pose) || pose.class_name != "CPose2D" || pose.version > 1) return false;
+  c.skip(3 * (pose.version == 0 ? sizeof(float) : sizeof(double)));
+  return !pose.has_end_flag || c.endFlag();
+}
+
+// A scan-matching action's pose distribution, its header read, through its end flag (Read): the
+// sizes MRPT allocates by before it reads the elements (CPosePDFParticles' particles,
+// CPosePDFSOG's modes, CPosePDFGrid's cells), and a grid's cells against its sides, which MRPT
+// indexes them by when it takes the mean. A layout not walked here (an old version) is
+// OtherLayout.
 Parse checkPosePdf(Cursor& c, const ObjectHeader& pdf, std::string& why) {
+  const auto end = [&] { return !pdf.has_end_flag || c.endFlag() ? Parse::Read : Parse::OtherLayout; };
   const std::uint64_t at = c.position();
+  if (pdf.class_name == "CPosePDFGaussian" && (pdf.version == 1 || pdf.version == 2)) {
+    // The mean, then the covariance's upper triangle (version 1 in float).
+    if (!walkPose2D(c)) return Parse::OtherLayout;
+    c.skip(6 * (pdf.version == 1 ? sizeof(float) : sizeof(double)));
+    return end();
+  }
+  if (pdf.class_name == "CPosePDFGaussianInf" && pdf.version == 0) {
+    c.skip(3 * sizeof(double) + 6 * sizeof(double));  // the mean, the information's triangle
+    return end();
+  }
   if ((pdf.class_name == "CPosePDFParticles" && pdf.version <= 1) ||
       (pdf.class_name == "CPosePDFSOG" && pdf.version <= 2)) {
     const bool particles = pdf.class_name == "CPosePDFParticles";
@@ -114,7 +133,17 @@ Parse checkPosePdf(Cursor& c, const ObjectHeader& pdf, std::string& why) {
       why = "corrupt " + pdf.class_name + ": " + why;
       return Parse::Impossible;
     }
-    return Parse::OtherLayout;
+    if (particles) {
+      if (pdf.version == 0) return Parse::OtherLayout;  // (CPose2D objects)
+      c.skip(std::uint64_t{n} * 4 * sizeof(double));  // log weight, x, y, phi
+      return end();
+    }
+    for (std::uint32_t i = 0; i < n; ++i) {  // log weight, mean, covariance's triangle
+      c.skip(sizeof(double));
+      if (!walkPose2D(c)) return Parse::OtherLayout;
+      c.skip(6 * (pdf.version == 1 ? sizeof(float) : sizeof(double)));
+    }
+    return end();
   }
   if (pdf.class_name != "CPosePDFGrid" || pdf.version != 0) return Parse::OtherLayout;
   c.skip(8 * sizeof(double));  // the bounds and resolutions
@@ -148,7 +177,24 @@ Parse checkPosePdf(Cursor& c, const ObjectHeader& pdf, std::string& why) {
           std::to_string(side[1]) + " x " + std::to_string(side[2]);
     return Parse::Impossible;
   }
-  return Parse::OtherLayout;
+  c.skip(std::uint64_t{count} * sizeof(double));
+  return end();
+}
+
+// What follows either estimate in a CActionRobotMovement2D (versions 4-7): velocities,
+// encoders, the timestamp.
+Parse checkMovementTail(Cursor& c, int version) {
+  std::uint8_t has_velocities = 0, has_encoders = 0;
+  if (!c.value(has_velocities)) return Parse::OtherLayout;
+  if (version >= 7) {
+    if (has_velocities) c.skip(3 * sizeof(double));  // TTwist2D
+  } else {
+    c.skip(2 * sizeof(double));
+  }
+  if (!c.value(has_encoders)) return Parse::OtherLayout;
+  if (version < 7 || has_encoders) c.skip(2 * sizeof(std::int32_t));
+  if (version >= 6) c.skip(sizeof(std::uint64_t));  // the timestamp
+  return Parse::Read;
 }
 
 // CActionRobotMovement2D::serializeFrom of MRPT 2.5.8, versions 4-7, up to its end flag: an
@@ -160,8 +206,8 @@ Parse checkMovement2D(Cursor& c, int version, std::string& why) {
   if (!c.value(method)) return Parse::OtherLayout;
   if (method != 0) {
     // Not an odometry estimate (emOdometry = 0): scan matching (1), whose pose distribution
-    // object follows, left to MRPT; MRPT uses what it reads there as a CPosePDF without a check
-    // (another object, or none, ends the process).
+    // object follows (MRPT uses what it reads there as a CPosePDF without a check: another
+    // object, or none, ends the process).
     if (method != 1) {
       why = "unknown estimation method " + std::to_string(method) +
             " (0 odometry, 1 scan matching)";
@@ -177,18 +223,10 @@ Parse checkMovement2D(Cursor& c, int version, std::string& why) {
             " where scan matching's pose distribution (a CPosePDF) belongs";
       return Parse::Impossible;
     }
-    return checkPosePdf(c, pdf, why);
+    const Parse p = checkPosePdf(c, pdf, why);
+    return p == Parse::Read ? checkMovementTail(c, version) : p;
   }
-  ObjectHeader pose;
-  if (!readHeader(c, pose) || pose.class_name != "CPose2D") return Parse::OtherLayout;
-  if (pose.version == 0) {
-    c.skip(3 * sizeof(float));
-  } else if (pose.version == 1) {
-    c.skip(3 * sizeof(double));
-  } else {
-    return Parse::OtherLayout;
-  }
-  if (pose.has_end_flag && !c.endFlag()) return Parse::OtherLayout;
+  if (!walkPose2D(c)) return Parse::OtherLayout;  // the raw odometry increment
   std::int32_t model = 0;
   std::uint32_t particles = 0;
   if (!c.value(model)) return Parse::OtherLayout;
@@ -207,17 +245,7 @@ Parse checkMovement2D(Cursor& c, int version, std::string& why) {
     return Parse::Impossible;
   }
   c.skip((version >= 5 ? 6 : 4) * sizeof(float));  // the Thrun model's alphas and extra noise
-  std::uint8_t has_velocities = 0, has_encoders = 0;
-  if (!c.value(has_velocities)) return Parse::OtherLayout;
-  if (version >= 7) {
-    if (has_velocities) c.skip(3 * sizeof(double));  // TTwist2D
-  } else {
-    c.skip(2 * sizeof(double));
-  }
-  if (!c.value(has_encoders)) return Parse::OtherLayout;
-  if (version < 7 || has_encoders) c.skip(2 * sizeof(std::int32_t));
-  if (version >= 6) c.skip(sizeof(std::uint64_t));  // the timestamp
-  return Parse::Read;
+  return checkMovementTail(c, version);
 }
 
 // CActionCollection::serializeFrom, version 0: a count, then the action objects.
