@@ -341,6 +341,22 @@ TEST(RawlogPrecheck, OldSensoryFramesAreCheckedAsTheCurrentOne) {
             "frame's timestamp through each)");
 }
 
+// MRPT reads a class name as a C string, up to its first NUL, whatever its stated length: a
+// name of 21 bytes, "CActionCollection" and 4 bytes more from a NUL on, is a CActionCollection
+// to MRPT and to the check (found by fuzz_rawlog: its count, 1,665,221,526, made MRPT allocate
+// gigabytes of action pointers).
+TEST(RawlogPrecheck, ClassNamesEndAtTheirFirstNulAsMrptReadsThem) {
+  TempDir tmp;
+  const std::string name = std::string("CActionCollection") + std::string("\0\x01\0\0", 4);
+  const std::string head = std::string(1, static_cast<char>(0x80 | name.size())) + name + '\0';
+  std::size_t before = 0;
+  const std::string reason = damageReason(tmp, head + u32(1665221526u) + "\x88", &before);
+  EXPECT_EQ(reason,
+            "corrupt CActionCollection: action count 1665221526 at byte " +
+                std::to_string(before + head.size()) + " (more than 4096 actions)");
+  EXPECT_EQ(damageReason(tmp, head + u32(0) + "\x88", &before), "(read)");
+}
+
 // Sizes at their bounds are read by MRPT as usual (a 2D scan of 1,000,000 rays).
 TEST(RawlogPrecheck, SizesAtTheBoundAreRead) {
   auto s = mrpt::obs::CObservation2DRangeScan::Create();

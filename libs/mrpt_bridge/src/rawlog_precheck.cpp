@@ -72,6 +72,8 @@ bool readHeader(Cursor& c, ObjectHeader& h) {
   if (length > 120) return false;
   std::string name(length, '\0');
   if (length > 0 && !c.bytes(name.data(), length)) return false;
+  // MRPT takes the name as a C string: up to its first NUL, whatever the length said.
+  name.resize(std::min(name.size(), name.find('\0')));
   const auto ns = name.rfind("::");
   h.class_name = ns == std::string::npos ? name : name.substr(ns + 2);
   if (!h.has_end_flag) {
