@@ -11,6 +11,7 @@
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationComment.h>
@@ -355,6 +356,24 @@ TEST(RawlogPrecheck, ClassNamesEndAtTheirFirstNulAsMrptReadsThem) {
             "corrupt CActionCollection: action count 1665221526 at byte " +
                 std::to_string(before + head.size()) + " (more than 4096 actions)");
   EXPECT_EQ(damageReason(tmp, head + u32(0) + "\x88", &before), "(read)");
+}
+
+// MRPT keeps a collection's actions as deep-copying pointers made from what it read cast to a
+// CAction: a null object or another class (found by fuzz_rawlog: a CPose2D) was copied
+// through a null pointer (SEGV). Both are damage; the two action classes read. (The walk does
+// not go through a CActionRobotMovement3D: what follows one is left to MRPT.)
+TEST(RawlogPrecheck, CollectionsHoldOnlyActions) {
+  TempDir tmp;
+  const std::string head = "\x91" "CActionCollection" + std::string(1, '\0') + u32(2);
+  mrpt::obs::CActionRobotMovement3D moved;
+  const std::string action = serialized(moved);
+  std::size_t before = 0;
+  EXPECT_EQ(damageReason(tmp, head + std::string("\x87" "nullptr\x88") + action + "\x88", &before),
+            "corrupt CActionCollection: action 1 of 2 is a null object");
+  EXPECT_EQ(damageReason(tmp, head + serialized(mrpt::poses::CPose2D(1, 2, 0)) + action + "\x88",
+                         &before),
+            "corrupt CActionCollection: action 1 of 2 is a CPose2D, not an action");
+  EXPECT_EQ(damageReason(tmp, head + action + action + "\x88", &before), "(read)");
 }
 
 // Sizes at their bounds are read by MRPT as usual (a 2D scan of 1,000,000 rays).

@@ -262,9 +262,18 @@ Parse checkActions(Cursor& c, int version, std::string& why) {
   }
   for (std::uint32_t i = 0; i < actions; ++i) {
     ObjectHeader action;
-    if (!readHeader(c, action) || action.class_name != "CActionRobotMovement2D") {
-      return Parse::OtherLayout;
+    if (!readHeader(c, action)) return Parse::OtherLayout;
+    // MRPT keeps each action as a deep-copying pointer made from what it read cast to a CAction:
+    // anything else, or a null object, is copied through a null pointer.
+    if (action.class_name != "CActionRobotMovement2D" &&
+        action.class_name != "CActionRobotMovement3D") {
+      why = "corrupt CActionCollection: action " + std::to_string(i + 1) + " of " +
+            std::to_string(actions) + " is " +
+            (action.class_name == "nullptr" ? std::string("a null object")
+                                            : "a " + action.class_name + ", not an action");
+      return Parse::Impossible;
     }
+    if (action.class_name != "CActionRobotMovement2D") return Parse::OtherLayout;
     const Parse p = checkMovement2D(c, action.version, why);
     if (p == Parse::Impossible) {
       why = "corrupt CActionRobotMovement2D (action " + std::to_string(i + 1) + " of " +
