@@ -107,6 +107,9 @@ bool walkPose2D(Cursor& c) {
   return !pose.has_end_flag || c.endFlag();
 }
 
+// The upper triangle of a 3 x 3 symmetric matrix as MRPT writes it (in float, or double).
+void skipTriangle(Cursor& c, bool in_float) { c.skip(6 * (in_float ? sizeof(float) : sizeof(double))); }
+
 // A scan-matching action's pose distribution, its header read, through its end flag (Read): the
 // sizes MRPT allocates by before it reads the elements (CPosePDFParticles' particles,
 // CPosePDFSOG's modes, CPosePDFGrid's cells), and a grid's cells against its sides, which MRPT
@@ -118,11 +121,12 @@ Parse checkPosePdf(Cursor& c, const ObjectHeader& pdf, std::string& why) {
   if (pdf.class_name == "CPosePDFGaussian" && (pdf.version == 1 || pdf.version == 2)) {
     // The mean, then the covariance's upper triangle (version 1 in float).
     if (!walkPose2D(c)) return Parse::OtherLayout;
-    c.skip(6 * (pdf.version == 1 ? sizeof(float) : sizeof(double)));
+    skipTriangle(c, pdf.version == 1);
     return end();
   }
   if (pdf.class_name == "CPosePDFGaussianInf" && pdf.version == 0) {
-    c.skip(3 * sizeof(double) + 6 * sizeof(double));  // the mean, the information's triangle
+    c.skip(3 * sizeof(double));  // the mean
+    skipTriangle(c, false);      // the information matrix
     return end();
   }
   if ((pdf.class_name == "CPosePDFParticles" && pdf.version <= 1) ||
@@ -143,7 +147,7 @@ Parse checkPosePdf(Cursor& c, const ObjectHeader& pdf, std::string& why) {
     for (std::uint32_t i = 0; i < n; ++i) {  // log weight, mean, covariance's triangle
       c.skip(sizeof(double));
       if (!walkPose2D(c)) return Parse::OtherLayout;
-      c.skip(6 * (pdf.version == 1 ? sizeof(float) : sizeof(double)));
+      skipTriangle(c, pdf.version == 1);
     }
     return end();
   }
@@ -158,10 +162,6 @@ Parse checkPosePdf(Cursor& c, const ObjectHeader& pdf, std::string& why) {
   const std::uint64_t count_at = c.position();
   std::uint32_t count = 0;
   if (!c.value(count)) return Parse::OtherLayout;
-  const auto cells = [](const std::int32_t* s) {
-    return static_cast<std::uint64_t>(s[0]) * static_cast<std::uint64_t>(s[1]) *
-           static_cast<std::uint64_t>(s[2]);
-  };
   if (side[0] < 0 || side[1] < 0 || side[2] < 0 ||
       static_cast<std::int64_t>(side[0]) * side[1] != side[3]) {
     why = "corrupt CPosePDFGrid: sides " + std::to_string(side[0]) + " x " +
@@ -173,7 +173,7 @@ Parse checkPosePdf(Cursor& c, const ObjectHeader& pdf, std::string& why) {
     why = "corrupt CPosePDFGrid: " + why;
     return Parse::Impossible;
   }
-  if (count != cells(side)) {
+  if (count != static_cast<std::uint64_t>(side[3]) * static_cast<std::uint64_t>(side[2])) {
     why = "corrupt CPosePDFGrid: " + std::to_string(count) + " cells at byte " +
           std::to_string(count_at) + " for sides " + std::to_string(side[0]) + " x " +
           std::to_string(side[1]) + " x " + std::to_string(side[2]);

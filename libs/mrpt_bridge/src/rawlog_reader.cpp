@@ -22,6 +22,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -139,16 +140,26 @@ struct GridCells : mrpt::poses::CPosePDFGrid {
   }
 };
 
-// Why a robot movement's pose change cannot be used (a grid distribution whose cells do not
-// match its sides; a coordinate not finite: the robot's pose would be NaN from there on; a move
-// longer than kMaxMovementM), or "" when it can or a is no movement.
-std::string unusableMovement(const mrpt::obs::CAction& a) {
+Eigen::Isometry3d planarIsometry(double x, double y, double phi) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  t.translation() = Eigen::Vector3d(x, y, 0.0);
+  return t;
+}
+
+// A robot movement's increment into inc, or why its pose change cannot be used (a grid
+// distribution whose cells do not match its sides; a coordinate not finite: the robot's pose
+// would be NaN from there on; a move longer than kMaxMovementM). "" with inc unset for anything
+// else (another action, a 2D movement without a pose change).
+std::string movementIncrement(const mrpt::obs::CAction& a,
+                              std::optional<Eigen::Isometry3d>& inc) {
   std::vector<double> v;
   std::string names;
   if (const auto* m3 = dynamic_cast<const mrpt::obs::CActionRobotMovement3D*>(&a)) {
     const mrpt::poses::CPose3D& p = m3->poseChange.mean;
     v = {p.x(), p.y(), p.z(), p.yaw(), p.pitch(), p.roll()};
     names = "(x, y, z, yaw, pitch, roll)";
+    inc = toIsometry(p);
   } else if (const auto* m2 = dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(&a)) {
     if (!m2->poseChange) return "";
     if (const auto* g = dynamic_cast<const mrpt::poses::CPosePDFGrid*>(m2->poseChange.get())) {
@@ -163,6 +174,9 @@ std::string unusableMovement(const mrpt::obs::CAction& a) {
     }
     v = {p.x(), p.y(), p.phi()};
     names = "(x, y, phi)";
+    inc = planarIsometry(p.x(), p.y(), p.phi());
+  } else {
+    return "";
   }
   std::ostringstream os;
   if (std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); })) {
@@ -170,42 +184,15 @@ std::string unusableMovement(const mrpt::obs::CAction& a) {
     if (move <= kMaxMovementM) return "";
     os << "its pose change moves the robot " << move << " m (more than " << kMaxMovementM
        << " m between two observations)";
-    return os.str();
+  } else {
+    os << "its pose change " << names << " = (";
+    for (std::size_t i = 0; i < v.size(); ++i) os << (i ? ", " : "") << v[i];
+    os << ") is not finite";
   }
-  os << "its pose change " << names << " = (";
-  for (std::size_t i = 0; i < v.size(); ++i) os << (i ? ", " : "") << v[i];
-  os << ") is not finite";
+  inc.reset();
   return os.str();
 }
 
-// unusableMovement for a top-level object: an action, or each action of a collection
-// ("corrupt CActionRobotMovement2D (action 2 of 3 in a CActionCollection): ...").
-std::string unusableMovements(const mrpt::serialization::CSerializable::Ptr& o) {
-  if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(o)) {
-    std::size_t i = 0;
-    for (const auto& a : *acts) {
-      ++i;
-      const std::string why = a ? unusableMovement(*a) : std::string();
-      if (!why.empty()) {
-        return "corrupt " + detail::shortClassName(*a) + " (action " + std::to_string(i) + " of " +
-               std::to_string(acts->size()) + " in a CActionCollection): " + why;
-      }
-    }
-    return "";
-  }
-  if (auto act = std::dynamic_pointer_cast<mrpt::obs::CAction>(o)) {
-    const std::string why = unusableMovement(*act);
-    return why.empty() ? why : "corrupt " + detail::shortClassName(*act) + ": " + why;
-  }
-  return "";
-}
-
-Eigen::Isometry3d planarIsometry(double x, double y, double phi) {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.linear() = Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  t.translation() = Eigen::Vector3d(x, y, 0.0);
-  return t;
-}
 
 }  // namespace
 
@@ -238,48 +225,44 @@ struct RawlogReader::Impl {
     ++stats.odometry_actions;
   }
 
-  // Uses the first robot movement of a collection (or of a bare action); counts the rest.
-  void handleAction(const mrpt::obs::CAction& a, bool& used) {
-    const bool is_movement = dynamic_cast<const mrpt::obs::CActionRobotMovement3D*>(&a) ||
-                             dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(&a);
-    if (!is_movement) {
-      skip("action " + detail::shortClassName(a) + " (not a robot movement)");
-      return;
+  // The actions of one object (a collection's, or one bare action): every movement's pose change
+  // checked first (one that cannot be used is damage at the object, at object_index and
+  // position), then the first movement's increment used and the rest counted.
+  void handleActions(const std::vector<const mrpt::obs::CAction*>& acts, bool in_collection,
+                     std::size_t object_index, uint64_t position) {
+    std::vector<std::optional<Eigen::Isometry3d>> inc(acts.size());
+    for (std::size_t i = 0; i < acts.size(); ++i) {
+      if (!acts[i]) continue;
+      const std::string why = movementIncrement(*acts[i], inc[i]);
+      if (why.empty()) continue;
+      const std::string where = in_collection ? " (action " + std::to_string(i + 1) + " of " +
+                                                    std::to_string(acts.size()) +
+                                                    " in a CActionCollection)"
+                                              : "";
+      fail(object_index, position,
+           "corrupt " + detail::shortClassName(*acts[i]) + where + ": " + why);
     }
-    if (used) {
-      skip("extra robot movement in one CActionCollection (the first is used)");
-      return;
-    }
-    if (const auto* m3 = dynamic_cast<const mrpt::obs::CActionRobotMovement3D*>(&a)) {
-      addIncrement(toIsometry(m3->poseChange.mean));
-      used = true;
-      return;
-    }
-    const auto& m2 = dynamic_cast<const mrpt::obs::CActionRobotMovement2D&>(a);
-    if (!m2.poseChange) {
-      skip("CActionRobotMovement2D without a pose change");
-      return;
-    }
-    const mrpt::poses::CPose2D d = m2.poseChange->getMeanVal();
-    addIncrement(planarIsometry(d.x(), d.y(), d.phi()));
-    used = true;
-  }
-
-  void handleActions(const mrpt::obs::CActionCollection& acts) {
-    ++stats.action_collections;
-    seen_frames = true;
-    if (acts.size() == 0) skip("empty CActionCollection");
     bool used = false;
-    for (const auto& a : acts) {
-      if (a) {
-        handleAction(*a, used);
-      } else {
+    for (std::size_t i = 0; i < acts.size(); ++i) {
+      const mrpt::obs::CAction* a = acts[i];
+      if (!a) {
         skip("null action in a CActionCollection");
+      } else if (!dynamic_cast<const mrpt::obs::CActionRobotMovement3D*>(a) &&
+                 !dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(a)) {
+        skip("action " + detail::shortClassName(*a) + " (not a robot movement)");
+      } else if (used) {
+        skip("extra robot movement in one CActionCollection (the first is used)");
+      } else if (!inc[i]) {
+        skip("CActionRobotMovement2D without a pose change");
+      } else {
+        addIncrement(*inc[i]);
+        used = true;
       }
     }
   }
 
-  void handleObject(const mrpt::serialization::CSerializable::Ptr& o, std::size_t object_index) {
+  void handleObject(const mrpt::serialization::CSerializable::Ptr& o, std::size_t object_index,
+                    uint64_t position) {
     if (!o) {
       skip("null object");
       return;
@@ -298,7 +281,12 @@ struct RawlogReader::Impl {
       return;
     }
     if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(o)) {
-      handleActions(*acts);
+      ++stats.action_collections;
+      seen_frames = true;
+      if (acts->size() == 0) skip("empty CActionCollection");
+      std::vector<const mrpt::obs::CAction*> list;
+      for (const auto& a : *acts) list.push_back(a ? a.get() : nullptr);
+      handleActions(list, true, object_index, position);
       return;
     }
     if (auto obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(o)) {
@@ -309,8 +297,7 @@ struct RawlogReader::Impl {
     if (auto act = std::dynamic_pointer_cast<mrpt::obs::CAction>(o)) {
       // A bare action outside a collection: use a movement, count anything else.
       seen_frames = true;
-      bool used = false;
-      handleAction(*act, used);
+      handleActions({act.get()}, false, object_index, position);
       return;
     }
     skip("top-level " + detail::shortClassName(*o) +
@@ -393,10 +380,8 @@ bool RawlogReader::next(RawlogEntry& entry) {
       d.fail(object_index, position, "corrupt or truncated (" + describeReadError(e.what()) + ")");
     }
     if (!impossible.empty()) d.fail(object_index, position, impossible);
-    const std::string unusable = unusableMovements(object);
-    if (!unusable.empty()) d.fail(object_index, position, unusable);
+    d.handleObject(object, object_index, position);  // (may find the object's actions damaged)
     ++d.stats.objects;
-    d.handleObject(object, object_index);
   }
 }
 
