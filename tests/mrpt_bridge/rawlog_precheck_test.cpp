@@ -9,6 +9,7 @@
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
+#include <mrpt/math/CMatrixD.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CActionRobotMovement3D.h>
@@ -374,6 +375,46 @@ TEST(RawlogPrecheck, CollectionsHoldOnlyActions) {
                          &before),
             "corrupt CActionCollection: action 1 of 2 is a CPose2D, not an action");
   EXPECT_EQ(damageReason(tmp, head + action + action + "\x88", &before), "(read)");
+}
+
+// A TCamera before version 6 (MRPT reads versions 0-6) is walked as MRPT reads it: before version 4
+// its intrinsics are a CMatrixD object, which MRPT reallocates to the size it reads before it
+// checks the size (found by fuzz_rawlog: a version-2 camera in a 3D scan whose matrix claimed
+// 1.7e18 bytes; the allocator returned null and MRPT wrote through it: SEGV).
+TEST(RawlogPrecheck, OldCamerasAreWalkedAndTheirMatricesBounded) {
+  TempDir tmp;
+  const std::string scan = serialized(*scan3D());
+  const std::string name = "\x92" "mrpt::img::TCamera";
+  const std::string current = name + "\x06";
+  const auto camera_at = scan.find(current);
+  ASSERT_NE(camera_at, std::string::npos);
+  const std::size_t name_at = camera_at + current.size() + 13 * 8 + 8;
+  const auto name_length = static_cast<std::uint8_t>(scan[name_at]);  // "camera": < 256
+  const std::size_t current_size = name_at + 4 + name_length + 1 + 1 - camera_at;
+  ASSERT_EQ(scan[camera_at + current_size - 1], '\x88');
+  const std::string doubles = [](int n) { return std::string(8 * n, '\0'); }(6);
+  const std::string three = serialized(mrpt::math::CMatrixD(3, 3));
+  const std::string resolution = u32(480) + u32(640);
+  const auto withCamera = [&](const std::string& camera) {
+    return std::string(scan).replace(camera_at, current_size, camera);
+  };
+  const std::string v0 = name + std::string(1, '\0') + doubles + three +
+                         serialized(mrpt::math::CMatrixD(1, 5)) + "\x88";
+  const std::string v2 = name + "\x02" + doubles + three + resolution + "\x88";
+  const std::string v5 = name + "\x05" + doubles + std::string(7 * 8, '\0') + resolution +
+                         u32(3) + "cam\x88";
+  std::size_t head = 0;
+  for (const std::string* camera : {&v0, &v2, &v5}) {
+    EXPECT_EQ(damageReason(tmp, withCamera(*camera), &head), "(read)");
+    std::string why;
+    EXPECT_EQ(walked(withCamera(*camera), &why), withCamera(*camera).size()) << why;
+  }
+  std::string huge = v2;
+  const std::size_t rows_at = huge.find("CMatrixD") + 9;
+  huge.replace(rows_at, 8, u32(2000000000u) + u32(3));
+  EXPECT_EQ(damageReason(tmp, withCamera(huge), &head),
+            "corrupt CObservation3DRangeScan: camera intrinsics rows 2000000000 at byte " +
+                std::to_string(head + camera_at + rows_at) + " (more than 65535 rows)");
 }
 
 // Sizes at their bounds are read by MRPT as usual (a 2D scan of 1,000,000 rays).

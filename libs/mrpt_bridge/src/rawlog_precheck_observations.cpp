@@ -87,15 +87,26 @@ Parse pose(Cursor& c, std::string& why) {
   return endOf(c, h) ? kRead : kOther;
 }
 
-// TCamera, version 6 (MRPT 2.5): 13 doubles (the intrinsics, the distortion, the focal length), the
-// resolution, the camera's name, the distortion model (a byte).
+// TCamera, versions 0-6: the focal length and 5 distortion parameters (3 more from version 3), the
+// intrinsics (a CMatrixD object before version 4, 4 doubles from it), a CMatrixD of distortion
+// (version 0), the resolution (from 2), the camera's name (from 5), the distortion model (6: a
+// byte). MRPT reallocates each CMatrixD to the size it reads before it checks it is 3 x 3 or 1 x 5.
 Parse camera(Cursor& c, std::string& why) {
   ObjectHeader h;
-  if (!header(c, h, {"TCamera"}) || h.version != 6) return kOther;
-  c.skip(13 * sizeof(double) + 2 * sizeof(std::uint32_t));
-  const Parse p = string(c, "camera name length", why);
+  if (!header(c, h, {"TCamera"}) || h.version > 6) return kOther;
+  const int v = h.version;
+  c.skip((v >= 3 ? 9 : 6) * sizeof(double));
+  Parse p = kRead;
+  if (v < 4) {
+    p = matrix(c, "camera intrinsics", why);
+  } else {
+    c.skip(4 * sizeof(double));
+  }
+  if (p == kRead && v == 0) p = matrix(c, "camera distortion", why);
   if (p != kRead) return p;
-  c.skip(1);
+  if (v >= 2) c.skip(2 * sizeof(std::uint32_t));
+  if (v >= 5 && (p = string(c, "camera name length", why)) != kRead) return p;
+  if (v >= 6) c.skip(1);
   return endOf(c, h) ? kRead : kOther;
 }
 
