@@ -142,10 +142,14 @@ TEST(RawlogPrecheck, ObjectsMrptWritesAreWalkedToTheirEnd) {
       actions.insert(matched);
     }
     actions.insert(odometry);
+    mrpt::obs::CActionRobotMovement3D moved;
+    moved.poseChange.mean = mrpt::poses::CPose3D(0.4, 0.1, 0.0, 0.2, 0.0, 0.0);
+    actions.insert(moved);
+    actions.insert(odometry);
     const mrpt::serialization::CSerializable::Ptr bare[] = {scan2D(), scan3D(), greyImage(),
                                                             stereo()};
     const mrpt::serialization::CSerializable* objects[] = {
-        bare[0].get(), bare[1].get(), bare[2].get(), bare[3].get(), &frame, &actions};
+        bare[0].get(), bare[1].get(), bare[2].get(), bare[3].get(), &frame, &actions, &moved};
     for (const auto* o : objects) {
       SCOPED_TRACE(std::string(o->GetRuntimeClass()->className) + (jpeg ? " (JPEG)" : ""));
       const std::string bytes = serialized(*o);
@@ -361,8 +365,7 @@ TEST(RawlogPrecheck, ClassNamesEndAtTheirFirstNulAsMrptReadsThem) {
 
 // MRPT keeps a collection's actions as deep-copying pointers made from what it read cast to a
 // CAction: a null object or another class (found by fuzz_rawlog: a CPose2D) was copied
-// through a null pointer (SEGV). Both are damage; the two action classes read. (The walk does
-// not go through a CActionRobotMovement3D: what follows one is left to MRPT.)
+// through a null pointer (SEGV). Both are damage; the two action classes read.
 TEST(RawlogPrecheck, CollectionsHoldOnlyActions) {
   TempDir tmp;
   const std::string head = "\x91" "CActionCollection" + std::string(1, '\0') + u32(2);
@@ -375,6 +378,33 @@ TEST(RawlogPrecheck, CollectionsHoldOnlyActions) {
                          &before),
             "corrupt CActionCollection: action 1 of 2 is a CPose2D, not an action");
   EXPECT_EQ(damageReason(tmp, head + action + action + "\x88", &before), "(read)");
+}
+
+// A 3D movement's velocity flags and velocities are each a count MRPT resizes to, then the
+// elements (MRPT writes 6 of each): a count past 6 is damage, in a collection or bare.
+TEST(RawlogPrecheck, ThreeDMovementVelocityCountsAreBounded) {
+  TempDir tmp;
+  const std::string moved = serialized(mrpt::obs::CActionRobotMovement3D());
+  const std::size_t velocities_at = moved.size() - 1 - 8 - 6 * 4 - 4;  // before the timestamp
+  const std::size_t flags_at = velocities_at - 6 - 4;
+  ASSERT_EQ(moved.substr(flags_at, 4), u32(6));
+  ASSERT_EQ(moved.substr(velocities_at, 4), u32(6));
+  const std::string head = "\x91" "CActionCollection" + std::string(1, '\0') + u32(1);
+  std::size_t before = 0;
+  for (const auto& [at, field] : {std::pair{flags_at, "velocity flag count"},
+                                  std::pair{velocities_at, "velocity count"}}) {
+    const std::string bad = std::string(moved).replace(at, 4, u32(0xFFFFFFFFu));
+    const std::string in_collection = damageReason(tmp, head + bad + "\x88", &before);
+    EXPECT_EQ(in_collection,
+              "corrupt CActionRobotMovement3D (action 1 of 1 in a CActionCollection): " +
+                  std::string(field) + " 4294967295 at byte " +
+                  std::to_string(before + head.size() + at) + " (more than 6 components)");
+    const std::string alone = damageReason(tmp, bad, &before);
+    EXPECT_EQ(alone, "corrupt CActionRobotMovement3D: " + std::string(field) +
+                         " 4294967295 at byte " + std::to_string(before + at) +
+                         " (more than 6 components)");
+  }
+  EXPECT_EQ(damageReason(tmp, head + moved + "\x88", &before), "(read)");
 }
 
 // A TCamera before version 6 (MRPT reads versions 0-6) is walked as MRPT reads it: before version 4

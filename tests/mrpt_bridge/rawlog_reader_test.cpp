@@ -514,16 +514,16 @@ TEST(RawlogReader, ScanMatchingPoseDistributionSizesAreCheckedBeforeMrptAllocate
   EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, sides_at, 40000u)),
             prefix + "corrupt CPosePDFGrid: sides 40000 x 5 x 5 with 25 cells a layer, at byte " +
                 std::to_string(sides_at));
-  // The same grid as the second action of a collection, behind a 3D movement, whose layout
-  // the pre-check leaves to MRPT (found by fuzz_rawlog behind actions the walk then stopped
-  // at): the reader checks the grid MRPT read before it takes the mean.
-  mrpt::obs::CActionCollection two;
-  mrpt::obs::CActionRobotMovement3D moved;
-  moved.poseChange.mean = mrpt::poses::CPose3D(0.2, 0, 0, 0, 0, 0);
-  two.insert(moved);
+  // The same grid behind particles of version 0 (CPose2D objects), a layout the pre-check leaves
+  // to MRPT (found by fuzz_rawlog behind actions the walk then stopped at): the reader checks the
+  // grid MRPT read before it takes the mean.
+  mrpt::obs::CActionCollection two = scanMatched(mrpt::poses::CPosePDFParticles::Create(1));
   two.insert(*scanMatched(grid).get(0));
   writeAroundActions(file, two);
   bytes = readFileBytes(file);
+  const std::string pose2d = std::string("\x94" "mrpt::poses::CPose2D\x01") + std::string(24, '\0');
+  bytes.replace(bodyOf(bytes, "CPosePDFParticles") - 1, 1 + 4 + 4 * 8,  // version 1, 1 particle
+                std::string(1, '\0') + withInt32(std::string(12, '\0'), 0, 1) + pose2d + "\x88");
   EXPECT_EQ(damageAtSecondObject(file, bytes), "(read)");
   const std::size_t second_sides_at = bodyOf(bytes, "CPosePDFGrid") + 8 * sizeof(double);
   EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, second_sides_at, 40000u)),

@@ -250,6 +250,44 @@ Parse checkMovement2D(Cursor& c, int version, std::string& why) {
   return checkMovementTail(c, version);
 }
 
+// CActionRobotMovement3D::serializeFrom of MRPT 2.5.8, versions 0-1, up to its end flag: the
+// estimation method, the pose change (a CPose3DPDFGaussian object, version 1: the mean, a CPose3D
+// object, then the covariance's upper triangle of 21 doubles), a flag for each velocity and the
+// velocities (a count each, which MRPT resizes to), the timestamp (version 1).
+Parse checkMovement3D(Cursor& c, int version, std::string& why) {
+  if (version > 1) return Parse::OtherLayout;
+  c.skip(sizeof(std::uint32_t));  // the estimation method (MRPT keeps it, reads nothing by it)
+  ObjectHeader pdf;
+  if (!readHeader(c, pdf) || pdf.class_name != "CPose3DPDFGaussian" || pdf.version != 1) {
+    return Parse::OtherLayout;
+  }
+  const Parse p = checkPose(c, why);
+  if (p != Parse::Read) return p;
+  c.skip(21 * sizeof(double));
+  if (pdf.has_end_flag && !c.endFlag()) return Parse::OtherLayout;
+  const struct {
+    const char* field;
+    std::size_t bytes;  // an element's
+  } vectors[] = {{"velocity flag count", 1}, {"velocity count", sizeof(float)}};
+  for (const auto& v : vectors) {
+    const std::uint64_t at = c.position();
+    std::uint32_t n = 0;
+    if (!c.value(n)) return Parse::OtherLayout;
+    if (!withinBound(v.field, n, at, kMaxVelocityComponents, "components", why)) {
+      return Parse::Impossible;
+    }
+    c.skip(std::uint64_t{n} * v.bytes);
+  }
+  if (version >= 1) c.skip(sizeof(std::uint64_t));  // the timestamp
+  return Parse::Read;
+}
+
+// A robot movement (2D or 3D) of the version given, its header read, up to its end flag.
+Parse checkMovement(Cursor& c, const ObjectHeader& h, std::string& why) {
+  return h.class_name == "CActionRobotMovement2D" ? checkMovement2D(c, h.version, why)
+                                                  : checkMovement3D(c, h.version, why);
+}
+
 // CActionCollection::serializeFrom, version 0: a count, then the action objects.
 Parse checkActions(Cursor& c, int version, std::string& why) {
   if (version != 0) return Parse::OtherLayout;
@@ -273,10 +311,9 @@ Parse checkActions(Cursor& c, int version, std::string& why) {
                                             : "a " + action.class_name + ", not an action");
       return Parse::Impossible;
     }
-    if (action.class_name != "CActionRobotMovement2D") return Parse::OtherLayout;
-    const Parse p = checkMovement2D(c, action.version, why);
+    const Parse p = checkMovement(c, action, why);
     if (p == Parse::Impossible) {
-      why = "corrupt CActionRobotMovement2D (action " + std::to_string(i + 1) + " of " +
+      why = "corrupt " + action.class_name + " (action " + std::to_string(i + 1) + " of " +
             std::to_string(actions) + " in a CActionCollection): " + why;
       return p;
     }
@@ -322,8 +359,8 @@ Parse checkTopLevel(Cursor& c, const ObjectHeader& top, std::string& why) {
   if (top.class_name == "CActionCollection") return checkActions(c, top.version, why);
   if (top.class_name == "CSensoryFrame") return checkFrame(c, top.version, why);
   Parse p = Parse::OtherLayout;
-  if (top.class_name == "CActionRobotMovement2D") {
-    p = checkMovement2D(c, top.version, why);
+  if (top.class_name == "CActionRobotMovement2D" || top.class_name == "CActionRobotMovement3D") {
+    p = checkMovement(c, top, why);
     if (p == Parse::Read && top.has_end_flag && !c.endFlag()) p = Parse::OtherLayout;
   } else {
     p = checkObservation(c, top, why);

@@ -35,6 +35,9 @@ constexpr std::uint32_t kMaxOdometryParticles = 100000;
 constexpr std::uint32_t kMaxPosePdfElements = 100000;
 /// Most cells of a CPosePDFGrid (2^24 doubles, 128 MiB).
 constexpr std::uint64_t kMaxPoseGridCells = std::uint64_t{1} << 24;
+/// Most velocity components of a CActionRobotMovement3D (MRPT writes 6: x y z yaw pitch roll, and
+/// a flag for each).
+constexpr std::uint32_t kMaxVelocityComponents = 6;
 /// Most actions in one CActionCollection (a robot writes one or two per step).
 constexpr std::uint32_t kMaxActionsPerCollection = 4096;
 /// Most observations in one CSensoryFrame (a robot writes one per sensor and step).

@@ -79,4 +79,7 @@ bool withinBound(const char* field, std::uint64_t value, std::uint64_t at, std::
 /// other class is OtherLayout), up to and including its end flag.
 Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why);
 
+/// A CPose3D (versions 0-3), CPose3DQuat or CPose2D object, header to end flag.
+Parse checkPose(Cursor& c, std::string& why);
+
 }  // namespace upd::mrpt_bridge::detail

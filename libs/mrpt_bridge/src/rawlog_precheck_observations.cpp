@@ -410,6 +410,8 @@ Parse stereoImages(Cursor& c, int version, std::string& why) {
 
 }  // namespace
 
+Parse checkPose(Cursor& c, std::string& why) { return pose(c, why); }
+
 Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
   Parse p = kOther;
   if (h.class_name == "CObservation2DRangeScan") {
