@@ -1,8 +1,9 @@
 // Writes the fuzzers' generated seed corpora: small valid files of every cloud format (the
 // samples of the bad-input catalogue), for the pipeline the generated scenes at a coarse
-// spacing as raw floats, and for the rawlog reader a stream of the actions the recorded
-// rawlogs lack (scan matching with each pose distribution). scripts/fuzz.sh adds the seeds
-// taken from ../shared/data.
+// spacing as raw floats, and for the rawlog reader what the recorded rawlogs lack: a stream of
+// actions (scan matching with each pose distribution, a 3D movement) and one of the other
+// sensors a robot records beside its depth camera (IMU, odometry, GNSS, point clouds, range
+// finders, JPEG camera images). scripts/fuzz.sh adds the seeds taken from ../shared/data.
 //   fuzz_seeds OUTDIR   ->  OUTDIR/{pcd,ply,xyz,kitti_bin,pipeline,rawlog}/...
 #include "io/cloud_samples.h"
 
@@ -10,8 +11,20 @@
 
 #include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
+#include <mrpt/img/CImage.h>
+#include <mrpt/maps/CColouredPointsMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CActionRobotMovement3D.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationComment.h>
+#include <mrpt/obs/CObservationGPS.h>
+#include <mrpt/obs/CObservationIMU.h>
+#include <mrpt/obs/CObservationImage.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationRange.h>
+#include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
 #include <mrpt/poses/CPosePDFGaussianInf.h>
 #include <mrpt/poses/CPosePDFGrid.h>
@@ -70,12 +83,89 @@ void putActionsRawlog(const fs::path& dir) {
     matched.poseChange = mrpt::containers::deepcopy_poly_ptr<mrpt::poses::CPosePDF::Ptr>(pdf);
     acts.insert(matched);
   }
+  mrpt::obs::CActionRobotMovement3D moved;
+  moved.poseChange.mean = mrpt::poses::CPose3D(0.3, 0.0, 0.01, 0.05, 0.0, 0.0);
+  acts.insert(moved);
   mrpt::io::CFileOutputStream out((dir / "actions.rawlog").string());
   auto ar = mrpt::serialization::archiveFrom(out);
   mrpt::obs::CObservationComment first, last;
   first.text = "before";
   last.text = "after";
   ar << first << acts << last;
+}
+
+// A small JPEG image of w x h pixels with a gradient (MRPT compresses colour images as JPEG).
+mrpt::img::CImage gradient(int w, int h) {
+  mrpt::img::CImage im(w, h, mrpt::img::CH_RGB);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      im.setPixel(x, y, mrpt::img::TColor(static_cast<std::uint8_t>(8 * x),
+                                          static_cast<std::uint8_t>(8 * y), 90));
+    }
+  }
+  return im;
+}
+
+// A plain rawlog object stream of the other sensors a robot records: a frame of an IMU, wheel
+// odometry, a GNSS fix (GGA and RMC), two point clouds (plain and coloured), a range finder, a
+// JPEG camera image and a small 3D scan with a JPEG intensity image; then the same bare.
+void putSensorsRawlog(const fs::path& dir) {
+  mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+  auto imu = mrpt::obs::CObservationIMU::Create();
+  imu->set(mrpt::obs::IMU_X_ACC, 0.1);
+  imu->set(mrpt::obs::IMU_Z_ACC, 9.8);
+  imu->set(mrpt::obs::IMU_WZ, 0.02);
+  auto odometry = mrpt::obs::CObservationOdometry::Create();
+  odometry->odometry = mrpt::poses::CPose2D(1.0, 0.2, 0.1);
+  odometry->hasEncodersInfo = true;
+  odometry->encoderLeftTicks = 120;
+  odometry->encoderRightTicks = 118;
+  auto gps = mrpt::obs::CObservationGPS::Create();
+  mrpt::obs::gnss::Message_NMEA_GGA gga;
+  gga.fields.latitude_degrees = 36.7;
+  gga.fields.longitude_degrees = -4.4;
+  gga.fields.fix_quality = 1;
+  gga.fields.satellitesUsed = 8;
+  gps->setMsg(gga);
+  mrpt::obs::gnss::Message_NMEA_RMC rmc;
+  rmc.fields.latitude_degrees = 36.7;
+  rmc.fields.longitude_degrees = -4.4;
+  gps->setMsg(rmc);
+  auto plain = mrpt::obs::CObservationPointCloud::Create();
+  auto points = mrpt::maps::CSimplePointsMap::Create();
+  auto coloured = mrpt::maps::CColouredPointsMap::Create();
+  for (int i = 0; i < 40; ++i) {
+    points->insertPoint(0.1f * i, 0.05f * i, 0.0f);
+    coloured->insertPointRGB(0.1f * i, 0.0f, 0.02f * i, 0.5f, 0.4f, 0.3f);
+  }
+  plain->pointcloud = points;
+  auto colour = mrpt::obs::CObservationPointCloud::Create();
+  colour->pointcloud = coloured;
+  auto range = mrpt::obs::CObservationRange::Create();
+  for (int i = 0; i < 3; ++i) {
+    mrpt::obs::CObservationRange::TMeasurement m;
+    m.sensorID = static_cast<uint16_t>(i);
+    m.sensedDistance = 0.5f + 0.25f * i;
+    range->sensedData.push_back(m);
+  }
+  auto camera = mrpt::obs::CObservationImage::Create();
+  camera->image = gradient(32, 24);
+  auto depth = mrpt::obs::CObservation3DRangeScan::Create();
+  depth->hasRangeImage = true;
+  depth->rangeImage_setSize(24, 32);
+  depth->rangeImage.fill(1000);
+  depth->hasIntensityImage = true;
+  depth->intensityImage = gradient(32, 24);
+  depth->cameraParams.ncols = depth->cameraParamsIntensity.ncols = 32;
+  depth->cameraParams.nrows = depth->cameraParamsIntensity.nrows = 24;
+  const mrpt::obs::CObservation::Ptr all[] = {imu, odometry, gps, plain, colour, range, camera,
+                                              depth};
+  mrpt::obs::CSensoryFrame frame;
+  for (const auto& o : all) frame.insert(o);
+  mrpt::io::CFileOutputStream out((dir / "sensors.rawlog").string());
+  auto ar = mrpt::serialization::archiveFrom(out);
+  ar << frame;
+  for (const auto& o : all) ar << *o;
 }
 
 }  // namespace
@@ -115,5 +205,6 @@ int main(int argc, char** argv) {
     put(out / "pipeline", "scene_" + name, floats(p, 0));
   }
   putActionsRawlog(out / "rawlog");
+  putSensorsRawlog(out / "rawlog");
   return 0;
 }
