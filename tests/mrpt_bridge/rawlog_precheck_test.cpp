@@ -7,6 +7,10 @@
 #include "upd/mrpt_bridge/rawlog_reader.h"
 
 #include <mrpt/img/CImage.h>
+#include <mrpt/maps/CColouredPointsMap.h>
+#include <mrpt/maps/CPointsMapXYZI.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/maps/CWeightedPointsMap.h>
 #include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/math/CMatrixD.h>
@@ -17,6 +21,7 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationImage.h>
+#include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationStereoImages.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
@@ -405,6 +410,43 @@ TEST(RawlogPrecheck, ThreeDMovementVelocityCountsAreBounded) {
                          " (more than 6 components)");
   }
   EXPECT_EQ(damageReason(tmp, head + moved + "\x88", &before), "(read)");
+}
+
+// A point cloud observation's map: MRPT resizes every field to the count it reads (its aligned
+// allocator does not fail: a corrupt count had the process killed for memory, 22 GB resident)
+// and a coloured map's channels to counts of their own. Each is bounded as a 3D scan's points, in
+// every points map class; sound clouds and a null one read.
+TEST(RawlogPrecheck, PointCloudCountsAreBounded) {
+  TempDir tmp;
+  const mrpt::maps::CPointsMap::Ptr maps[] = {
+      mrpt::maps::CSimplePointsMap::Create(), mrpt::maps::CColouredPointsMap::Create(),
+      mrpt::maps::CPointsMapXYZI::Create(), mrpt::maps::CWeightedPointsMap::Create()};
+  std::size_t before = 0;
+  for (const auto& map : maps) {
+    const std::string name = map->GetRuntimeClass()->className;
+    SCOPED_TRACE(name);
+    for (int i = 0; i < 5; ++i) map->insertPoint(0.1f * i, 0.2f, 0.3f);
+    mrpt::obs::CObservationPointCloud o;
+    o.pointcloud = map;
+    const std::string good = serialized(o);
+    EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
+    const std::size_t count_at = good.find(name) + name.size() + 1;  // after the version byte
+    ASSERT_EQ(good.substr(count_at, 4), u32(5));
+    std::vector<std::pair<std::size_t, std::string>> counts = {{count_at, "point count"}};
+    if (name == "mrpt::maps::CColouredPointsMap") {
+      const std::size_t red_at = count_at + 4 + 15 * 4;
+      ASSERT_EQ(good.substr(red_at, 4), u32(5));
+      counts.push_back({red_at, "red count"});
+    }
+    for (const auto& [at, field] : counts) {
+      const std::string reason =
+          damageReason(tmp, std::string(good).replace(at, 4, u32(0xFFFFFFFFu)), &before);
+      EXPECT_EQ(reason, "corrupt CObservationPointCloud: " + field + " 4294967295 at byte " +
+                            std::to_string(before + at) + " (more than 16777216 points)");
+    }
+  }
+  mrpt::obs::CObservationPointCloud none;
+  EXPECT_EQ(damageReason(tmp, serialized(none), &before), "(read)");
 }
 
 // A TCamera before version 6 (MRPT reads versions 0-6) is walked as MRPT reads it: before version 4

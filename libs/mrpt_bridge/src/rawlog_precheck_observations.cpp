@@ -408,6 +408,55 @@ Parse stereoImages(Cursor& c, int version, std::string& why) {
   return string(c, "sensor label length", why);
 }
 
+// A point count at the cursor, bounded as a 3D scan's points.
+Parse pointCount(Cursor& c, const char* field, std::uint32_t& n, std::string& why) {
+  const std::uint64_t at = c.position();
+  if (!c.value(n)) return kOther;
+  return withinBound(field, n, at, kMaxImagePixels, "points", why) ? kRead : kImpossible;
+}
+
+// A CPointsMap object (or a null one): the point count and the coordinates, in each class a
+// count MRPT resizes every field to, then x, y, z as floats; CColouredPointsMap's colour
+// channels after them are vectors of their own counts; CPointsMapXYZI's intensities and
+// CWeightedPointsMap's weights have the point count. The map's options after the points are left
+// to MRPT (OtherLayout), as is any other layout.
+Parse pointsMap(Cursor& c, std::string& why) {
+  ObjectHeader h;
+  if (!readHeader(c, h)) return kOther;
+  if (h.class_name == "nullptr") return endOf(c, h) ? kRead : kOther;
+  const int v = h.version;
+  const bool simple = h.class_name == "CSimplePointsMap" && v <= 10;
+  const bool coloured = h.class_name == "CColouredPointsMap" && v <= 9;
+  const bool xyzi = h.class_name == "CPointsMapXYZI" && v == 0;
+  const bool weighted = h.class_name == "CWeightedPointsMap" && v <= 2;
+  if (!simple && !coloured && !xyzi && !weighted) return kOther;
+  std::uint32_t n = 0;
+  Parse p = pointCount(c, "point count", n, why);
+  if (p != kRead) return p;
+  c.skip(std::uint64_t{n} * (xyzi || weighted ? 4 : 3) * sizeof(float));
+  if (coloured) {
+    for (const char* channel : {"red count", "green count", "blue count"}) {
+      std::uint32_t k = 0;
+      if ((p = pointCount(c, channel, k, why)) != kRead) return p;
+      c.skip(std::uint64_t{k} * sizeof(float));
+    }
+  }
+  return kOther;
+}
+
+// CObservationPointCloud, version 0: label, timestamp, sensor pose, the external storage flag,
+// then a file name or the points map.
+Parse pointCloud(Cursor& c, int version, std::string& why) {
+  if (version != 0) return kOther;
+  Parse p = string(c, "sensor label length", why);
+  if (p != kRead) return p;
+  c.skip(sizeof(std::uint64_t));
+  if ((p = pose(c, why)) != kRead) return p;
+  std::uint8_t external = 0;
+  if (!c.value(external)) return kOther;
+  return external ? string(c, "external file name length", why) : pointsMap(c, why);
+}
+
 }  // namespace
 
 Parse checkPose(Cursor& c, std::string& why) { return pose(c, why); }
@@ -422,6 +471,8 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
     p = monoImage(c, h.version, why);
   } else if (h.class_name == "CObservationStereoImages") {
     p = stereoImages(c, h.version, why);
+  } else if (h.class_name == "CObservationPointCloud") {
+    p = pointCloud(c, h.version, why);
   }
   if (p != kRead) return p;
   return endOf(c, h) ? kRead : kOther;
