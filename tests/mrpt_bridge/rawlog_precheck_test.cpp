@@ -20,6 +20,7 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationComment.h>
+#include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/CObservationImage.h>
 #include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationStereoImages.h>
@@ -447,6 +448,51 @@ TEST(RawlogPrecheck, PointCloudCountsAreBounded) {
   }
   mrpt::obs::CObservationPointCloud none;
   EXPECT_EQ(damageReason(tmp, serialized(none), &before), "(read)");
+}
+
+// The walk of a frame stops at the first observation of a layout it does not know (an IMU's),
+// and MRPT would read the rest unchecked (found by fuzz_rawlog: a coloured cloud's channel count,
+// behind an IMU, made MRPT allocate gigabytes). The reader hands MRPT a frame one observation at
+// a time, each checked at its own start; an element of another kind, or a missing end flag, is
+// damage; a version-0 frame's timestamp is set on its observations, as MRPT does.
+TEST(RawlogPrecheck, FrameElementsAreEachCheckedAtTheirStart) {
+  TempDir tmp;
+  auto cloud = mrpt::obs::CObservationPointCloud::Create();
+  auto points = mrpt::maps::CSimplePointsMap::Create();
+  points->insertPoint(1.0f, 2.0f, 0.5f);
+  cloud->pointcloud = points;
+  mrpt::obs::CSensoryFrame frame;
+  frame.insert(mrpt::obs::CObservationIMU::Create());
+  frame.insert(cloud);
+  const std::string good = serialized(frame);
+  std::string why;
+  EXPECT_EQ(walked(good, &why), 0u) << "the walk was to stop at the IMU";
+  std::size_t before = 0;
+  EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
+  const std::string name = "CSimplePointsMap";
+  const std::size_t count_at = good.find(name) + name.size() + 1;
+  const std::string reason =
+      damageReason(tmp, std::string(good).replace(count_at, 4, u32(0xFFFFFFFFu)), &before);
+  EXPECT_EQ(reason, "corrupt CObservationPointCloud (observation 2 of 2 in a CSensoryFrame): "
+                    "point count 4294967295 at byte " + std::to_string(before + count_at) +
+                        " (more than 16777216 points)");
+  const std::string v2 = "\x8D" "CSensoryFrame\x02" + u32(1);
+  EXPECT_EQ(damageReason(tmp, v2 + serialized(mrpt::poses::CPose2D(1, 2, 0)) + "\x88", &before),
+            "corrupt CSensoryFrame: observation 1 of 1 is a CPose2D, not an observation");
+  mrpt::obs::CObservationComment comment;
+  EXPECT_EQ(damageReason(tmp, v2 + serialized(comment) + "\x77", &before),
+            "corrupt CSensoryFrame: no end flag after its 1 observations");
+  const std::int64_t ticks = 0x0102030405060708;
+  std::string stamp(8, '\0');
+  for (int i = 0; i < 8; ++i) stamp[i] = static_cast<char>((ticks >> (8 * i)) & 0xFF);
+  const fs::path file = tmp.path() / "v0.rawlog";
+  const std::string v0 = "\x8D" "CSensoryFrame" + std::string(1, '\0') + u32(7) + stamp + u32(1) +
+                         serialized(comment) + "\x88";
+  std::ofstream(file, std::ios::binary).write(v0.data(), static_cast<std::streamsize>(v0.size()));
+  RawlogReader reader(file.string());
+  RawlogEntry e;
+  ASSERT_TRUE(reader.next(e));
+  EXPECT_EQ(e.observation->timestamp, mrpt::Clock::time_point(mrpt::Clock::duration(ticks)));
 }
 
 // A TCamera before version 6 (MRPT reads versions 0-6) is walked as MRPT reads it: before version 4

@@ -514,9 +514,9 @@ TEST(RawlogReader, ScanMatchingPoseDistributionSizesAreCheckedBeforeMrptAllocate
   EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, sides_at, 40000u)),
             prefix + "corrupt CPosePDFGrid: sides 40000 x 5 x 5 with 25 cells a layer, at byte " +
                 std::to_string(sides_at));
-  // The same grid behind particles of version 0 (CPose2D objects), a layout the pre-check leaves
-  // to MRPT (found by fuzz_rawlog behind actions the walk then stopped at): the reader checks the
-  // grid MRPT read before it takes the mean.
+  // The same grid behind particles of version 0 (CPose2D objects), a layout the walk of the
+  // collection leaves to MRPT (found by fuzz_rawlog behind actions the walk then stopped at):
+  // the reader hands MRPT a collection one action at a time, each checked at its own start.
   mrpt::obs::CActionCollection two = scanMatched(mrpt::poses::CPosePDFParticles::Create(1));
   two.insert(*scanMatched(grid).get(0));
   writeAroundActions(file, two);
@@ -527,8 +527,9 @@ TEST(RawlogReader, ScanMatchingPoseDistributionSizesAreCheckedBeforeMrptAllocate
   EXPECT_EQ(damageAtSecondObject(file, bytes), "(read)");
   const std::size_t second_sides_at = bodyOf(bytes, "CPosePDFGrid") + 8 * sizeof(double);
   EXPECT_EQ(damageAtSecondObject(file, withInt32(bytes, second_sides_at, 40000u)),
-            "corrupt CActionRobotMovement2D (action 2 of 2 in a CActionCollection): its "
-            "CPosePDFGrid holds 125 cells for sides 40000 x 5 x 5 (25 a layer)");
+            "corrupt CActionRobotMovement2D (action 2 of 2 in a CActionCollection): corrupt "
+            "CPosePDFGrid: sides 40000 x 5 x 5 with 25 cells a layer, at byte " +
+                std::to_string(second_sides_at));
 }
 
 // A robot movement whose pose change is not finite, or moves the robot more than a kilometre

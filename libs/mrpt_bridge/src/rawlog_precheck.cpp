@@ -288,6 +288,29 @@ Parse checkMovement(Cursor& c, const ObjectHeader& h, std::string& why) {
                                                   : checkMovement3D(c, h.version, why);
 }
 
+// Action i of n in a CActionCollection, through its end flag: MRPT keeps each action as a
+// deep-copying pointer made from what it read cast to a CAction: anything else, or a null
+// object, is copied through a null pointer.
+Parse checkAction(Cursor& c, std::uint32_t i, std::uint32_t n, std::string& why) {
+  ObjectHeader action;
+  if (!readHeader(c, action)) return Parse::OtherLayout;
+  const std::string where = std::to_string(i + 1) + " of " + std::to_string(n);
+  if (action.class_name != "CActionRobotMovement2D" &&
+      action.class_name != "CActionRobotMovement3D") {
+    why = "corrupt CActionCollection: action " + where + " is " +
+          (action.class_name == "nullptr" ? std::string("a null object")
+                                          : "a " + action.class_name + ", not an action");
+    return Parse::Impossible;
+  }
+  const Parse p = checkMovement(c, action, why);
+  if (p == Parse::Impossible) {
+    why = "corrupt " + action.class_name + " (action " + where + " in a CActionCollection): " + why;
+    return p;
+  }
+  if (p == Parse::OtherLayout || (action.has_end_flag && !c.endFlag())) return Parse::OtherLayout;
+  return Parse::Read;
+}
+
 // CActionCollection::serializeFrom, version 0: a count, then the action objects.
 Parse checkActions(Cursor& c, int version, std::string& why) {
   if (version != 0) return Parse::OtherLayout;
@@ -299,27 +322,28 @@ Parse checkActions(Cursor& c, int version, std::string& why) {
     return Parse::Impossible;
   }
   for (std::uint32_t i = 0; i < actions; ++i) {
-    ObjectHeader action;
-    if (!readHeader(c, action)) return Parse::OtherLayout;
-    // MRPT keeps each action as a deep-copying pointer made from what it read cast to a CAction:
-    // anything else, or a null object, is copied through a null pointer.
-    if (action.class_name != "CActionRobotMovement2D" &&
-        action.class_name != "CActionRobotMovement3D") {
-      why = "corrupt CActionCollection: action " + std::to_string(i + 1) + " of " +
-            std::to_string(actions) + " is " +
-            (action.class_name == "nullptr" ? std::string("a null object")
-                                            : "a " + action.class_name + ", not an action");
-      return Parse::Impossible;
-    }
-    const Parse p = checkMovement(c, action, why);
-    if (p == Parse::Impossible) {
-      why = "corrupt " + action.class_name + " (action " + std::to_string(i + 1) + " of " +
-            std::to_string(actions) + " in a CActionCollection): " + why;
-      return p;
-    }
-    if (p == Parse::OtherLayout || (action.has_end_flag && !c.endFlag())) return Parse::OtherLayout;
+    const Parse p = checkAction(c, i, actions, why);
+    if (p != Parse::Read) return p;
   }
   return c.endFlag() ? Parse::Read : Parse::OtherLayout;
+}
+
+// Observation i of n in a CSensoryFrame of the version given, through its end flag.
+Parse checkFrameObservation(Cursor& c, int version, std::uint32_t i, std::uint32_t n,
+                            std::string& why) {
+  ObjectHeader obs;
+  if (!readHeader(c, obs)) return Parse::OtherLayout;
+  const std::string where = std::to_string(i + 1) + " of " + std::to_string(n);
+  if (version == 0 && obs.class_name == "nullptr") {
+    why = "corrupt CSensoryFrame: observation " + where +
+          " is a null object (MRPT sets a version-0 frame's timestamp through each)";
+    return Parse::Impossible;
+  }
+  const Parse p = checkObservation(c, obs, why);
+  if (p == Parse::Impossible) {
+    why = "corrupt " + obs.class_name + " (observation " + where + " in a CSensoryFrame): " + why;
+  }
+  return p;
 }
 
 // CSensoryFrame::serializeFrom, versions 0-2: before version 2 the frame's ID, in version 0
@@ -337,19 +361,7 @@ Parse checkFrame(Cursor& c, int version, std::string& why) {
     return Parse::Impossible;
   }
   for (std::uint32_t i = 0; i < count; ++i) {
-    ObjectHeader obs;
-    if (!readHeader(c, obs)) return Parse::OtherLayout;
-    if (version == 0 && obs.class_name == "nullptr") {
-      why = "corrupt CSensoryFrame: observation " + std::to_string(i + 1) + " of " +
-            std::to_string(count) +
-            " is a null object (MRPT sets a version-0 frame's timestamp through each)";
-      return Parse::Impossible;
-    }
-    const Parse p = checkObservation(c, obs, why);
-    if (p == Parse::Impossible) {
-      why = "corrupt " + obs.class_name + " (observation " + std::to_string(i + 1) + " of " +
-            std::to_string(count) + " in a CSensoryFrame): " + why;
-    }
+    const Parse p = checkFrameObservation(c, version, i, count, why);
     if (p != Parse::Read) return p;
   }
   return c.endFlag() ? Parse::Read : Parse::OtherLayout;
@@ -370,6 +382,34 @@ Parse checkTopLevel(Cursor& c, const ObjectHeader& top, std::string& why) {
 }
 
 }  // namespace
+
+bool peekContainerHead(LookaheadStream& in, ContainerHead& head) {
+  Cursor c(in);
+  ObjectHeader h;
+  if (!readHeader(c, h)) return false;
+  head = ContainerHead{};
+  head.frame = h.class_name == "CSensoryFrame";
+  head.version = h.version;
+  head.has_end_flag = h.has_end_flag;
+  if (head.frame && h.version >= 0 && h.version <= 2) {
+    if (h.version < 2) c.skip(sizeof(std::uint32_t));  // the ID
+    if (h.version == 0 && !c.value(head.timestamp)) return false;
+  } else if (h.class_name != "CActionCollection" || h.version != 0) {
+    return false;
+  }
+  if (!c.value(head.count)) return false;
+  head.bytes = c.walked();
+  return true;
+}
+
+std::string precheckNextElement(LookaheadStream& in, const ContainerHead& head,
+                                std::uint32_t index) {
+  Cursor c(in);
+  std::string why;
+  const Parse p = head.frame ? checkFrameObservation(c, head.version, index, head.count, why)
+                             : checkAction(c, index, head.count, why);
+  return p == Parse::Impossible ? why : std::string();
+}
 
 std::string precheckNextObject(LookaheadStream& in, std::size_t* checked_bytes) {
   if (checked_bytes) *checked_bytes = 0;

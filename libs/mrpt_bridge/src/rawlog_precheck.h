@@ -86,4 +86,26 @@ class LookaheadStream : public mrpt::io::CStream {
 /// one the checks know, to its end flag), 0 when the checks stopped before its end.
 std::string precheckNextObject(LookaheadStream& in, std::size_t* checked_bytes = nullptr);
 
+/// The head of a container the reader hands to MRPT one element at a time, so that each element
+/// is checked at its own start (the walk of the whole container stops at the first element of a
+/// layout it does not know): a CSensoryFrame (versions 0-2) or a CActionCollection (version 0).
+struct ContainerHead {
+  bool frame = false;  ///< a CSensoryFrame; else a CActionCollection
+  int version = 0;
+  bool has_end_flag = true;
+  std::uint32_t count = 0;     ///< elements (checked by precheckNextObject first)
+  std::int64_t timestamp = 0;  ///< a version-0 frame's, which MRPT sets on every observation
+  std::size_t bytes = 0;       ///< from the object's first byte to its first element
+};
+
+/// true, with its head, when the next object is such a container. Consumes nothing.
+bool peekContainerHead(LookaheadStream& in, ContainerHead& head);
+
+/// As precheckNextObject, for element `index` (0-based) of the container `head` at the stream's
+/// position, with the container walk's reasons ("corrupt CObservationPointCloud (observation 4 of
+/// 8 in a CSensoryFrame): point count ...", "corrupt CActionCollection: action 2 of 2 is a
+/// null object").
+std::string precheckNextElement(LookaheadStream& in, const ContainerHead& head,
+                                std::uint32_t index);
+
 }  // namespace upd::mrpt_bridge::detail

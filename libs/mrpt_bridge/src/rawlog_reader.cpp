@@ -14,7 +14,6 @@
 #include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/obs/CSensoryFrame.h>
-#include <mrpt/poses/CPosePDFGrid.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <algorithm>
@@ -122,24 +121,6 @@ std::string describeReadError(const std::string& what) {
 // corrupt (a flipped bit in a double), and would carry every later frame kilometres off the map.
 constexpr double kMaxMovementM = 1000.0;
 
-// A CPosePDFGrid's cells against its sides, which MRPT indexes them by when it takes the mean
-// (reading far past them where they disagree). Its sizes are protected: reached through member
-// pointers named in a derived class.
-struct GridCells : mrpt::poses::CPosePDFGrid {
-  // "" when the grid's cells are its sides' product, else why not.
-  static std::string mismatch(const mrpt::poses::CPosePDFGrid& g) {
-    const std::size_t cells = (g.*(&GridCells::m_data)).size();
-    const std::size_t x = g.getSizeX(), y = g.getSizeY(), phi = g.getSizePhi();
-    const std::size_t layer = g.*(&GridCells::m_sizeXY);
-    std::size_t xy = 0, all = 0;
-    const bool fits = !__builtin_mul_overflow(x, y, &xy) && !__builtin_mul_overflow(xy, phi, &all);
-    if (x > 0 && y > 0 && phi > 0 && fits && layer == xy && cells == all) return "";
-    return "its CPosePDFGrid holds " + std::to_string(cells) + " cells for sides " +
-           std::to_string(x) + " x " + std::to_string(y) + " x " + std::to_string(phi) + " (" +
-           std::to_string(layer) + " a layer)";
-  }
-};
-
 Eigen::Isometry3d planarIsometry(double x, double y, double phi) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.linear() = Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -147,9 +128,8 @@ Eigen::Isometry3d planarIsometry(double x, double y, double phi) {
   return t;
 }
 
-// A robot movement's increment into inc, or why its pose change cannot be used (a grid
-// distribution whose cells do not match its sides; a coordinate not finite: the robot's pose
-// would be NaN from there on; a move longer than kMaxMovementM). "" with inc unset for anything
+// A robot movement's increment into inc, or why its pose change cannot be used (a coordinate
+// not finite: the robot's pose would be NaN from there on; a move longer than kMaxMovementM). "" with inc unset for anything
 // else (another action, a 2D movement without a pose change).
 std::string movementIncrement(const mrpt::obs::CAction& a,
                               std::optional<Eigen::Isometry3d>& inc) {
@@ -162,10 +142,6 @@ std::string movementIncrement(const mrpt::obs::CAction& a,
     inc = toIsometry(p);
   } else if (const auto* m2 = dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(&a)) {
     if (!m2->poseChange) return "";
-    if (const auto* g = dynamic_cast<const mrpt::poses::CPosePDFGrid*>(m2->poseChange.get())) {
-      const std::string why = GridCells::mismatch(*g);
-      if (!why.empty()) return why;
-    }
     mrpt::poses::CPose2D p;
     try {
       p = m2->poseChange->getMeanVal();
@@ -261,6 +237,28 @@ struct RawlogReader::Impl {
     }
   }
 
+  void handleFrame(const std::vector<mrpt::obs::CObservation::Ptr>& observations,
+                   std::size_t object_index) {
+    ++stats.sensory_frames;
+    seen_frames = true;
+    if (observations.empty()) skip("empty CSensoryFrame");
+    for (const auto& obs : observations) {
+      if (!obs) {
+        skip("null observation in a CSensoryFrame");
+        continue;
+      }
+      pending.push_back({obs, object_index});
+    }
+  }
+
+  void handleCollection(const std::vector<const mrpt::obs::CAction*>& actions,
+                        std::size_t object_index, uint64_t position) {
+    ++stats.action_collections;
+    seen_frames = true;
+    if (actions.empty()) skip("empty CActionCollection");
+    handleActions(actions, true, object_index, position);
+  }
+
   void handleObject(const mrpt::serialization::CSerializable::Ptr& o, std::size_t object_index,
                     uint64_t position) {
     if (!o) {
@@ -268,25 +266,13 @@ struct RawlogReader::Impl {
       return;
     }
     if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(o)) {
-      ++stats.sensory_frames;
-      seen_frames = true;
-      if (sf->size() == 0) skip("empty CSensoryFrame");
-      for (const auto& obs : *sf) {
-        if (!obs) {
-          skip("null observation in a CSensoryFrame");
-          continue;
-        }
-        pending.push_back({obs, object_index});
-      }
+      handleFrame({sf->begin(), sf->end()}, object_index);
       return;
     }
     if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(o)) {
-      ++stats.action_collections;
-      seen_frames = true;
-      if (acts->size() == 0) skip("empty CActionCollection");
       std::vector<const mrpt::obs::CAction*> list;
       for (const auto& a : *acts) list.push_back(a ? a.get() : nullptr);
-      handleActions(list, true, object_index, position);
+      handleCollection(list, object_index, position);
       return;
     }
     if (auto obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(o)) {
@@ -302,6 +288,57 @@ struct RawlogReader::Impl {
     }
     skip("top-level " + detail::shortClassName(*o) +
          " (not an action, sensory frame or observation)");
+  }
+
+  // A sensory frame or action collection read as MRPT reads it, but one element at a time, each
+  // checked at its own start (the check of the whole container stops at the first element of a
+  // layout it does not know: what follows would reach MRPT unchecked), then handled.
+  void readContainer(const detail::ContainerHead& head, std::size_t object_index,
+                     uint64_t position) {
+    std::vector<std::uint8_t> head_bytes(head.bytes);  // the header and count, peeked
+    archive->ReadBuffer(head_bytes.data(), head_bytes.size());
+    const char* kind = head.frame ? "observation" : "action";
+    std::vector<mrpt::serialization::CSerializable::Ptr> elements(head.count);
+    for (std::uint32_t i = 0; i < head.count; ++i) {
+      const std::string why = detail::precheckNextElement(*lookahead, head, i);
+      if (!why.empty()) fail(object_index, position, why);
+      *archive >> elements[i];
+      const bool fits =
+          !elements[i] || (head.frame ? !!std::dynamic_pointer_cast<mrpt::obs::CObservation>(
+                                            elements[i])
+                                      : !!std::dynamic_pointer_cast<mrpt::obs::CAction>(
+                                            elements[i]));
+      if (!fits) {
+        fail(object_index, position,
+             std::string("corrupt ") + (head.frame ? "CSensoryFrame" : "CActionCollection") +
+                 ": " + kind + " " + std::to_string(i + 1) + " of " +
+                 std::to_string(head.count) + " is a " + detail::shortClassName(*elements[i]) +
+                 ", not an " + kind);
+      }
+    }
+    std::uint8_t end = 0x88;
+    if (head.has_end_flag) archive->ReadBuffer(&end, 1);
+    if (end != 0x88) {
+      fail(object_index, position,
+           std::string("corrupt ") + (head.frame ? "CSensoryFrame" : "CActionCollection") +
+               ": no end flag after its " + std::to_string(head.count) + " " + kind + "s");
+    }
+    if (head.frame) {
+      std::vector<mrpt::obs::CObservation::Ptr> observations;
+      for (const auto& e : elements) {
+        auto obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(e);
+        // (A version-0 frame's timestamp is its observations': MRPT sets it on each.)
+        if (obs && head.version == 0) {
+          obs->timestamp = mrpt::Clock::time_point(mrpt::Clock::duration(head.timestamp));
+        }
+        observations.push_back(std::move(obs));
+      }
+      handleFrame(observations, object_index);
+    } else {
+      std::vector<const mrpt::obs::CAction*> actions;
+      for (const auto& e : elements) actions.push_back(dynamic_cast<const mrpt::obs::CAction*>(e.get()));
+      handleCollection(actions, object_index, position);
+    }
   }
 
   [[noreturn]] void fail(std::size_t object_index, uint64_t offset, const std::string& why) {
@@ -364,9 +401,20 @@ bool RawlogReader::next(RawlogEntry& entry) {
     const uint64_t position = d.lookahead->getPosition();
     mrpt::serialization::CSerializable::Ptr object;
     std::string impossible;
+    bool read_as_container = false;
     try {
       impossible = detail::precheckNextObject(*d.lookahead);
-      if (impossible.empty()) *d.archive >> object;
+      detail::ContainerHead head;
+      if (!impossible.empty()) {
+        // (reported below)
+      } else if (detail::peekContainerHead(*d.lookahead, head)) {
+        d.readContainer(head, object_index, position);
+        read_as_container = true;
+      } else {
+        *d.archive >> object;
+      }
+    } catch (const RawlogError&) {
+      throw;
     } catch (const mrpt::serialization::CExceptionEOF& e) {
       if (d.lookahead->getPosition() != position) {
         d.fail(object_index, position,
@@ -380,7 +428,8 @@ bool RawlogReader::next(RawlogEntry& entry) {
       d.fail(object_index, position, "corrupt or truncated (" + describeReadError(e.what()) + ")");
     }
     if (!impossible.empty()) d.fail(object_index, position, impossible);
-    d.handleObject(object, object_index, position);  // (may find the object's actions damaged)
+    // (may find the object's actions damaged)
+    if (!read_as_container) d.handleObject(object, object_index, position);
     ++d.stats.objects;
   }
 }
