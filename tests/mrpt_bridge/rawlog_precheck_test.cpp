@@ -109,6 +109,12 @@ mrpt::obs::CObservationStereoImages::Ptr stereo() {
   return o;
 }
 
+mrpt::obs::CObservationComment::Ptr note() {
+  auto o = mrpt::obs::CObservationComment::Create();
+  o->text = "COMMENTTEXT";
+  return o;
+}
+
 std::size_t walked(const std::string& bytes, std::string* why = nullptr) {
   mrpt::io::CMemoryStream mem;
   mem.assignMemoryNotOwn(bytes.data(), bytes.size());
@@ -131,6 +137,7 @@ TEST(RawlogPrecheck, ObjectsMrptWritesAreWalkedToTheirEnd) {
     frame.insert(scan3D());
     frame.insert(greyImage());
     frame.insert(stereo());
+    frame.insert(note());
     mrpt::obs::CActionCollection actions;
     mrpt::obs::CActionRobotMovement2D odometry;
     odometry.estimationMethod = mrpt::obs::CActionRobotMovement2D::emOdometry;
@@ -153,9 +160,10 @@ TEST(RawlogPrecheck, ObjectsMrptWritesAreWalkedToTheirEnd) {
     actions.insert(moved);
     actions.insert(odometry);
     const mrpt::serialization::CSerializable::Ptr bare[] = {scan2D(), scan3D(), greyImage(),
-                                                            stereo()};
+                                                            stereo(), note()};
     const mrpt::serialization::CSerializable* objects[] = {
-        bare[0].get(), bare[1].get(), bare[2].get(), bare[3].get(), &frame, &actions, &moved};
+        bare[0].get(), bare[1].get(), bare[2].get(), bare[3].get(), bare[4].get(),
+        &frame,        &actions,      &moved};
     for (const auto* o : objects) {
       SCOPED_TRACE(std::string(o->GetRuntimeClass()->className) + (jpeg ? " (JPEG)" : ""));
       const std::string bytes = serialized(*o);
@@ -217,6 +225,9 @@ std::vector<Corruption> corruptions(bool in_frame) {
        " (more than 65535 pixels)"},
       {"grey image height", wrap(greyImage()), u32(37) + u32(29), 4, u32(0x80000000u),
        im + "image height 2147483648", " (more than 65535 pixels)"},
+      {"comment", wrap(note()), u32(11) + "COMMENTTEXT", 0, ones,
+       "corrupt CObservationComment" + where + "comment length 4294967295",
+       " (more than 16777216 bytes)"},
       {"JPEG size", stereo_bytes, u32(48) + u32(40), 8, ones, st + "image JPEG size 4294967295",
        " (more than 268435456 bytes)"},
   };

@@ -53,6 +53,8 @@ constexpr std::uint32_t kMaxImageSide = 65535;
 constexpr std::uint32_t kMaxEncodedImageBytes = 1u << 28;
 /// Most bytes of a string (a sensor label, a camera name, an external file name).
 constexpr std::uint32_t kMaxStringBytes = 1u << 16;
+/// Most bytes of a CObservationComment's text (a note, a configuration block).
+constexpr std::uint32_t kMaxCommentBytes = 1u << 24;
 
 /// A read-only stream over another that can look at the bytes ahead of its position without
 /// consuming them. Its position is the count of bytes consumed (the underlying stream's

@@ -28,11 +28,12 @@ bool header(Cursor& c, ObjectHeader& h, std::initializer_list<const char*> class
 bool endOf(Cursor& c, const ObjectHeader& h) { return !h.has_end_flag || c.endFlag(); }
 
 // A std::string: a 32-bit length, then the bytes (MRPT resizes the string to the length first).
-Parse string(Cursor& c, const char* field, std::string& why) {
+Parse string(Cursor& c, const char* field, std::string& why,
+             std::uint32_t max_bytes = kMaxStringBytes) {
   const std::uint64_t at = c.position();
   std::uint32_t length = 0;
   if (!c.value(length)) return kOther;
-  if (!withinBound(field, length, at, kMaxStringBytes, "bytes", why)) return kImpossible;
+  if (!withinBound(field, length, at, max_bytes, "bytes", why)) return kImpossible;
   c.skip(length);
   return kRead;
 }
@@ -457,6 +458,14 @@ Parse pointCloud(Cursor& c, int version, std::string& why) {
   return external ? string(c, "external file name length", why) : pointsMap(c, why);
 }
 
+// CObservationComment, version 0: the text, then the timestamp.
+Parse comment(Cursor& c, int version, std::string& why) {
+  if (version != 0) return kOther;
+  const Parse p = string(c, "comment length", why, kMaxCommentBytes);
+  c.skip(sizeof(std::uint64_t));
+  return p;
+}
+
 }  // namespace
 
 Parse checkPose(Cursor& c, std::string& why) { return pose(c, why); }
@@ -473,6 +482,8 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
     p = stereoImages(c, h.version, why);
   } else if (h.class_name == "CObservationPointCloud") {
     p = pointCloud(c, h.version, why);
+  } else if (h.class_name == "CObservationComment") {
+    p = comment(c, h.version, why);
   }
   if (p != kRead) return p;
   return endOf(c, h) ? kRead : kOther;
