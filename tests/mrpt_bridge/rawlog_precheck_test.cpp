@@ -23,6 +23,7 @@
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/CObservationImage.h>
 #include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationRange.h>
 #include <mrpt/obs/CObservationStereoImages.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
@@ -109,6 +110,19 @@ mrpt::obs::CObservationStereoImages::Ptr stereo() {
   return o;
 }
 
+mrpt::obs::CObservationRange::Ptr sonars() {
+  auto o = mrpt::obs::CObservationRange::Create();
+  for (int i = 0; i < 3; ++i) {
+    mrpt::obs::CObservationRange::TMeasurement m;
+    m.sensorID = static_cast<std::uint16_t>(i);
+    m.sensedDistance = 0.5f + i;
+    o->sensedData.push_back(m);
+  }
+  o->sensorConeApperture = 0.3f;  // the bytes before the count: 9a 99 99 3e
+  o->sensorLabel = "SONARS";
+  return o;
+}
+
 mrpt::obs::CObservationComment::Ptr note() {
   auto o = mrpt::obs::CObservationComment::Create();
   o->text = "COMMENTTEXT";
@@ -138,6 +152,7 @@ TEST(RawlogPrecheck, ObjectsMrptWritesAreWalkedToTheirEnd) {
     frame.insert(greyImage());
     frame.insert(stereo());
     frame.insert(note());
+    frame.insert(sonars());
     mrpt::obs::CActionCollection actions;
     mrpt::obs::CActionRobotMovement2D odometry;
     odometry.estimationMethod = mrpt::obs::CActionRobotMovement2D::emOdometry;
@@ -160,10 +175,10 @@ TEST(RawlogPrecheck, ObjectsMrptWritesAreWalkedToTheirEnd) {
     actions.insert(moved);
     actions.insert(odometry);
     const mrpt::serialization::CSerializable::Ptr bare[] = {scan2D(), scan3D(), greyImage(),
-                                                            stereo(), note()};
+                                                            stereo(), note(),   sonars()};
     const mrpt::serialization::CSerializable* objects[] = {
         bare[0].get(), bare[1].get(), bare[2].get(), bare[3].get(), bare[4].get(),
-        &frame,        &actions,      &moved};
+        bare[5].get(), &frame,        &actions,      &moved};
     for (const auto* o : objects) {
       SCOPED_TRACE(std::string(o->GetRuntimeClass()->className) + (jpeg ? " (JPEG)" : ""));
       const std::string bytes = serialized(*o);
@@ -228,6 +243,9 @@ std::vector<Corruption> corruptions(bool in_frame) {
       {"comment", wrap(note()), u32(11) + "COMMENTTEXT", 0, ones,
        "corrupt CObservationComment" + where + "comment length 4294967295",
        " (more than 16777216 bytes)"},
+      {"range measurements", wrap(sonars()), std::string("\x9a\x99\x99\x3e", 4) + u32(3), 4, ones,
+       "corrupt CObservationRange" + where + "measurement count 4294967295",
+       " (more than 65536 measurements)"},
       {"JPEG size", stereo_bytes, u32(48) + u32(40), 8, ones, st + "image JPEG size 4294967295",
        " (more than 268435456 bytes)"},
   };

@@ -53,6 +53,8 @@ constexpr std::uint32_t kMaxImageSide = 65535;
 constexpr std::uint32_t kMaxEncodedImageBytes = 1u << 28;
 /// Most bytes of a string (a sensor label, a camera name, an external file name).
 constexpr std::uint32_t kMaxStringBytes = 1u << 16;
+/// Most measurements of a CObservationRange (a ring of sonars or infrared rangers gives tens).
+constexpr std::uint32_t kMaxRangeMeasurements = 65536;
 /// Most bytes of a CObservationComment's text (a note, a configuration block).
 constexpr std::uint32_t kMaxCommentBytes = 1u << 24;
 

@@ -466,6 +466,29 @@ Parse comment(Cursor& c, int version, std::string& why) {
   return p;
 }
 
+// CObservationRange, version 3: the minimum and maximum range and the cone's aperture, a count of
+// measurements (MRPT resizes its list to it), each an ID, the sensor's pose (a CPose3D object)
+// and the distance; the label and the timestamp.
+Parse ranges(Cursor& c, int version, std::string& why) {
+  if (version != 3) return kOther;
+  c.skip(3 * sizeof(float));
+  const std::uint64_t at = c.position();
+  std::uint32_t n = 0;
+  if (!c.value(n)) return kOther;
+  if (!withinBound("measurement count", n, at, kMaxRangeMeasurements, "measurements", why)) {
+    return kImpossible;
+  }
+  Parse p = kRead;
+  for (std::uint32_t i = 0; i < n && p == kRead; ++i) {
+    c.skip(sizeof(std::uint16_t));
+    p = pose(c, why);
+    c.skip(sizeof(float));
+  }
+  if (p != kRead || (p = string(c, "sensor label length", why)) != kRead) return p;
+  c.skip(sizeof(std::uint64_t));
+  return kRead;
+}
+
 }  // namespace
 
 Parse checkPose(Cursor& c, std::string& why) { return pose(c, why); }
@@ -484,6 +507,8 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
     p = pointCloud(c, h.version, why);
   } else if (h.class_name == "CObservationComment") {
     p = comment(c, h.version, why);
+  } else if (h.class_name == "CObservationRange") {
+    p = ranges(c, h.version, why);
   }
   if (p != kRead) return p;
   return endOf(c, h) ? kRead : kOther;
