@@ -2,17 +2,13 @@
 // end (the check follows the layout byte for byte), and each size MRPT would allocate from,
 // corrupted in a file written here, is damage naming the object, the field and its byte.
 #include "../../libs/mrpt_bridge/src/rawlog_precheck.h"
+#include "rawlog_bytes.h"
 #include "rawlog_damage.h"
 #include "temp_dir.h"
 #include "upd/mrpt_bridge/rawlog_reader.h"
 
 #include <mrpt/img/CImage.h>
-#include <mrpt/maps/CColouredPointsMap.h>
-#include <mrpt/maps/CPointsMapXYZI.h>
-#include <mrpt/maps/CSimplePointsMap.h>
-#include <mrpt/maps/CWeightedPointsMap.h>
 #include <mrpt/io/CFileOutputStream.h>
-#include <mrpt/io/CMemoryStream.h>
 #include <mrpt/math/CMatrixD.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
@@ -22,7 +18,7 @@
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationIMU.h>
 #include <mrpt/obs/CObservationImage.h>
-#include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CObservationRange.h>
 #include <mrpt/obs/CObservationStereoImages.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -45,23 +41,11 @@ namespace fs = std::filesystem;
 using upd::mrpt_bridge::RawlogEntry;
 using upd::mrpt_bridge::RawlogError;
 using upd::mrpt_bridge::RawlogReader;
-using upd::mrpt_bridge::detail::LookaheadStream;
-using upd::mrpt_bridge::detail::precheckNextObject;
+using upd::test::damageReason;
+using upd::test::serialized;
 using upd::test::TempDir;
-
-std::string serialized(const mrpt::serialization::CSerializable& o) {
-  mrpt::io::CMemoryStream mem;
-  mrpt::serialization::archiveFrom(mem) << o;
-  const auto* data = static_cast<const char*>(mem.getRawBufferData());
-  return std::string(data, data + mem.getTotalBytesCount());
-}
-
-// The distinctive sizes below are found in the bytes by value (the payloads are zeros).
-std::string u32(std::uint32_t v) {
-  std::string s(4, '\0');
-  for (int i = 0; i < 4; ++i) s[i] = static_cast<char>((v >> (8 * i)) & 0xFF);
-  return s;
-}
+using upd::test::u32;
+using upd::test::walked;
 
 mrpt::obs::CObservation2DRangeScan::Ptr scan2D() {
   auto s = mrpt::obs::CObservation2DRangeScan::Create();
@@ -123,21 +107,25 @@ mrpt::obs::CObservationRange::Ptr sonars() {
   return o;
 }
 
+mrpt::obs::CObservationIMU::Ptr inertial() {
+  auto o = mrpt::obs::CObservationIMU::Create();
+  o->set(mrpt::obs::IMU_Z_ACC, 9.8);
+  o->sensorLabel = "IMULABEL";
+  return o;
+}
+
+mrpt::obs::CObservationOdometry::Ptr wheels(bool encoders) {
+  auto o = mrpt::obs::CObservationOdometry::Create();
+  o->odometry = mrpt::poses::CPose2D(1.0, 0.5, 0.1);
+  o->hasEncodersInfo = o->hasVelocities = encoders;
+  o->sensorLabel = "WHEELS";
+  return o;
+}
+
 mrpt::obs::CObservationComment::Ptr note() {
   auto o = mrpt::obs::CObservationComment::Create();
   o->text = "COMMENTTEXT";
   return o;
-}
-
-std::size_t walked(const std::string& bytes, std::string* why = nullptr) {
-  mrpt::io::CMemoryStream mem;
-  mem.assignMemoryNotOwn(bytes.data(), bytes.size());
-  LookaheadStream in(mem);
-  std::size_t checked = 0;
-  const std::string reason = precheckNextObject(in, &checked);
-  if (why) *why = reason;
-  EXPECT_EQ(in.getPosition(), 0u) << "the check consumed bytes";
-  return checked;
 }
 
 // Every field of every object MRPT writes is where the check expects it: the walk ends exactly at
@@ -153,6 +141,9 @@ TEST(RawlogPrecheck, ObjectsMrptWritesAreWalkedToTheirEnd) {
     frame.insert(stereo());
     frame.insert(note());
     frame.insert(sonars());
+    frame.insert(inertial());
+    frame.insert(wheels(true));
+    frame.insert(wheels(false));
     mrpt::obs::CActionCollection actions;
     mrpt::obs::CActionRobotMovement2D odometry;
     odometry.estimationMethod = mrpt::obs::CActionRobotMovement2D::emOdometry;
@@ -175,10 +166,10 @@ TEST(RawlogPrecheck, ObjectsMrptWritesAreWalkedToTheirEnd) {
     actions.insert(moved);
     actions.insert(odometry);
     const mrpt::serialization::CSerializable::Ptr bare[] = {scan2D(), scan3D(), greyImage(),
-                                                            stereo(), note(),   sonars()};
-    const mrpt::serialization::CSerializable* objects[] = {
-        bare[0].get(), bare[1].get(), bare[2].get(), bare[3].get(), bare[4].get(),
-        bare[5].get(), &frame,        &actions,      &moved};
+                                                            stereo(), note(),   sonars(),
+                                                            inertial(), wheels(true)};
+    std::vector<const mrpt::serialization::CSerializable*> objects = {&frame, &actions, &moved};
+    for (const auto& o : bare) objects.push_back(o.get());
     for (const auto* o : objects) {
       SCOPED_TRACE(std::string(o->GetRuntimeClass()->className) + (jpeg ? " (JPEG)" : ""));
       const std::string bytes = serialized(*o);
@@ -246,6 +237,12 @@ std::vector<Corruption> corruptions(bool in_frame) {
       {"range measurements", wrap(sonars()), std::string("\x9a\x99\x99\x3e", 4) + u32(3), 4, ones,
        "corrupt CObservationRange" + where + "measurement count 4294967295",
        " (more than 65536 measurements)"},
+      {"IMU label", wrap(inertial()), u32(8) + "IMULABEL", 0, ones,
+       "corrupt CObservationIMU" + where + "sensor label length 4294967295",
+       " (more than 65536 bytes)"},
+      {"odometry label", wrap(wheels(true)), u32(6) + "WHEELS", 0, ones,
+       "corrupt CObservationOdometry" + where + "sensor label length 4294967295",
+       " (more than 65536 bytes)"},
       {"JPEG size", stereo_bytes, u32(48) + u32(40), 8, ones, st + "image JPEG size 4294967295",
        " (more than 268435456 bytes)"},
   };
@@ -286,21 +283,6 @@ TEST(RawlogPrecheck, CorruptSizesAreDamageNamingObjectFieldAndByte) {
       }
     }
   }
-}
-
-// The reason RawlogReader gives for a file of a comment and then `object`.
-std::string damageReason(const TempDir& tmp, const std::string& object, std::size_t* head_size) {
-  mrpt::obs::CObservationComment before;
-  before.text = "before";
-  const std::string head = serialized(before);
-  *head_size = head.size();
-  std::size_t offset = 0;
-  const std::string reason =
-      upd::test::damageAtSecondObject(tmp.path() / "damaged.rawlog", head + object, &offset);
-  if (reason != "(read)") {
-    EXPECT_EQ(offset, head.size());
-  }
-  return reason;
 }
 
 // MRPT decodes an image's JPEG with libjpeg's default error handler, which ends the process on a
@@ -413,115 +395,6 @@ TEST(RawlogPrecheck, CollectionsHoldOnlyActions) {
                          &before),
             "corrupt CActionCollection: action 1 of 2 is a CPose2D, not an action");
   EXPECT_EQ(damageReason(tmp, head + action + action + "\x88", &before), "(read)");
-}
-
-// A 3D movement's velocity flags and velocities are each a count MRPT resizes to, then the
-// elements (MRPT writes 6 of each): a count past 6 is damage, in a collection or bare.
-TEST(RawlogPrecheck, ThreeDMovementVelocityCountsAreBounded) {
-  TempDir tmp;
-  const std::string moved = serialized(mrpt::obs::CActionRobotMovement3D());
-  const std::size_t velocities_at = moved.size() - 1 - 8 - 6 * 4 - 4;  // before the timestamp
-  const std::size_t flags_at = velocities_at - 6 - 4;
-  ASSERT_EQ(moved.substr(flags_at, 4), u32(6));
-  ASSERT_EQ(moved.substr(velocities_at, 4), u32(6));
-  const std::string head = "\x91" "CActionCollection" + std::string(1, '\0') + u32(1);
-  std::size_t before = 0;
-  for (const auto& [at, field] : {std::pair{flags_at, "velocity flag count"},
-                                  std::pair{velocities_at, "velocity count"}}) {
-    const std::string bad = std::string(moved).replace(at, 4, u32(0xFFFFFFFFu));
-    const std::string in_collection = damageReason(tmp, head + bad + "\x88", &before);
-    EXPECT_EQ(in_collection,
-              "corrupt CActionRobotMovement3D (action 1 of 1 in a CActionCollection): " +
-                  std::string(field) + " 4294967295 at byte " +
-                  std::to_string(before + head.size() + at) + " (more than 6 components)");
-    const std::string alone = damageReason(tmp, bad, &before);
-    EXPECT_EQ(alone, "corrupt CActionRobotMovement3D: " + std::string(field) +
-                         " 4294967295 at byte " + std::to_string(before + at) +
-                         " (more than 6 components)");
-  }
-  EXPECT_EQ(damageReason(tmp, head + moved + "\x88", &before), "(read)");
-}
-
-// A point cloud observation's map: MRPT resizes every field to the count it reads (its aligned
-// allocator does not fail: a corrupt count had the process killed for memory, 22 GB resident)
-// and a coloured map's channels to counts of their own. Each is bounded as a 3D scan's points, in
-// every points map class; sound clouds and a null one read.
-TEST(RawlogPrecheck, PointCloudCountsAreBounded) {
-  TempDir tmp;
-  const mrpt::maps::CPointsMap::Ptr maps[] = {
-      mrpt::maps::CSimplePointsMap::Create(), mrpt::maps::CColouredPointsMap::Create(),
-      mrpt::maps::CPointsMapXYZI::Create(), mrpt::maps::CWeightedPointsMap::Create()};
-  std::size_t before = 0;
-  for (const auto& map : maps) {
-    const std::string name = map->GetRuntimeClass()->className;
-    SCOPED_TRACE(name);
-    for (int i = 0; i < 5; ++i) map->insertPoint(0.1f * i, 0.2f, 0.3f);
-    mrpt::obs::CObservationPointCloud o;
-    o.pointcloud = map;
-    const std::string good = serialized(o);
-    EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
-    const std::size_t count_at = good.find(name) + name.size() + 1;  // after the version byte
-    ASSERT_EQ(good.substr(count_at, 4), u32(5));
-    std::vector<std::pair<std::size_t, std::string>> counts = {{count_at, "point count"}};
-    if (name == "mrpt::maps::CColouredPointsMap") {
-      const std::size_t red_at = count_at + 4 + 15 * 4;
-      ASSERT_EQ(good.substr(red_at, 4), u32(5));
-      counts.push_back({red_at, "red count"});
-    }
-    for (const auto& [at, field] : counts) {
-      const std::string reason =
-          damageReason(tmp, std::string(good).replace(at, 4, u32(0xFFFFFFFFu)), &before);
-      EXPECT_EQ(reason, "corrupt CObservationPointCloud: " + field + " 4294967295 at byte " +
-                            std::to_string(before + at) + " (more than 16777216 points)");
-    }
-  }
-  mrpt::obs::CObservationPointCloud none;
-  EXPECT_EQ(damageReason(tmp, serialized(none), &before), "(read)");
-}
-
-// The walk of a frame stops at the first observation of a layout it does not know (an IMU's),
-// and MRPT would read the rest unchecked (found by fuzz_rawlog: a coloured cloud's channel count,
-// behind an IMU, made MRPT allocate gigabytes). The reader hands MRPT a frame one observation at
-// a time, each checked at its own start; an element of another kind, or a missing end flag, is
-// damage; a version-0 frame's timestamp is set on its observations, as MRPT does.
-TEST(RawlogPrecheck, FrameElementsAreEachCheckedAtTheirStart) {
-  TempDir tmp;
-  auto cloud = mrpt::obs::CObservationPointCloud::Create();
-  auto points = mrpt::maps::CSimplePointsMap::Create();
-  points->insertPoint(1.0f, 2.0f, 0.5f);
-  cloud->pointcloud = points;
-  mrpt::obs::CSensoryFrame frame;
-  frame.insert(mrpt::obs::CObservationIMU::Create());
-  frame.insert(cloud);
-  const std::string good = serialized(frame);
-  std::string why;
-  EXPECT_EQ(walked(good, &why), 0u) << "the walk was to stop at the IMU";
-  std::size_t before = 0;
-  EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
-  const std::string name = "CSimplePointsMap";
-  const std::size_t count_at = good.find(name) + name.size() + 1;
-  const std::string reason =
-      damageReason(tmp, std::string(good).replace(count_at, 4, u32(0xFFFFFFFFu)), &before);
-  EXPECT_EQ(reason, "corrupt CObservationPointCloud (observation 2 of 2 in a CSensoryFrame): "
-                    "point count 4294967295 at byte " + std::to_string(before + count_at) +
-                        " (more than 16777216 points)");
-  const std::string v2 = "\x8D" "CSensoryFrame\x02" + u32(1);
-  EXPECT_EQ(damageReason(tmp, v2 + serialized(mrpt::poses::CPose2D(1, 2, 0)) + "\x88", &before),
-            "corrupt CSensoryFrame: observation 1 of 1 is a CPose2D, not an observation");
-  mrpt::obs::CObservationComment comment;
-  EXPECT_EQ(damageReason(tmp, v2 + serialized(comment) + "\x77", &before),
-            "corrupt CSensoryFrame: no end flag after its 1 observations");
-  const std::int64_t ticks = 0x0102030405060708;
-  std::string stamp(8, '\0');
-  for (int i = 0; i < 8; ++i) stamp[i] = static_cast<char>((ticks >> (8 * i)) & 0xFF);
-  const fs::path file = tmp.path() / "v0.rawlog";
-  const std::string v0 = "\x8D" "CSensoryFrame" + std::string(1, '\0') + u32(7) + stamp + u32(1) +
-                         serialized(comment) + "\x88";
-  std::ofstream(file, std::ios::binary).write(v0.data(), static_cast<std::streamsize>(v0.size()));
-  RawlogReader reader(file.string());
-  RawlogEntry e;
-  ASSERT_TRUE(reader.next(e));
-  EXPECT_EQ(e.observation->timestamp, mrpt::Clock::time_point(mrpt::Clock::duration(ticks)));
 }
 
 // A TCamera before version 6 (MRPT reads versions 0-6) is walked as MRPT reads it: before version 4

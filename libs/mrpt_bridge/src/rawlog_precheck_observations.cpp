@@ -9,6 +9,8 @@
 
 #include <jpeglib.h>
 
+#include <mrpt/obs/CObservationIMU.h>  // COUNT_IMU_DATA_FIELDS
+
 namespace upd::mrpt_bridge::detail {
 namespace {
 
@@ -489,6 +491,34 @@ Parse ranges(Cursor& c, int version, std::string& why) {
   return kRead;
 }
 
+// CObservationIMU, version 4: the sensor pose, a flag for each of MRPT's IMU fields, the
+// timestamp, a double for each field, the label.
+Parse imu(Cursor& c, int version, std::string& why) {
+  if (version != 4) return kOther;
+  const Parse p = pose(c, why);
+  if (p != kRead) return p;
+  c.skip(mrpt::obs::COUNT_IMU_DATA_FIELDS * (1 + sizeof(double)) + sizeof(std::uint64_t));
+  return string(c, "sensor label length", why);
+}
+
+// CObservationOdometry, versions 0-2: the odometry (a CPose2D object), label, timestamp; from
+// version 1 the encoder ticks (always in version 1, after their flag in 2) and the velocities
+// (two floats in version 1, a TTwist2D after their flag in 2).
+Parse odometry(Cursor& c, int version, std::string& why) {
+  if (version > 2) return kOther;
+  Parse p = pose(c, why);
+  if (p != kRead || (p = string(c, "sensor label length", why)) != kRead) return p;
+  c.skip(sizeof(std::uint64_t));
+  if (version == 0) return kRead;
+  std::uint8_t encoders = 0, velocities = 0;
+  if (!c.value(encoders)) return kOther;
+  if (encoders || version < 2) c.skip(2 * sizeof(std::int32_t));
+  if (!c.value(velocities)) return kOther;
+  if (version < 2) c.skip(2 * sizeof(float));
+  if (version == 2 && velocities) c.skip(3 * sizeof(double));
+  return kRead;
+}
+
 }  // namespace
 
 Parse checkPose(Cursor& c, std::string& why) { return pose(c, why); }
@@ -509,6 +539,10 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
     p = comment(c, h.version, why);
   } else if (h.class_name == "CObservationRange") {
     p = ranges(c, h.version, why);
+  } else if (h.class_name == "CObservationIMU") {
+    p = imu(c, h.version, why);
+  } else if (h.class_name == "CObservationOdometry") {
+    p = odometry(c, h.version, why);
   }
   if (p != kRead) return p;
   return endOf(c, h) ? kRead : kOther;

@@ -1,0 +1,148 @@
+// The rawlog pre-check on what robots record beside depth images (3D movements, point clouds, the
+// observations of a frame behind one the check does not know): each size MRPT allocates from,
+// corrupted in bytes MRPT wrote, is damage at its object.
+#include "rawlog_bytes.h"
+#include "upd/mrpt_bridge/rawlog_reader.h"
+
+#include <mrpt/maps/CColouredPointsMap.h>
+#include <mrpt/maps/CPointsMapXYZI.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/maps/CWeightedPointsMap.h>
+#include <mrpt/obs/CActionRobotMovement3D.h>
+#include <mrpt/obs/CObservationComment.h>
+#include <mrpt/obs/CObservationGPS.h>
+#include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose2D.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using upd::mrpt_bridge::RawlogEntry;
+using upd::mrpt_bridge::RawlogReader;
+using upd::test::damageReason;
+using upd::test::serialized;
+using upd::test::TempDir;
+using upd::test::u32;
+using upd::test::walked;
+
+// A 3D movement's velocity flags and velocities are each a count MRPT resizes to, then the
+// elements (MRPT writes 6 of each): a count past 6 is damage, in a collection or bare.
+TEST(RawlogPrecheck, ThreeDMovementVelocityCountsAreBounded) {
+  TempDir tmp;
+  const std::string moved = serialized(mrpt::obs::CActionRobotMovement3D());
+  const std::size_t velocities_at = moved.size() - 1 - 8 - 6 * 4 - 4;  // before the timestamp
+  const std::size_t flags_at = velocities_at - 6 - 4;
+  ASSERT_EQ(moved.substr(flags_at, 4), u32(6));
+  ASSERT_EQ(moved.substr(velocities_at, 4), u32(6));
+  const std::string head = "\x91" "CActionCollection" + std::string(1, '\0') + u32(1);
+  std::size_t before = 0;
+  for (const auto& [at, field] : {std::pair{flags_at, "velocity flag count"},
+                                  std::pair{velocities_at, "velocity count"}}) {
+    const std::string bad = std::string(moved).replace(at, 4, u32(0xFFFFFFFFu));
+    const std::string in_collection = damageReason(tmp, head + bad + "\x88", &before);
+    EXPECT_EQ(in_collection,
+              "corrupt CActionRobotMovement3D (action 1 of 1 in a CActionCollection): " +
+                  std::string(field) + " 4294967295 at byte " +
+                  std::to_string(before + head.size() + at) + " (more than 6 components)");
+    const std::string alone = damageReason(tmp, bad, &before);
+    EXPECT_EQ(alone, "corrupt CActionRobotMovement3D: " + std::string(field) +
+                         " 4294967295 at byte " + std::to_string(before + at) +
+                         " (more than 6 components)");
+  }
+  EXPECT_EQ(damageReason(tmp, head + moved + "\x88", &before), "(read)");
+}
+
+// A point cloud observation's map: MRPT resizes every field to the count it reads (its aligned
+// allocator does not fail: a corrupt count had the process killed for memory, 22 GB resident)
+// and a coloured map's channels to counts of their own. Each is bounded as a 3D scan's points, in
+// every points map class; sound clouds and a null one read.
+TEST(RawlogPrecheck, PointCloudCountsAreBounded) {
+  TempDir tmp;
+  const mrpt::maps::CPointsMap::Ptr maps[] = {
+      mrpt::maps::CSimplePointsMap::Create(), mrpt::maps::CColouredPointsMap::Create(),
+      mrpt::maps::CPointsMapXYZI::Create(), mrpt::maps::CWeightedPointsMap::Create()};
+  std::size_t before = 0;
+  for (const auto& map : maps) {
+    const std::string name = map->GetRuntimeClass()->className;
+    SCOPED_TRACE(name);
+    for (int i = 0; i < 5; ++i) map->insertPoint(0.1f * i, 0.2f, 0.3f);
+    mrpt::obs::CObservationPointCloud o;
+    o.pointcloud = map;
+    const std::string good = serialized(o);
+    EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
+    const std::size_t count_at = good.find(name) + name.size() + 1;  // after the version byte
+    ASSERT_EQ(good.substr(count_at, 4), u32(5));
+    std::vector<std::pair<std::size_t, std::string>> counts = {{count_at, "point count"}};
+    if (name == "mrpt::maps::CColouredPointsMap") {
+      const std::size_t red_at = count_at + 4 + 15 * 4;
+      ASSERT_EQ(good.substr(red_at, 4), u32(5));
+      counts.push_back({red_at, "red count"});
+    }
+    for (const auto& [at, field] : counts) {
+      const std::string reason =
+          damageReason(tmp, std::string(good).replace(at, 4, u32(0xFFFFFFFFu)), &before);
+      EXPECT_EQ(reason, "corrupt CObservationPointCloud: " + field + " 4294967295 at byte " +
+                            std::to_string(before + at) + " (more than 16777216 points)");
+    }
+  }
+  mrpt::obs::CObservationPointCloud none;
+  EXPECT_EQ(damageReason(tmp, serialized(none), &before), "(read)");
+}
+
+// The walk of a frame stops at the first observation of a layout it does not know (a GNSS
+// receiver's), and MRPT would read the rest unchecked (found by fuzz_rawlog: a coloured cloud's
+// channel count, behind an IMU reading the walk did not know then, made MRPT allocate
+// gigabytes). The reader hands MRPT a frame one observation at a time, each checked at its own
+// start; an element of another kind, or a missing end flag, is damage; a version-0 frame's
+// timestamp is set on its observations, as MRPT does.
+TEST(RawlogPrecheck, FrameElementsAreEachCheckedAtTheirStart) {
+  TempDir tmp;
+  auto cloud = mrpt::obs::CObservationPointCloud::Create();
+  auto points = mrpt::maps::CSimplePointsMap::Create();
+  points->insertPoint(1.0f, 2.0f, 0.5f);
+  cloud->pointcloud = points;
+  mrpt::obs::CSensoryFrame frame;
+  frame.insert(mrpt::obs::CObservationGPS::Create());
+  frame.insert(cloud);
+  const std::string good = serialized(frame);
+  std::string why;
+  EXPECT_EQ(walked(good, &why), 0u) << "the walk was to stop at the GNSS observation";
+  std::size_t before = 0;
+  EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
+  const std::string name = "CSimplePointsMap";
+  const std::size_t count_at = good.find(name) + name.size() + 1;
+  const std::string reason =
+      damageReason(tmp, std::string(good).replace(count_at, 4, u32(0xFFFFFFFFu)), &before);
+  EXPECT_EQ(reason, "corrupt CObservationPointCloud (observation 2 of 2 in a CSensoryFrame): "
+                    "point count 4294967295 at byte " + std::to_string(before + count_at) +
+                        " (more than 16777216 points)");
+  const std::string v2 = "\x8D" "CSensoryFrame\x02" + u32(1);
+  EXPECT_EQ(damageReason(tmp, v2 + serialized(mrpt::poses::CPose2D(1, 2, 0)) + "\x88", &before),
+            "corrupt CSensoryFrame: observation 1 of 1 is a CPose2D, not an observation");
+  mrpt::obs::CObservationComment comment;
+  EXPECT_EQ(damageReason(tmp, v2 + serialized(comment) + "\x77", &before),
+            "corrupt CSensoryFrame: no end flag after its 1 observations");
+  const std::int64_t ticks = 0x0102030405060708;
+  std::string stamp(8, '\0');
+  for (int i = 0; i < 8; ++i) stamp[i] = static_cast<char>((ticks >> (8 * i)) & 0xFF);
+  const fs::path file = tmp.path() / "v0.rawlog";
+  const std::string v0 = "\x8D" "CSensoryFrame" + std::string(1, '\0') + u32(7) + stamp + u32(1) +
+                         serialized(comment) + "\x88";
+  std::ofstream(file, std::ios::binary).write(v0.data(), static_cast<std::streamsize>(v0.size()));
+  RawlogReader reader(file.string());
+  RawlogEntry e;
+  ASSERT_TRUE(reader.next(e));
+  EXPECT_EQ(e.observation->timestamp, mrpt::Clock::time_point(mrpt::Clock::duration(ticks)));
+}
+
+}  // namespace
