@@ -131,7 +131,7 @@ TEST(RawlogPrecheck, FrameElementsAreEachCheckedAtTheirStart) {
             "corrupt CSensoryFrame: observation 1 of 1 is a CPose2D, not an observation");
   mrpt::obs::CObservationComment comment;
   EXPECT_EQ(damageReason(tmp, v2 + serialized(comment) + "\x77", &before),
-            "corrupt CSensoryFrame: no end flag after its 1 observations");
+            "corrupt CSensoryFrame: no end flag after its 1 observation");
   const std::int64_t ticks = 0x0102030405060708;
   std::string stamp(8, '\0');
   for (int i = 0; i < 8; ++i) stamp[i] = static_cast<char>((ticks >> (8 * i)) & 0xFF);

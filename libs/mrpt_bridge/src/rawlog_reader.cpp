@@ -129,8 +129,8 @@ Eigen::Isometry3d planarIsometry(double x, double y, double phi) {
 }
 
 // A robot movement's increment into inc, or why its pose change cannot be used (a coordinate
-// not finite: the robot's pose would be NaN from there on; a move longer than kMaxMovementM). "" with inc unset for anything
-// else (another action, a 2D movement without a pose change).
+// not finite: the robot's pose would be NaN from there on; a move longer than kMaxMovementM).
+// "" with inc unset for anything else (another action, a 2D movement without a pose change).
 std::string movementIncrement(const mrpt::obs::CAction& a,
                               std::optional<Eigen::Isometry3d>& inc) {
   std::vector<double> v;
@@ -303,11 +303,10 @@ struct RawlogReader::Impl {
       const std::string why = detail::precheckNextElement(*lookahead, head, i);
       if (!why.empty()) fail(object_index, position, why);
       *archive >> elements[i];
-      const bool fits =
-          !elements[i] || (head.frame ? !!std::dynamic_pointer_cast<mrpt::obs::CObservation>(
-                                            elements[i])
-                                      : !!std::dynamic_pointer_cast<mrpt::obs::CAction>(
-                                            elements[i]));
+      const auto* e = elements[i].get();
+      const bool observation = dynamic_cast<const mrpt::obs::CObservation*>(e) != nullptr;
+      const bool action = dynamic_cast<const mrpt::obs::CAction*>(e) != nullptr;
+      const bool fits = !e || (head.frame ? observation : action);
       if (!fits) {
         fail(object_index, position,
              std::string("corrupt ") + (head.frame ? "CSensoryFrame" : "CActionCollection") +
@@ -321,7 +320,8 @@ struct RawlogReader::Impl {
     if (end != 0x88) {
       fail(object_index, position,
            std::string("corrupt ") + (head.frame ? "CSensoryFrame" : "CActionCollection") +
-               ": no end flag after its " + std::to_string(head.count) + " " + kind + "s");
+               ": no end flag after its " + std::to_string(head.count) + " " + kind +
+               (head.count == 1 ? "" : "s"));
     }
     if (head.frame) {
       std::vector<mrpt::obs::CObservation::Ptr> observations;
