@@ -12,8 +12,10 @@
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationGPS.h>
 #include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationRange.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose2D.h>
+#include <mrpt/poses/CPose3D.h>
 
 #include <gtest/gtest.h>
 
@@ -60,6 +62,59 @@ TEST(RawlogPrecheck, ThreeDMovementVelocityCountsAreBounded) {
                          " (more than 6 components)");
   }
   EXPECT_EQ(damageReason(tmp, head + moved + "\x88", &before), "(read)");
+}
+
+// Range finders of the layouts MRPT reads (versions 0-3: the IDs from 3, the label from 1, the
+// timestamp from 2) read, and a corrupt measurement count in each is damage (found by
+// fuzz_rawlog: a version-2 list resized to 6.5 GB when the walk knew only version 3).
+TEST(RawlogPrecheck, OldRangeFindersAreWalkedAndTheirCountsBounded) {
+  TempDir tmp;
+  const std::string pose = serialized(mrpt::poses::CPose3D(0.1, 0.0, 0.2, 0.0, 0.0, 0.0));
+  const std::string floats(12, '\0'), distance(4, '\0'), label = u32(2) + "US";
+  const std::string name = "\x9c" "mrpt::obs::CObservationRange";
+  std::size_t before = 0;
+  for (int version = 0; version <= 3; ++version) {
+    SCOPED_TRACE(version);
+    std::string measurements;
+    for (int i = 0; i < 2; ++i) {
+      measurements += (version >= 3 ? std::string(2, '\0') : std::string()) + pose + distance;
+    }
+    const std::string head = name + static_cast<char>(version) + floats;
+    const std::string tail = (version >= 1 ? label : std::string()) +
+                             (version >= 2 ? std::string(8, '\0') : std::string()) + "\x88";
+    EXPECT_EQ(damageReason(tmp, head + u32(2) + measurements + tail, &before), "(read)");
+    const std::string reason =
+        damageReason(tmp, head + u32(2000000000u) + measurements + tail, &before);
+    EXPECT_EQ(reason, "corrupt CObservationRange: measurement count 2000000000 at byte " +
+                          std::to_string(before + head.size()) + " (more than 65536 measurements)");
+  }
+}
+
+// A GNSS observation's label and message count, corrupted in one MRPT wrote, are damage (found by
+// fuzz_rawlog: a label of 4.1 GB, allocated before the stream ended); its messages are left to
+// MRPT.
+TEST(RawlogPrecheck, GnssLabelAndMessageCountAreBounded) {
+  TempDir tmp;
+  auto gps = mrpt::obs::CObservationGPS::Create();
+  gps->sensorLabel = "GNSSLABEL";
+  mrpt::obs::gnss::Message_NMEA_GGA gga;
+  gga.fields.latitude_degrees = 36.7;
+  gps->setMsg(gga);
+  const std::string good = serialized(*gps);
+  std::size_t before = 0;
+  EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
+  const std::size_t label_at = good.find(u32(9) + "GNSSLABEL");
+  const std::size_t count_at =
+      label_at + 4 + 9 + serialized(mrpt::poses::CPose3D()).size() + 1;  // after the flag
+  ASSERT_EQ(good.substr(count_at, 4), u32(1));
+  const std::string long_label = std::string(good).replace(label_at, 4, u32(0xF6000000u));
+  const std::string label = damageReason(tmp, long_label, &before);
+  EXPECT_EQ(label, "corrupt CObservationGPS: sensor label length 4127195136 at byte " +
+                       std::to_string(before + label_at) + " (more than 65536 bytes)");
+  const std::string many = std::string(good).replace(count_at, 4, u32(5000));
+  const std::string count = damageReason(tmp, many, &before);
+  EXPECT_EQ(count, "corrupt CObservationGPS: message count 5000 at byte " +
+                       std::to_string(before + count_at) + " (more than 1024 messages)");
 }
 
 // A point cloud observation's map: MRPT resizes every field to the count it reads (its aligned

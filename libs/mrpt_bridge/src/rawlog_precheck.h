@@ -55,6 +55,8 @@ constexpr std::uint32_t kMaxEncodedImageBytes = 1u << 28;
 constexpr std::uint32_t kMaxStringBytes = 1u << 16;
 /// Most measurements of a CObservationRange (a ring of sonars or infrared rangers gives tens).
 constexpr std::uint32_t kMaxRangeMeasurements = 65536;
+/// Most messages of a CObservationGPS (MRPT keeps one of each message type).
+constexpr std::uint32_t kMaxGnssMessages = 1024;
 /// Most bytes of a CObservationComment's text (a note, a configuration block).
 constexpr std::uint32_t kMaxCommentBytes = 1u << 24;
 

@@ -468,11 +468,11 @@ Parse comment(Cursor& c, int version, std::string& why) {
   return p;
 }
 
-// CObservationRange, version 3: the minimum and maximum range and the cone's aperture, a count of
-// measurements (MRPT resizes its list to it), each an ID, the sensor's pose (a CPose3D object)
-// and the distance; the label and the timestamp.
+// CObservationRange, versions 0-3: the minimum and maximum range and the cone's aperture, a count
+// of measurements (MRPT resizes its list to it), each an ID (from version 3), the sensor's pose (a
+// CPose3D object) and the distance; the label (from 1) and the timestamp (from 2).
 Parse ranges(Cursor& c, int version, std::string& why) {
-  if (version != 3) return kOther;
+  if (version > 3) return kOther;
   c.skip(3 * sizeof(float));
   const std::uint64_t at = c.position();
   std::uint32_t n = 0;
@@ -482,13 +482,29 @@ Parse ranges(Cursor& c, int version, std::string& why) {
   }
   Parse p = kRead;
   for (std::uint32_t i = 0; i < n && p == kRead; ++i) {
-    c.skip(sizeof(std::uint16_t));
+    if (version >= 3) c.skip(sizeof(std::uint16_t));
     p = pose(c, why);
     c.skip(sizeof(float));
   }
-  if (p != kRead || (p = string(c, "sensor label length", why)) != kRead) return p;
-  c.skip(sizeof(std::uint64_t));
-  return kRead;
+  if (p == kRead && version >= 1) p = string(c, "sensor label length", why);
+  if (version >= 2) c.skip(sizeof(std::uint64_t));
+  return p;
+}
+
+// CObservationGPS, versions 10-11: two timestamps, the label, the sensor pose, (11) whether the
+// timestamp is the satellites', the message count; the messages (of many layouts) are left to
+// MRPT.
+Parse gnss(Cursor& c, int version, std::string& why) {
+  if (version != 10 && version != 11) return kOther;
+  c.skip(2 * sizeof(std::uint64_t));
+  Parse p = string(c, "sensor label length", why);
+  if (p != kRead || (p = pose(c, why)) != kRead) return p;
+  if (version == 11) c.skip(1);
+  const std::uint64_t at = c.position();
+  std::uint32_t n = 0;
+  if (!c.value(n)) return kOther;
+  if (!withinBound("message count", n, at, kMaxGnssMessages, "messages", why)) return kImpossible;
+  return kOther;
 }
 
 // CObservationIMU, version 4: the sensor pose, a flag for each of MRPT's IMU fields, the
@@ -539,6 +555,8 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
     p = comment(c, h.version, why);
   } else if (h.class_name == "CObservationRange") {
     p = ranges(c, h.version, why);
+  } else if (h.class_name == "CObservationGPS") {
+    p = gnss(c, h.version, why);
   } else if (h.class_name == "CObservationIMU") {
     p = imu(c, h.version, why);
   } else if (h.class_name == "CObservationOdometry") {
