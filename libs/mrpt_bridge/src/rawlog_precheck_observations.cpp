@@ -540,30 +540,22 @@ Parse odometry(Cursor& c, int version, std::string& why) {
 Parse checkPose(Cursor& c, std::string& why) { return pose(c, why); }
 
 Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
-  Parse p = kOther;
-  if (h.class_name == "CObservation2DRangeScan") {
-    p = scan2D(c, h.version, why);
-  } else if (h.class_name == "CObservation3DRangeScan") {
-    p = scan3D(c, h.version, why);
-  } else if (h.class_name == "CObservationImage") {
-    p = monoImage(c, h.version, why);
-  } else if (h.class_name == "CObservationStereoImages") {
-    p = stereoImages(c, h.version, why);
-  } else if (h.class_name == "CObservationPointCloud") {
-    p = pointCloud(c, h.version, why);
-  } else if (h.class_name == "CObservationComment") {
-    p = comment(c, h.version, why);
-  } else if (h.class_name == "CObservationRange") {
-    p = ranges(c, h.version, why);
-  } else if (h.class_name == "CObservationGPS") {
-    p = gnss(c, h.version, why);
-  } else if (h.class_name == "CObservationIMU") {
-    p = imu(c, h.version, why);
-  } else if (h.class_name == "CObservationOdometry") {
-    p = odometry(c, h.version, why);
+  // The walk of each observation class, by its name without the namespace.
+  static const struct {
+    const char* name;
+    Parse (*walk)(Cursor&, int, std::string&);
+  } kWalks[] = {{"CObservation2DRangeScan", scan2D}, {"CObservation3DRangeScan", scan3D},
+                {"CObservationImage", monoImage},     {"CObservationStereoImages", stereoImages},
+                {"CObservationPointCloud", pointCloud}, {"CObservationComment", comment},
+                {"CObservationRange", ranges},        {"CObservationGPS", gnss},
+                {"CObservationIMU", imu},             {"CObservationOdometry", odometry}};
+  for (const auto& w : kWalks) {
+    if (h.class_name != w.name) continue;
+    const Parse p = w.walk(c, h.version, why);
+    if (p != kRead) return p;
+    return endOf(c, h) ? kRead : kOther;
   }
-  if (p != kRead) return p;
-  return endOf(c, h) ? kRead : kOther;
+  return kOther;
 }
 
 }  // namespace upd::mrpt_bridge::detail
