@@ -107,8 +107,9 @@ mrpt::img::CImage gradient(int w, int h) {
 }
 
 // A plain rawlog object stream of the other sensors a robot records: a frame of an IMU, wheel
-// odometry, a GNSS fix (GGA and RMC), two point clouds (plain and coloured), a range finder, a
-// JPEG camera image and a small 3D scan with a JPEG intensity image; then the same bare.
+// odometry, a GNSS reading (GGA and RMC fixes, a Novatel frame kept whole, Topcon satellites,
+// Novatel ranges), two point clouds (plain and coloured), a range finder, a JPEG camera image and
+// a small 3D scan with a JPEG intensity image; then the same bare.
 void putSensorsRawlog(const fs::path& dir) {
   mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
   auto imu = mrpt::obs::CObservationIMU::Create();
@@ -131,6 +132,18 @@ void putSensorsRawlog(const fs::path& dir) {
   rmc.fields.latitude_degrees = 36.7;
   rmc.fields.longitude_degrees = -4.4;
   gps->setMsg(rmc);
+  mrpt::obs::gnss::Message_NV_OEM6_GENERIC_FRAME frame_msg;
+  frame_msg.msg_body = {0x11, 0x22, 0x33, 0x44};
+  gps->setMsg(frame_msg);
+  mrpt::obs::gnss::Message_TOPCON_SATS sats;
+  sats.USIs = {3, 7, 9};
+  sats.ELs = {40, 50, 60};
+  sats.AZs = {20, 120, 300};
+  gps->setMsg(sats);
+  mrpt::obs::gnss::Message_NV_OEM6_RANGECMP ranges;
+  ranges.num_obs = 2;
+  ranges.obs_data.resize(2);
+  gps->setMsg(ranges);
   auto plain = mrpt::obs::CObservationPointCloud::Create();
   auto points = mrpt::maps::CSimplePointsMap::Create();
   auto coloured = mrpt::maps::CColouredPointsMap::Create();

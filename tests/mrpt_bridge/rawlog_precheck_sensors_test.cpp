@@ -11,6 +11,7 @@
 #include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationGPS.h>
+#include <mrpt/obs/gnss_messages.h>
 #include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationRange.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -91,8 +92,7 @@ TEST(RawlogPrecheck, OldRangeFindersAreWalkedAndTheirCountsBounded) {
 }
 
 // A GNSS observation's label and message count, corrupted in one MRPT wrote, are damage (found by
-// fuzz_rawlog: a label of 4.1 GB, allocated before the stream ended); its messages are left to
-// MRPT.
+// fuzz_rawlog: a label of 4.1 GB, allocated before the stream ended).
 TEST(RawlogPrecheck, GnssLabelAndMessageCountAreBounded) {
   TempDir tmp;
   auto gps = mrpt::obs::CObservationGPS::Create();
@@ -115,6 +115,68 @@ TEST(RawlogPrecheck, GnssLabelAndMessageCountAreBounded) {
   const std::string count = damageReason(tmp, many, &before);
   EXPECT_EQ(count, "corrupt CObservationGPS: message count 5000 at byte " +
                        std::to_string(before + count_at) + " (more than 1024 messages)");
+}
+
+// A GNSS observation holding a message of every type MRPT builds (the lists of the five that hold
+// lists not empty) is walked to its end; a corrupt Novatel frame body length (MRPT allocated and
+// zeroed 1 GiB for one, 2.3 s) or Topcon satellite count (1 GiB, 0.6 s) is damage at its byte.
+TEST(RawlogPrecheck, GnssMessagesAreWalked) {
+  namespace gnss = mrpt::obs::gnss;
+  TempDir tmp;
+  auto gps = mrpt::obs::CObservationGPS::Create();
+  for (int type = 0; type < 5000; ++type) {
+    auto* m = gnss::gnss_message::Factory(static_cast<gnss::gnss_message_type_t>(type));
+    if (m) gps->messages[m->message_type] = gnss::gnss_message_ptr(m);
+  }
+  ASSERT_GE(gps->messages.size(), 20u);
+  auto& frame = dynamic_cast<gnss::Message_NV_OEM6_GENERIC_FRAME&>(
+      *gps->messages[gnss::NV_OEM6_GENERIC_FRAME].get());
+  frame.msg_body = {0x11, 0x22, 0x33, 0x44};  // MRPT reads back 4 bytes of a body
+  auto& sats = dynamic_cast<gnss::Message_TOPCON_SATS&>(*gps->messages[gnss::TOPCON_SATS].get());
+  sats.USIs = {3, 7, 9};
+  sats.ELs = {40, 50, 60};
+  sats.AZs = {0x2A5A, 120, 300};
+  auto& ranges = dynamic_cast<gnss::Message_NV_OEM6_RANGECMP&>(
+      *gps->messages[gnss::NV_OEM6_RANGECMP].get());
+  ranges.num_obs = 2;
+  ranges.obs_data.resize(2);
+  auto& version = dynamic_cast<gnss::Message_NV_OEM6_VERSION&>(
+      *gps->messages[gnss::NV_OEM6_VERSION].get());
+  version.num_comps = 1;
+  version.components.resize(1);
+  const std::string good = serialized(*gps);
+  std::string why;
+  EXPECT_EQ(walked(good, &why), good.size()) << why;
+  std::size_t before = 0;
+  EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
+
+  const std::size_t body_at = good.find(u32(4) + "\x11\x22\x33\x44");
+  ASSERT_NE(body_at, std::string::npos);
+  EXPECT_EQ(damageReason(tmp, std::string(good).replace(body_at, 4, u32(1u << 30)), &before),
+            "corrupt CObservationGPS: Novatel frame body length 1073741824 at byte " +
+                std::to_string(before + body_at) + " (more than 65536 bytes)");
+  const std::size_t ids_at = good.find(u32(3) + "\x03\x07\x09");
+  ASSERT_NE(ids_at, std::string::npos);
+  EXPECT_EQ(damageReason(tmp, std::string(good).replace(ids_at, 4, u32(1u << 30)), &before),
+            "corrupt CObservationGPS: satellite ID count 1073741824 at byte " +
+                std::to_string(before + ids_at) + " (more than 4096 satellites)");
+  const std::size_t azimuths_at = good.find(u32(3) + "\x5A\x2A");
+  ASSERT_NE(azimuths_at, std::string::npos);
+  EXPECT_EQ(damageReason(tmp, std::string(good).replace(azimuths_at, 4, u32(0xFFFFFFF0u)), &before),
+            "corrupt CObservationGPS: azimuth count 4294967280 at byte " +
+                std::to_string(before + azimuths_at) + " (more than 4096 satellites)");
+  // A block length other than the type's, or a type MRPT does not know: MRPT says so.
+  mrpt::obs::CObservationGPS one;
+  one.setMsg(gnss::Message_NV_OEM6_BESTPOS());
+  const std::string bestpos = serialized(one);
+  const std::size_t type_at = bestpos.find(u32(gnss::NV_OEM6_BESTPOS));
+  ASSERT_NE(type_at, std::string::npos);
+  for (const std::string& bad : {std::string(bestpos).replace(type_at + 4, 4, u32(7)),
+                                 std::string(bestpos).replace(type_at, 4, u32(4999))}) {
+    const std::string reason = damageReason(tmp, bad, &before);
+    EXPECT_NE(reason, "(read)");
+    EXPECT_EQ(reason.find("corrupt CObservationGPS:"), std::string::npos) << reason;
+  }
 }
 
 // A point cloud observation's map: MRPT resizes every field to the count it reads (its aligned

@@ -57,6 +57,11 @@ constexpr std::uint32_t kMaxStringBytes = 1u << 16;
 constexpr std::uint32_t kMaxRangeMeasurements = 65536;
 /// Most messages of a CObservationGPS (MRPT keeps one of each message type).
 constexpr std::uint32_t kMaxGnssMessages = 1024;
+/// Most bytes of a Novatel frame a CObservationGPS keeps whole (the receiver's own length field
+/// has 16 bits).
+constexpr std::uint32_t kMaxGnssFrameBytes = 1u << 16;
+/// Most satellites in one of a Topcon SATS message's lists (a receiver tracks tens).
+constexpr std::uint32_t kMaxGnssSatellites = 4096;
 /// Most bytes of a CObservationComment's text (a note, a configuration block).
 constexpr std::uint32_t kMaxCommentBytes = 1u << 24;
 

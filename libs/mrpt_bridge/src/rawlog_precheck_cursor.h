@@ -82,4 +82,7 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why);
 /// A CPose3D (versions 0-3), CPose3DQuat or CPose2D object, header to end flag.
 Parse checkPose(Cursor& c, std::string& why);
 
+/// The `count` messages of a CObservationGPS (its messages follow its message count).
+Parse checkGnssMessages(Cursor& c, std::uint32_t count, std::string& why);
+
 }  // namespace upd::mrpt_bridge::detail

@@ -492,8 +492,7 @@ Parse ranges(Cursor& c, int version, std::string& why) {
 }
 
 // CObservationGPS, versions 10-11: two timestamps, the label, the sensor pose, (11) whether the
-// timestamp is the satellites', the message count; the messages (of many layouts) are left to
-// MRPT.
+// timestamp is the satellites', the message count, the messages (rawlog_precheck_gnss.cpp).
 Parse gnss(Cursor& c, int version, std::string& why) {
   if (version != 10 && version != 11) return kOther;
   c.skip(2 * sizeof(std::uint64_t));
@@ -504,7 +503,7 @@ Parse gnss(Cursor& c, int version, std::string& why) {
   std::uint32_t n = 0;
   if (!c.value(n)) return kOther;
   if (!withinBound("message count", n, at, kMaxGnssMessages, "messages", why)) return kImpossible;
-  return kOther;
+  return checkGnssMessages(c, n, why);
 }
 
 // CObservationIMU, version 4: the sensor pose, a flag for each of MRPT's IMU fields, the
