@@ -14,7 +14,7 @@
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservation.h>
-#include <mrpt/obs/CObservationVelodyneScan.h>
+#include <mrpt/obs/CObservationBeaconRanges.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 #include <nlohmann/json.hpp>
@@ -261,28 +261,29 @@ TEST(PlaybackDamage, FlippedByteInASensoryFrame) {
                 gz_flipped, std::nullopt);
 }
 
-// A Velodyne scan whose calibration claims 4.3 billion lasers (hundreds of GB; the kind of object
-// fuzz_rawlog found): MRPT resizes a vector to the count it reads, the allocation fails
-// (std::bad_alloc; the address space is capped at 8 GB here so that it fails on any machine),
-// and the reader reports the object as damage in one line. Under AddressSanitizer the
-// allocation aborts the process instead (its operator new does not throw): skipped there.
+// An observation of a class the reader's pre-check leaves to MRPT (a beacon range finder's
+// readings) claiming 4.3 billion of them (hundreds of GB): MRPT resizes a vector to the count it
+// reads, the allocation fails (std::bad_alloc; the address space is capped at 8 GB here so that
+// it fails on any machine), and the reader reports the object as damage in one line. Under
+// AddressSanitizer the allocation aborts the process instead (its operator new does not throw):
+// skipped there.
 TEST(PlaybackDamage, AnObjectClaimingAnImpossibleSizeIsDamageNotACrash) {
 #if defined(UPD_TEST_UNDER_ASAN)
   GTEST_SKIP() << "under AddressSanitizer an impossible allocation aborts instead of throwing";
 #endif
-  constexpr std::uint32_t kLasers = 4321;  // a count found by its value in the written bytes
-  mrpt::obs::CObservationVelodyneScan scan;
-  scan.calibration.laser_corrections.resize(kLasers);
+  constexpr std::uint32_t kReadings = 4321;  // a count found by its value in the written bytes
+  mrpt::obs::CObservationBeaconRanges beacons;
+  beacons.sensedData.resize(kReadings);
   mrpt::io::CMemoryStream mem;
-  mrpt::serialization::archiveFrom(mem) << scan;
+  mrpt::serialization::archiveFrom(mem) << beacons;
   const auto* data = static_cast<const char*>(mem.getRawBufferData());
   std::string bytes(data, data + mem.getTotalBytesCount());
-  const auto at = bytes.find(std::string(reinterpret_cast<const char*>(&kLasers), 4));
+  const auto at = bytes.find(std::string(reinterpret_cast<const char*>(&kReadings), 4));
   ASSERT_NE(at, std::string::npos);
-  bytes.replace(at, 4, std::string("\xF0\xFF\xFF\xFF", 4));  // 4294967280 lasers
+  bytes.replace(at, 4, std::string("\xF0\xFF\xFF\xFF", 4));  // 4294967280 readings
 
   const test::TempDir tmp("huge");
-  const fs::path rawlog = tmp.path() / "velodyne.rawlog";
+  const fs::path rawlog = tmp.path() / "beacons.rawlog";
   writeBytes(rawlog, bytes);
   const fs::path out = tmp.path() / "out";
   const CmdResult r = test::runCommand("ulimit -v 8000000; " + std::string(UPD_BINARY) +

@@ -24,6 +24,7 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationRange.h>
+#include <mrpt/obs/CObservationVelodyneScan.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
 #include <mrpt/poses/CPosePDFGaussianInf.h>
@@ -108,8 +109,8 @@ mrpt::img::CImage gradient(int w, int h) {
 
 // A plain rawlog object stream of the other sensors a robot records: a frame of an IMU, wheel
 // odometry, a GNSS reading (GGA and RMC fixes, a Novatel frame kept whole, Topcon satellites,
-// Novatel ranges), two point clouds (plain and coloured), a range finder, a JPEG camera image and
-// a small 3D scan with a JPEG intensity image; then the same bare.
+// empty Novatel ranges), two point clouds (plain and coloured), a range finder, a JPEG camera
+// image, a small 3D scan with a JPEG intensity image and a Velodyne scan; then the same bare.
 void putSensorsRawlog(const fs::path& dir) {
   mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
   auto imu = mrpt::obs::CObservationIMU::Create();
@@ -132,18 +133,21 @@ void putSensorsRawlog(const fs::path& dir) {
   rmc.fields.latitude_degrees = 36.7;
   rmc.fields.longitude_degrees = -4.4;
   gps->setMsg(rmc);
-  mrpt::obs::gnss::Message_NV_OEM6_GENERIC_FRAME frame_msg;
-  frame_msg.msg_body = {0x11, 0x22, 0x33, 0x44};
-  gps->setMsg(frame_msg);
-  mrpt::obs::gnss::Message_TOPCON_SATS sats;
-  sats.USIs = {3, 7, 9};
-  sats.ELs = {40, 50, 60};
-  sats.AZs = {20, 120, 300};
-  gps->setMsg(sats);
-  mrpt::obs::gnss::Message_NV_OEM6_RANGECMP ranges;
-  ranges.num_obs = 2;
-  ranges.obs_data.resize(2);
-  gps->setMsg(ranges);
+  {
+    namespace gnss = mrpt::obs::gnss;
+    auto* frame_msg = new gnss::Message_NV_OEM6_GENERIC_FRAME();
+    frame_msg->msg_body = {0x11, 0x22, 0x33, 0x44};
+    gps->messages[gnss::NV_OEM6_GENERIC_FRAME] = gnss::gnss_message_ptr(frame_msg);
+    auto* sats = new gnss::Message_TOPCON_SATS();
+    sats->USIs = {3, 7, 9};
+    sats->ELs = {40, 50, 60};
+    sats->AZs = {20, 120, 300};
+    gps->messages[gnss::TOPCON_SATS] = gnss::gnss_message_ptr(sats);
+    // (RANGECMP is left empty: MRPT packs it to 1-byte alignment, its list included, and UBSan
+    // reports any call on that list from an instrumented build.)
+    gps->messages[gnss::NV_OEM6_RANGECMP] =
+        gnss::gnss_message_ptr(new gnss::Message_NV_OEM6_RANGECMP());
+  }
   auto plain = mrpt::obs::CObservationPointCloud::Create();
   auto points = mrpt::maps::CSimplePointsMap::Create();
   auto coloured = mrpt::maps::CColouredPointsMap::Create();
@@ -171,8 +175,21 @@ void putSensorsRawlog(const fs::path& dir) {
   depth->intensityImage = gradient(32, 24);
   depth->cameraParams.ncols = depth->cameraParamsIntensity.ncols = 32;
   depth->cameraParams.nrows = depth->cameraParamsIntensity.nrows = 24;
+  auto lidar = mrpt::obs::CObservationVelodyneScan::Create();
+  lidar->scan_packets.resize(1);
+  lidar->calibration.laser_corrections.resize(16);
+  for (int i = 0; i < 4; ++i) {
+    lidar->point_cloud.x.push_back(2.0f + i);
+    lidar->point_cloud.y.push_back(0.5f);
+    lidar->point_cloud.z.push_back(-0.4f);
+    lidar->point_cloud.intensity.push_back(90);
+    lidar->point_cloud.timestamp.push_back(mrpt::Clock::fromDouble(10.0 + 0.01 * i));
+    lidar->point_cloud.azimuth.push_back(0.2f * i);
+    lidar->point_cloud.laser_id.push_back(static_cast<int16_t>(i));
+  }
+  lidar->point_cloud.pointsForLaserID = {{0, 1}, {2, 3}};
   const mrpt::obs::CObservation::Ptr all[] = {imu, odometry, gps, plain, colour, range, camera,
-                                              depth};
+                                              depth, lidar};
   mrpt::obs::CSensoryFrame frame;
   for (const auto& o : all) frame.insert(o);
   mrpt::io::CFileOutputStream out((dir / "sensors.rawlog").string());

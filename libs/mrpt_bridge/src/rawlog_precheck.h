@@ -62,6 +62,10 @@ constexpr std::uint32_t kMaxGnssMessages = 1024;
 constexpr std::uint32_t kMaxGnssFrameBytes = 1u << 16;
 /// Most satellites in one of a Topcon SATS message's lists (a receiver tracks tens).
 constexpr std::uint32_t kMaxGnssSatellites = 4096;
+/// Most raw packets in one Velodyne scan (a turn of a 64-laser sensor at 5 Hz takes ~700).
+constexpr std::uint32_t kMaxLidarPackets = 65536;
+/// Most lasers in a Velodyne calibration or point cloud (sensors have 16 to 128).
+constexpr std::uint32_t kMaxLidarLasers = 4096;
 /// Most bytes of a CObservationComment's text (a note, a configuration block).
 constexpr std::uint32_t kMaxCommentBytes = 1u << 24;
 

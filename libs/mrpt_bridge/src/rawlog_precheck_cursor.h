@@ -82,6 +82,19 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why);
 /// A CPose3D (versions 0-3), CPose3DQuat or CPose2D object, header to end flag.
 Parse checkPose(Cursor& c, std::string& why);
 
+/// A std::string: its 32-bit length (bounded by max_bytes: false, with why, past it), then its
+/// bytes.
+Parse checkString(Cursor& c, const char* field, std::string& why,
+                  std::uint32_t max_bytes = kMaxStringBytes);
+
+/// A list MRPT resizes to the 32-bit count before it, then reads: the count bounded by max (false,
+/// with why naming field and unit, past it), the elements of element_bytes each skipped.
+Parse checkList(Cursor& c, const char* field, std::size_t element_bytes, std::uint64_t max,
+                const char* unit, std::string& why);
+
+/// A CObservationVelodyneScan's body (versions 0-2; any other is OtherLayout), after its header.
+Parse checkVelodyneScan(Cursor& c, int version, std::string& why);
+
 /// The `count` messages of a CObservationGPS (its messages follow its message count).
 Parse checkGnssMessages(Cursor& c, std::uint32_t count, std::string& why);
 

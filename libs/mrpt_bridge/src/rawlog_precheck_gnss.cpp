@@ -61,17 +61,6 @@ const std::map<int, FixedSize>& fixedSizes() {
   return sizes;
 }
 
-// A list MRPT resizes to the 32-bit count before it: the count bounded, the elements skipped.
-Parse list(Cursor& c, const char* field, std::size_t element_bytes, std::uint64_t max,
-           const char* unit, std::string& why) {
-  const std::uint64_t at = c.position();
-  std::uint32_t n = 0;
-  if (!c.value(n)) return kOther;
-  if (!withinBound(field, n, at, max, unit, why)) return kImpossible;
-  c.skip(std::uint64_t{n} * element_bytes);
-  return kRead;
-}
-
 // A Novatel frame kept whole: its header, a body length MRPT resizes the body to, and then (MRPT
 // 2.5.8 reads only as many bytes as the length field has) 4 bytes of the body when it has any.
 Parse genericFrame(Cursor& c, std::size_t header_bytes, std::string& why) {
@@ -110,9 +99,9 @@ Parse message(Cursor& c, std::string& why) {
       return records(c, sizeof(gnss::Message_NV_OEM6_VERSION::TComponentVersion));
     case gnss::TOPCON_SATS: {
       // Satellite IDs, elevations and azimuths: bytes, bytes and 16-bit values.
-      Parse p = list(c, "satellite ID count", 1, kMaxGnssSatellites, "satellites", why);
-      if (p == kRead) p = list(c, "elevation count", 1, kMaxGnssSatellites, "satellites", why);
-      if (p == kRead) p = list(c, "azimuth count", 2, kMaxGnssSatellites, "satellites", why);
+      Parse p = checkList(c, "satellite ID count", 1, kMaxGnssSatellites, "satellites", why);
+      if (p == kRead) p = checkList(c, "elevation count", 1, kMaxGnssSatellites, "satellites", why);
+      if (p == kRead) p = checkList(c, "azimuth count", 2, kMaxGnssSatellites, "satellites", why);
       return p;
     }
     default:
@@ -132,6 +121,16 @@ Parse message(Cursor& c, std::string& why) {
 }
 
 }  // namespace
+
+Parse checkList(Cursor& c, const char* field, std::size_t element_bytes, std::uint64_t max,
+                const char* unit, std::string& why) {
+  const std::uint64_t at = c.position();
+  std::uint32_t n = 0;
+  if (!c.value(n)) return kOther;
+  if (!withinBound(field, n, at, max, unit, why)) return kImpossible;
+  c.skip(std::uint64_t{n} * element_bytes);
+  return kRead;
+}
 
 Parse checkGnssMessages(Cursor& c, std::uint32_t count, std::string& why) {
   Parse p = kRead;

@@ -538,6 +538,10 @@ Parse odometry(Cursor& c, int version, std::string& why) {
 
 Parse checkPose(Cursor& c, std::string& why) { return pose(c, why); }
 
+Parse checkString(Cursor& c, const char* field, std::string& why, std::uint32_t max_bytes) {
+  return string(c, field, why, max_bytes);
+}
+
 Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
   // The walk of each observation class, by its name without the namespace.
   static const struct {
@@ -547,7 +551,8 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
                 {"CObservationImage", monoImage},     {"CObservationStereoImages", stereoImages},
                 {"CObservationPointCloud", pointCloud}, {"CObservationComment", comment},
                 {"CObservationRange", ranges},        {"CObservationGPS", gnss},
-                {"CObservationIMU", imu},             {"CObservationOdometry", odometry}};
+                {"CObservationIMU", imu},             {"CObservationOdometry", odometry},
+                {"CObservationVelodyneScan", checkVelodyneScan}};
   for (const auto& w : kWalks) {
     if (h.class_name != w.name) continue;
     const Parse p = w.walk(c, h.version, why);
