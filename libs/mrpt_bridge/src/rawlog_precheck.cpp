@@ -402,6 +402,21 @@ bool peekContainerHead(LookaheadStream& in, ContainerHead& head) {
   return true;
 }
 
+std::string precheckContainerHead(LookaheadStream& in, const ContainerHead& head) {
+  std::string why;
+  const std::uint64_t at = in.getPosition() + head.bytes - sizeof(std::uint32_t);
+  if (head.frame) {
+    if (!withinBound("observation count", head.count, at, kMaxObservationsPerFrame,
+                     "observations", why)) {
+      return "corrupt CSensoryFrame: " + why;
+    }
+  } else if (!withinBound("action count", head.count, at, kMaxActionsPerCollection, "actions",
+                          why)) {
+    return "corrupt CActionCollection: " + why;
+  }
+  return {};
+}
+
 std::string precheckNextElement(LookaheadStream& in, const ContainerHead& head,
                                 std::uint32_t index) {
   Cursor c(in);

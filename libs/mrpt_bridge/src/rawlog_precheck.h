@@ -108,13 +108,18 @@ struct ContainerHead {
   bool frame = false;  ///< a CSensoryFrame; else a CActionCollection
   int version = 0;
   bool has_end_flag = true;
-  std::uint32_t count = 0;     ///< elements (checked by precheckNextObject first)
+  std::uint32_t count = 0;     ///< elements (checked by precheckContainerHead)
   std::int64_t timestamp = 0;  ///< a version-0 frame's, which MRPT sets on every observation
   std::size_t bytes = 0;       ///< from the object's first byte to its first element
 };
 
 /// true, with its head, when the next object is such a container. Consumes nothing.
 bool peekContainerHead(LookaheadStream& in, ContainerHead& head);
+
+/// Why the head of the container at the stream's position is impossible (its element count past
+/// its bound, as precheckNextObject names it), or "". Its elements are checked one at a time by
+/// precheckNextElement.
+std::string precheckContainerHead(LookaheadStream& in, const ContainerHead& head);
 
 /// As precheckNextObject, for element `index` (0-based) of the container `head` at the stream's
 /// position, with the container walk's reasons ("corrupt CObservationPointCloud (observation 4 of

@@ -291,8 +291,8 @@ struct RawlogReader::Impl {
   }
 
   // A sensory frame or action collection read as MRPT reads it, but one element at a time, each
-  // checked at its own start (the check of the whole container stops at the first element of a
-  // layout it does not know: what follows would reach MRPT unchecked), then handled.
+  // checked at its own start (a check of the whole container would stop at the first element of
+  // a layout it does not know: what follows would reach MRPT unchecked), then handled.
   void readContainer(const detail::ContainerHead& head, std::size_t object_index,
                      uint64_t position) {
     std::vector<std::uint8_t> head_bytes(head.bytes);  // the header and count, peeked
@@ -403,15 +403,18 @@ bool RawlogReader::next(RawlogEntry& entry) {
     std::string impossible;
     bool read_as_container = false;
     try {
-      impossible = detail::precheckNextObject(*d.lookahead);
+      // A container's elements are checked one at a time as they are read (a walk of the whole
+      // container first would decode each JPEG in it once more); any other object whole.
       detail::ContainerHead head;
-      if (!impossible.empty()) {
-        // (reported below)
-      } else if (detail::peekContainerHead(*d.lookahead, head)) {
-        d.readContainer(head, object_index, position);
-        read_as_container = true;
+      if (detail::peekContainerHead(*d.lookahead, head)) {
+        impossible = detail::precheckContainerHead(*d.lookahead, head);
+        if (impossible.empty()) {
+          d.readContainer(head, object_index, position);
+          read_as_container = true;
+        }
       } else {
-        *d.archive >> object;
+        impossible = detail::precheckNextObject(*d.lookahead);
+        if (impossible.empty()) *d.archive >> object;
       }
     } catch (const RawlogError&) {
       throw;
