@@ -9,6 +9,7 @@
 
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileOutputStream.h>
+#include <mrpt/io/CMemoryStream.h>
 #include <mrpt/math/CMatrixD.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
@@ -31,7 +32,12 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <string>
 
@@ -333,6 +339,76 @@ TEST(RawlogPrecheck, JpegThatWouldEndTheProcessIsDamage) {
                 " is cut short by the end of the stream (MRPT would decode the part there is; "
                 "its JPEG reader ends the process on a cut header)");
   EXPECT_EQ(damageReason(tmp, good, &head), "(read)");
+}
+
+// Whether MRPT reading the one serialized object ends the process (libjpeg's default error
+// handler calls exit), in a child process.
+bool mrptReadEndsTheProcess(const std::string& object) {
+  std::fflush(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // Registered last, run first: the exit ends the child at once, without the exit handlers of
+    // the libraries and the test (a tenth of a second).
+    std::atexit([] { _exit(1); });
+    if (std::freopen("/dev/null", "w", stderr) == nullptr) _exit(3);
+    try {
+      mrpt::io::CMemoryStream in;
+      in.assignMemoryNotOwn(object.data(), object.size());
+      mrpt::serialization::CSerializable::Ptr o;
+      mrpt::serialization::archiveFrom(in) >> o;
+    } catch (...) {
+    }
+    _exit(0);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return !WIFEXITED(status) || WEXITSTATUS(status) != 0;
+}
+
+// The JPEG is decoded as MRPT decodes it, to the byte: an image whose JPEG byte count is cut
+// short (the rest of the object as MRPT wrote it) is damage exactly where MRPT's decoder would
+// end the process (found by fuzz_rawlog: a scan header cut by the byte count decoded with 10
+// zero bytes after it, as the check used to pad it, but ends the process at the count: "Huffman
+// table 0x0f was not defined"). Were the check to pass such a cut, the reader here would hand it
+// to MRPT and this test's process would end.
+TEST(RawlogPrecheck, JpegIsDamageExactlyWhereMrptsDecoderWouldEndTheProcess) {
+  TempDir tmp;
+  const bool jpeg_off = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+  mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+  mrpt::obs::CObservationImage camera;
+  camera.image.resize(32, 24, mrpt::img::CH_RGB);
+  for (int y = 0; y < 24; y += 4) {
+    for (int x = 0; x < 32; x += 4) {
+      camera.image.filledRectangle(x, y, x + 3, y + 3,
+                                   mrpt::img::TColor(8 * x, 10 * y, 255 - 5 * (x + y)));
+    }
+  }
+  const std::string good = serialized(camera);
+  mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(jpeg_off);
+  const std::size_t jpeg_at = good.find("\xFF\xD8\xFF");
+  ASSERT_NE(jpeg_at, std::string::npos);
+  std::uint32_t jpeg_bytes = 0;
+  for (int i = 3; i >= 0; --i)
+    jpeg_bytes = (jpeg_bytes << 8) | static_cast<std::uint8_t>(good[jpeg_at - 4 + i]);
+  ASSERT_EQ(good.substr(jpeg_at + jpeg_bytes - 2, 2), "\xFF\xD9");
+  std::size_t head = 0;
+  int cuts = 0, ending = 0;
+  // Every cut up to the end of the scan header (the markers: tables, frame, scan), then every
+  // 13th byte of the entropy-coded data.
+  const std::size_t scan = good.find("\xFF\xDA", jpeg_at) - jpeg_at;
+  ASSERT_LT(scan, jpeg_bytes);
+  for (std::uint32_t k = 0; k <= jpeg_bytes; k += (k < scan + 16 ? 1 : 13)) {
+    const std::string cut = good.substr(0, jpeg_at - 4) + u32(k) + good.substr(jpeg_at, k) +
+                            good.substr(jpeg_at + jpeg_bytes);
+    const bool ends = mrptReadEndsTheProcess(cut);
+    const std::string reason = damageReason(tmp, cut, &head);
+    EXPECT_EQ(reason.find("image JPEG") != std::string::npos, ends)
+        << k << " of " << jpeg_bytes << " JPEG bytes: " << reason;
+    ++cuts;
+    ending += ends;
+  }
+  EXPECT_GT(ending, 0);
+  EXPECT_LT(ending, cuts);
 }
 
 // The frames of MRPT before version 2 carry an ID (and in version 0 a timestamp) before their

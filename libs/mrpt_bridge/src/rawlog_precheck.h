@@ -7,8 +7,8 @@
 // before the object ends. CActionCollection resizes its list of actions to the count it reads.
 // The observations resize their buffers to the sizes they read: a CObservation2DRangeScan's
 // corrupt scan size makes MRPT allocate 4.3 GB per vector (its aligned allocator returns null
-// when that fails, and MRPT then writes through it), a CImage's JPEG size of 2^32 - 1 wraps to a
-// 9-byte buffer that MRPT then reads 4 GB into.
+// when that fails, and MRPT then writes through it), a CImage's JPEG size of 2^32 - 1 makes it
+// allocate and zero 4 GiB.
 // precheckNextObject() reads those fields of the next top-level object (a CActionCollection and
 // the CActionRobotMovement2D actions in it, or a bare CActionRobotMovement2D; a CSensoryFrame
 // and the observations in it, or a bare observation: 2D and 3D range scans, images, stereo

@@ -171,12 +171,15 @@ Parse colourImage(Cursor& c, int version, std::string& why) {
     const std::uint64_t bytes_at = c.position();
     std::uint32_t bytes = 0;
     if (!c.value(bytes)) return kOther;
-    // MRPT allocates bytes + 10 in 32 bits: 2^32 - 1 wraps to a 9-byte buffer it reads into.
+    // MRPT allocates and zeroes a buffer of the byte count (4 GiB for 2^32 - 1) and reads into it.
     if (!withinBound("image JPEG size", bytes, bytes_at, kMaxEncodedImageBytes, "bytes", why)) {
       return kImpossible;
     }
-    // MRPT hands libjpeg a buffer of bytes + 10.
-    std::vector<std::uint8_t> jpeg(std::size_t{bytes} + 10, 0);
+    // MRPT hands libjpeg exactly that buffer (its source then ends the data with an EOI marker):
+    // the same bytes are decoded here, not one more (a JPEG whose Huffman table runs past its byte
+    // count decodes with zeros after it, but ends the process at its end).
+    if (bytes == 0) return kRead;  // nothing to decode: MRPT's reader does not end the process
+    std::vector<std::uint8_t> jpeg(bytes, 0);
     if (!c.bytes(jpeg.data(), bytes)) {
       // MRPT reads what there is without a complaint (a short read is no error to CArchive)
       // and decodes it: a JPEG cut in its header ends the process in libjpeg.
