@@ -10,9 +10,11 @@
 #include <mrpt/maps/CWeightedPointsMap.h>
 #include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservationComment.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationGPS.h>
 #include <mrpt/obs/gnss_messages.h>
 #include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CObservationRange.h>
 #include <mrpt/obs/CObservationVelodyneScan.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -225,6 +227,46 @@ TEST(RawlogPrecheck, VelodyneScanCountsAreBounded) {
     EXPECT_EQ(damageReason(tmp, std::string(good).replace(k.at, 4, u32(k.corrupt)), &before),
               "corrupt CObservationVelodyneScan: " + k.field + " at byte " +
                   std::to_string(before + k.at) + " (more than " + k.bound + ")");
+  }
+}
+
+// MRPT reads a bool as a raw byte into the bool: a flag byte other than 0 or 1 (MRPT writes no
+// other) is a bool whose every use is undefined (found by fuzz_rawlog under UBSan: a 3D scan's
+// intensity image flag of 3, loaded by the cloud conversion). Each flag the walk reads is damage
+// at any other value.
+TEST(RawlogPrecheck, FlagsOtherThanZeroOrOneAreDamage) {
+  TempDir tmp;
+  mrpt::obs::CObservation3DRangeScan scan;
+  scan.hasPoints3D = false;
+  scan.hasRangeImage = true;
+  scan.rangeImage_setSize(4, 5);
+  scan.rangeImage.setZero();
+  const std::string depth = serialized(scan);
+  const std::size_t sides_at = depth.find(u32(4) + u32(5));
+  ASSERT_NE(sides_at, std::string::npos);
+  const std::size_t intensity_at = sides_at + 8 + 4 * 5 * 2;  // after the range image
+  ASSERT_EQ(depth[intensity_at], '\0');
+  ASSERT_EQ(depth[sides_at - 5], '\1');  // the range image flag, before rangeUnits
+  mrpt::obs::CObservationOdometry odometry;
+  const std::string wheels = serialized(odometry);
+  const std::size_t encoders_at = wheels.size() - 1 - 1 - 1;  // encoders, velocities, end flag
+  ASSERT_EQ(wheels[encoders_at], '\0');
+  const struct {
+    std::string bytes;
+    std::size_t at;
+    std::string why;
+  } cases[] = {
+      {depth, intensity_at, "corrupt CObservation3DRangeScan: intensity image flag 3"},
+      {depth, sides_at - 5, "corrupt CObservation3DRangeScan: range image flag 3"},
+      {wheels, encoders_at, "corrupt CObservationOdometry: encoders flag 3"},
+  };
+  std::size_t before = 0;
+  for (const auto& k : cases) {
+    ASSERT_EQ(damageReason(tmp, k.bytes, &before), "(read)");
+    std::string bad = k.bytes;
+    bad[k.at] = '\3';
+    EXPECT_EQ(damageReason(tmp, bad, &before),
+              k.why + " at byte " + std::to_string(before + k.at) + " (a flag is 0 or 1)");
   }
 }
 

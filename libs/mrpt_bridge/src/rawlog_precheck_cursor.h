@@ -68,6 +68,18 @@ struct ObjectHeader {
 /// it.
 bool readHeader(Cursor& c, ObjectHeader& h);
 
+/// A bool, which MRPT reads as a raw byte into the bool: a byte other than 0 or 1 (MRPT writes no
+/// other) is an impossible bool to whatever reads it. Impossible, with `why` naming the field, its
+/// value and its byte, for any other.
+inline Parse checkFlag(Cursor& c, const char* field, std::uint8_t& v, std::string& why) {
+  const std::uint64_t at = c.position();
+  if (!c.value(v)) return Parse::OtherLayout;
+  if (v <= 1) return Parse::Read;
+  why = std::string(field) + " flag " + std::to_string(v) + " at byte " + std::to_string(at) +
+        " (a flag is 0 or 1)";
+  return Parse::Impossible;
+}
+
 /// A count or size read from the stream at byte `at`, checked against its
 /// bound: false, with `why` naming the field ("scan size 4294967295 at byte
 /// 1234 (more than 1000000 rays)"), when it exceeds it.

@@ -48,7 +48,10 @@ Parse checkVelodyneScan(Cursor& c, int version, std::string& why) {
   for (const auto& f : kPoints) {
     if ((p = checkList(c, f.field, f.bytes, kMaxImagePixels, "points", why)) != kRead) return p;
   }
-  if (version >= 1) c.skip(1);
+  std::uint8_t satellite_time = 0;
+  if (version >= 1 && (p = checkFlag(c, "satellite timestamp", satellite_time, why)) != kRead) {
+    return p;
+  }
   if (version < 2) return kRead;
   if ((p = typeNames(c, why)) != kRead ||
       (p = checkList(c, "point timestamp count", sizeof(std::uint64_t), kMaxImagePixels, "points",

@@ -289,9 +289,10 @@ Parse image(Cursor& c, std::string& why) {
 }
 
 // An image flag, then the image when the flag is set.
-Parse optionalImage(Cursor& c, std::string& why) {
+Parse optionalImage(Cursor& c, const char* field, std::string& why) {
   std::uint8_t has = 0;
-  if (!c.value(has)) return kOther;
+  const Parse p = checkFlag(c, field, has, why);
+  if (p != kRead) return p;
   return has ? image(c, why) : kRead;
 }
 
@@ -322,7 +323,8 @@ Parse scan2D(Cursor& c, int version, std::string& why) {
 // CObservation3DRangeScan, versions 0-10: the 3D points, the range image and the other images.
 Parse scan3DImages(Cursor& c, int version, std::string& why) {
   std::uint8_t has_points = 1, has_range = 0;
-  if (version > 0 && !c.value(has_points)) return kOther;
+  Parse p = kRead;
+  if (version > 0 && (p = checkFlag(c, "3D points", has_points, why)) != kRead) return p;
   if (has_points) {
     const std::uint64_t at = c.position();
     std::uint32_t n = 0;
@@ -332,21 +334,19 @@ Parse scan3DImages(Cursor& c, int version, std::string& why) {
                                (version >= 8 ? 2 * sizeof(std::uint16_t) : 0)));
   }
   if (version == 0) return kRead;
-  if (!c.value(has_range)) return kOther;
+  if ((p = checkFlag(c, "range image", has_range, why)) != kRead) return p;
   if (version >= 9) c.skip(sizeof(float));  // rangeUnits
   if (has_range) {
     if (version < 9) {
-      const Parse p = matrix(c, "range image", why);
-      if (p != kRead) return p;
+      if ((p = matrix(c, "range image", why)) != kRead) return p;
     } else {
       std::uint64_t rows = 0, cols = 0;
-      const Parse p = sides(c, "range image", rows, cols, why);
-      if (p != kRead) return p;
+      if ((p = sides(c, "range image", rows, cols, why)) != kRead) return p;
       c.skip(rows * cols * sizeof(std::uint16_t));
     }
   }
-  Parse p = optionalImage(c, why);                     // intensity
-  if (p == kRead) p = optionalImage(c, why);           // confidence
+  p = optionalImage(c, "intensity image", why);
+  if (p == kRead) p = optionalImage(c, "confidence image", why);
   if (p == kRead && version >= 2) p = camera(c, why);  // depth camera
   if (p == kRead && version >= 4) p = camera(c, why);  // intensity camera
   if (p == kRead && version >= 4) p = pose(c, why);    // intensity camera's pose
@@ -362,16 +362,21 @@ Parse scan3D(Cursor& c, int version, std::string& why) {
   c.skip(sizeof(float) + sizeof(std::uint64_t));  // stdError, timestamp
   if ((p = string(c, "sensor label length", why)) != kRead) return p;
   if (version >= 3) {
-    for (const char* field :
-         {"external points file name length", "external range file name length"}) {
-      c.skip(1);  // stored externally
+    for (const auto& [flag, field] :
+         {std::pair{"points stored externally", "external points file name length"},
+          std::pair{"range stored externally", "external range file name length"}}) {
+      std::uint8_t external = 0;
+      if ((p = checkFlag(c, flag, external, why)) != kRead) return p;
       if ((p = string(c, field, why)) != kRead) return p;
     }
   }
-  if (version >= 5) c.skip(1);  // range_is_depth
+  std::uint8_t range_is_depth = 0;
+  if (version >= 5 && (p = checkFlag(c, "range is depth", range_is_depth, why)) != kRead) {
+    return p;
+  }
   if (version >= 6) c.skip(1);  // intensity channel
   std::uint8_t labels = 0;
-  if (version >= 7 && !c.value(labels)) return kOther;
+  if (version >= 7 && (p = checkFlag(c, "pixel labels", labels, why)) != kRead) return p;
   if (labels) return kOther;  // pixel labels: left to MRPT
   if (version < 10) return kRead;
   std::uint8_t layers = 0;
@@ -406,7 +411,10 @@ Parse stereoImages(Cursor& c, int version, std::string& why) {
   if (p == kRead) p = image(c, why);
   if (p != kRead) return p;
   std::uint8_t disparity = 0, right = 0;
-  if (!c.value(disparity) || !c.value(right)) return kOther;
+  if ((p = checkFlag(c, "disparity image", disparity, why)) != kRead ||
+      (p = checkFlag(c, "right image", right, why)) != kRead) {
+    return p;
+  }
   if (right && (p = image(c, why)) != kRead) return p;
   if (disparity && (p = image(c, why)) != kRead) return p;
   c.skip(sizeof(std::uint64_t));
@@ -459,7 +467,7 @@ Parse pointCloud(Cursor& c, int version, std::string& why) {
   c.skip(sizeof(std::uint64_t));
   if ((p = pose(c, why)) != kRead) return p;
   std::uint8_t external = 0;
-  if (!c.value(external)) return kOther;
+  if ((p = checkFlag(c, "stored externally", external, why)) != kRead) return p;
   return external ? string(c, "external file name length", why) : pointsMap(c, why);
 }
 
@@ -501,7 +509,10 @@ Parse gnss(Cursor& c, int version, std::string& why) {
   c.skip(2 * sizeof(std::uint64_t));
   Parse p = string(c, "sensor label length", why);
   if (p != kRead || (p = pose(c, why)) != kRead) return p;
-  if (version == 11) c.skip(1);
+  std::uint8_t satellite_time = 0;
+  if (version == 11 && (p = checkFlag(c, "satellite timestamp", satellite_time, why)) != kRead) {
+    return p;
+  }
   const std::uint64_t at = c.position();
   std::uint32_t n = 0;
   if (!c.value(n)) return kOther;
@@ -529,9 +540,9 @@ Parse odometry(Cursor& c, int version, std::string& why) {
   c.skip(sizeof(std::uint64_t));
   if (version == 0) return kRead;
   std::uint8_t encoders = 0, velocities = 0;
-  if (!c.value(encoders)) return kOther;
+  if ((p = checkFlag(c, "encoders", encoders, why)) != kRead) return p;
   if (encoders || version < 2) c.skip(2 * sizeof(std::int32_t));
-  if (!c.value(velocities)) return kOther;
+  if ((p = checkFlag(c, "velocities", velocities, why)) != kRead) return p;
   if (version < 2) c.skip(2 * sizeof(float));
   if (version == 2 && velocities) c.skip(3 * sizeof(double));
   return kRead;
