@@ -110,7 +110,8 @@ mrpt::img::CImage gradient(int w, int h) {
 // A plain rawlog object stream of the other sensors a robot records: a frame of an IMU, wheel
 // odometry, a GNSS reading (GGA and RMC fixes, a Novatel frame kept whole, Topcon satellites,
 // empty Novatel ranges), two point clouds (plain and coloured), a range finder, a JPEG camera
-// image, a small 3D scan with a JPEG intensity image and a Velodyne scan; then the same bare.
+// image, a small 3D scan with a JPEG intensity image and pixel labels, and a Velodyne scan; then
+// the same bare.
 void putSensorsRawlog(const fs::path& dir) {
   mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
   auto imu = mrpt::obs::CObservationIMU::Create();
@@ -173,6 +174,11 @@ void putSensorsRawlog(const fs::path& dir) {
   depth->rangeImage.fill(1000);
   depth->hasIntensityImage = true;
   depth->intensityImage = gradient(32, 24);
+  auto* labels = new mrpt::obs::TPixelLabelInfo<1>();
+  labels->setSize(24, 32);
+  labels->setLabelName(0, "ground");
+  labels->setLabelName(3, "rock");
+  depth->pixelLabels = mrpt::obs::TPixelLabelInfoBase::Ptr(labels);
   depth->cameraParams.ncols = depth->cameraParamsIntensity.ncols = 32;
   depth->cameraParams.nrows = depth->cameraParamsIntensity.nrows = 24;
   auto lidar = mrpt::obs::CObservationVelodyneScan::Create();

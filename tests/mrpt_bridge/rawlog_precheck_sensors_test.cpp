@@ -270,6 +270,45 @@ TEST(RawlogPrecheck, FlagsOtherThanZeroOrOneAreDamage) {
   }
 }
 
+// A 3D scan's pixel labels as MRPT writes them (a label matrix, label names) are walked to the
+// scan's end; the matrix sides MRPT resizes to, the name count and a name's length, corrupted,
+// are damage at their bytes.
+TEST(RawlogPrecheck, PixelLabelSizesAreBounded) {
+  TempDir tmp;
+  mrpt::obs::CObservation3DRangeScan scan;
+  scan.hasPoints3D = false;
+  auto* labels = new mrpt::obs::TPixelLabelInfo<2>();
+  labels->setSize(3, 7);
+  labels->setLabelName(1, "floor");
+  labels->setLabelName(5, "wall");
+  scan.pixelLabels = mrpt::obs::TPixelLabelInfoBase::Ptr(labels);
+  const std::string good = serialized(scan);
+  std::string why;
+  EXPECT_EQ(walked(good, &why), good.size()) << why;
+  std::size_t before = 0;
+  EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
+  const std::size_t rows_at = good.find(u32(3) + u32(7));
+  const std::size_t names_at = good.find(u32(2) + u32(1) + u32(5) + "floor");
+  const std::size_t wall_at = good.find(u32(4) + "wall");
+  ASSERT_NE(rows_at, std::string::npos);
+  ASSERT_NE(names_at, std::string::npos);
+  ASSERT_NE(wall_at, std::string::npos);
+  const struct {
+    std::size_t at;
+    std::uint32_t corrupt;
+    std::string field, bound;
+  } cases[] = {
+      {rows_at, 70000, "pixel label rows 70000", "65535 rows"},
+      {names_at, 1u << 30, "label name count 1073741824", "65536 names"},
+      {wall_at, 0xF0000000u, "label name length 4026531840", "65536 bytes"},
+  };
+  for (const auto& k : cases) {
+    EXPECT_EQ(damageReason(tmp, std::string(good).replace(k.at, 4, u32(k.corrupt)), &before),
+              "corrupt CObservation3DRangeScan: " + k.field + " at byte " +
+                  std::to_string(before + k.at) + " (more than " + k.bound + ")");
+  }
+}
+
 // A point cloud observation's map: MRPT resizes every field to the count it reads (its aligned
 // allocator does not fail: a corrupt count had the process killed for memory, 22 GB resident)
 // and a coloured map's channels to counts of their own. Each is bounded as a 3D scan's points, in

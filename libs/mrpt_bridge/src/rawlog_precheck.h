@@ -66,6 +66,8 @@ constexpr std::uint32_t kMaxGnssSatellites = 4096;
 constexpr std::uint32_t kMaxLidarPackets = 65536;
 /// Most lasers in a Velodyne calibration or point cloud (sensors have 16 to 128).
 constexpr std::uint32_t kMaxLidarLasers = 4096;
+/// Most label names of a 3D scan's pixel labels (a bit field of 8 bytes names at most 64).
+constexpr std::uint32_t kMaxLabelNames = 65536;
 /// Most bytes of a CObservationComment's text (a note, a configuration block).
 constexpr std::uint32_t kMaxCommentBytes = 1u << 24;
 

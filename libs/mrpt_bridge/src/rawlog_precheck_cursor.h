@@ -104,6 +104,9 @@ Parse checkString(Cursor& c, const char* field, std::string& why,
 Parse checkList(Cursor& c, const char* field, std::size_t element_bytes, std::uint64_t max,
                 const char* unit, std::string& why);
 
+/// A CObservation3DRangeScan's pixel labels (TPixelLabelInfo), after their flag.
+Parse checkPixelLabels(Cursor& c, std::string& why);
+
 /// A CObservationVelodyneScan's body (versions 0-2; any other is OtherLayout), after its header.
 Parse checkVelodyneScan(Cursor& c, int version, std::string& why);
 

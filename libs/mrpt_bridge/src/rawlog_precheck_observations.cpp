@@ -377,7 +377,7 @@ Parse scan3D(Cursor& c, int version, std::string& why) {
   if (version >= 6) c.skip(1);  // intensity channel
   std::uint8_t labels = 0;
   if (version >= 7 && (p = checkFlag(c, "pixel labels", labels, why)) != kRead) return p;
-  if (labels) return kOther;  // pixel labels: left to MRPT
+  if (labels && (p = checkPixelLabels(c, why)) != kRead) return p;
   if (version < 10) return kRead;
   std::uint8_t layers = 0;
   if (!c.value(layers)) return kOther;
