@@ -346,12 +346,13 @@ TEST(RawlogPrecheck, PointCloudCountsAreBounded) {
   EXPECT_EQ(damageReason(tmp, serialized(none), &before), "(read)");
 }
 
-// The walk of a frame stops at the first observation of a layout it does not know (a GNSS
-// receiver's), and MRPT would read the rest unchecked (found by fuzz_rawlog: a coloured cloud's
-// channel count, behind an IMU reading the walk did not know then, made MRPT allocate
-// gigabytes). The reader hands MRPT a frame one observation at a time, each checked at its own
-// start; an element of another kind, or a missing end flag, is damage; a version-0 frame's
-// timestamp is set on its observations, as MRPT does.
+// A walk of a whole frame would stop at the first observation of a layout it does not know (a
+// point cloud's map options), and MRPT would read the rest unchecked (found by fuzz_rawlog: a
+// coloured cloud's channel count, behind an IMU reading the walk did not know then, made MRPT
+// allocate gigabytes). The reader hands MRPT a frame one observation at a time, each checked at
+// its own start; an element of another kind (found by fuzz_rawlog: a CActionCollection in a
+// frame, whose action count MRPT resized its list to, 6.5 GB), or a missing end flag, is damage;
+// a version-0 frame's timestamp is set on its observations, as MRPT does.
 TEST(RawlogPrecheck, FrameElementsAreEachCheckedAtTheirStart) {
   TempDir tmp;
   auto cloud = mrpt::obs::CObservationPointCloud::Create();
@@ -359,15 +360,15 @@ TEST(RawlogPrecheck, FrameElementsAreEachCheckedAtTheirStart) {
   points->insertPoint(1.0f, 2.0f, 0.5f);
   cloud->pointcloud = points;
   mrpt::obs::CSensoryFrame frame;
-  frame.insert(mrpt::obs::CObservationGPS::Create());
+  frame.insert(cloud);
   frame.insert(cloud);
   const std::string good = serialized(frame);
   std::string why;
-  EXPECT_EQ(walked(good, &why), 0u) << "the walk was to stop at the GNSS observation";
+  EXPECT_EQ(walked(good, &why), 0u) << "the walk was to stop at the first cloud's map options";
   std::size_t before = 0;
   EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
   const std::string name = "CSimplePointsMap";
-  const std::size_t count_at = good.find(name) + name.size() + 1;
+  const std::size_t count_at = good.rfind(name) + name.size() + 1;
   const std::string reason =
       damageReason(tmp, std::string(good).replace(count_at, 4, u32(0xFFFFFFFFu)), &before);
   EXPECT_EQ(reason, "corrupt CObservationPointCloud (observation 2 of 2 in a CSensoryFrame): "
@@ -376,6 +377,10 @@ TEST(RawlogPrecheck, FrameElementsAreEachCheckedAtTheirStart) {
   const std::string v2 = "\x8D" "CSensoryFrame\x02" + u32(1);
   EXPECT_EQ(damageReason(tmp, v2 + serialized(mrpt::poses::CPose2D(1, 2, 0)) + "\x88", &before),
             "corrupt CSensoryFrame: observation 1 of 1 is a CPose2D, not an observation");
+  const std::string collection = "\x9D" "mrpt::obs::CActionCollection" + std::string(1, '\0') +
+                                 u32(0xFFFFFFF0u) + "\x88";
+  EXPECT_EQ(damageReason(tmp, v2 + collection + "\x88", &before),
+            "corrupt CSensoryFrame: observation 1 of 1 is a CActionCollection, not an observation");
   mrpt::obs::CObservationComment comment;
   EXPECT_EQ(damageReason(tmp, v2 + serialized(comment) + "\x77", &before),
             "corrupt CSensoryFrame: no end flag after its 1 observation");

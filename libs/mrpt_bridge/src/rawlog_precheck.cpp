@@ -2,6 +2,9 @@
 
 #include "rawlog_precheck_cursor.h"
 
+#include <mrpt/obs/CObservation.h>
+#include <mrpt/rtti/CObject.h>
+
 #include <algorithm>
 #include <cstring>
 #include <iterator>
@@ -76,6 +79,7 @@ bool readHeader(Cursor& c, ObjectHeader& h) {
   name.resize(std::min(name.size(), name.find('\0')));
   const auto ns = name.rfind("::");
   h.class_name = ns == std::string::npos ? name : name.substr(ns + 2);
+  h.full_name = name;
   if (!h.has_end_flag) {
     std::int32_t v = 0;
     if (!c.value(v) || v < 0 || v >= 255) return false;
@@ -337,6 +341,14 @@ Parse checkFrameObservation(Cursor& c, int version, std::uint32_t i, std::uint32
   if (version == 0 && obs.class_name == "nullptr") {
     why = "corrupt CSensoryFrame: observation " + where +
           " is a null object (MRPT sets a version-0 frame's timestamp through each)";
+    return Parse::Impossible;
+  }
+  // MRPT reads any class it knows before the frame can see it is not an observation (a
+  // CActionCollection in a frame resizes its list to the count it reads).
+  const auto* known = mrpt::rtti::findRegisteredClass(obs.full_name);
+  if (known && !known->derivedFrom(CLASS_ID(mrpt::obs::CObservation))) {
+    why = "corrupt CSensoryFrame: observation " + where + " is a " + obs.class_name +
+          ", not an observation";
     return Parse::Impossible;
   }
   const Parse p = checkObservation(c, obs, why);

@@ -60,6 +60,7 @@ class Cursor {
 
 struct ObjectHeader {
   std::string class_name;  ///< without a namespace
+  std::string full_name;   ///< as written (MRPT looks the class up by it)
   int version = -1;
   bool has_end_flag = true;  ///< false in the format before MRPT 0.5.5
 };
