@@ -128,8 +128,9 @@ TEST(RawlogPrecheck, GnssMessagesAreWalked) {
   TempDir tmp;
   auto gps = mrpt::obs::CObservationGPS::Create();
   for (int type = 0; type < 5000; ++type) {
+    // (emplace: gnss_message_ptr's assignment copies the message and leaks the one it held)
     auto* m = gnss::gnss_message::Factory(static_cast<gnss::gnss_message_type_t>(type));
-    if (m) gps->messages[m->message_type] = gnss::gnss_message_ptr(m);
+    if (m) gps->messages.emplace(m->message_type, gnss::gnss_message_ptr(m));
   }
   ASSERT_GE(gps->messages.size(), 20u);
   auto& frame = dynamic_cast<gnss::Message_NV_OEM6_GENERIC_FRAME&>(
