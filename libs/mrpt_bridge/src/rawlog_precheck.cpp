@@ -292,6 +292,21 @@ Parse checkMovement(Cursor& c, const ObjectHeader& h, std::string& why) {
                                                   : checkMovement3D(c, h.version, why);
 }
 
+// Why a frame's observation count or a collection's action count read at byte `at` is past its
+// bound ("corrupt CSensoryFrame: observation count ..."), or "".
+std::string containerCountPastBound(bool frame, std::uint32_t count, std::uint64_t at) {
+  std::string why;
+  if (frame) {
+    if (!withinBound("observation count", count, at, kMaxObservationsPerFrame, "observations",
+                     why)) {
+      return "corrupt CSensoryFrame: " + why;
+    }
+  } else if (!withinBound("action count", count, at, kMaxActionsPerCollection, "actions", why)) {
+    return "corrupt CActionCollection: " + why;
+  }
+  return {};
+}
+
 // Action i of n in a CActionCollection, through its end flag: MRPT keeps each action as a
 // deep-copying pointer made from what it read cast to a CAction: anything else, or a null
 // object, is copied through a null pointer.
@@ -321,10 +336,7 @@ Parse checkActions(Cursor& c, int version, std::string& why) {
   const std::uint64_t at = c.position();
   std::uint32_t actions = 0;
   if (!c.value(actions)) return Parse::OtherLayout;
-  if (!withinBound("action count", actions, at, kMaxActionsPerCollection, "actions", why)) {
-    why = "corrupt CActionCollection: " + why;
-    return Parse::Impossible;
-  }
+  if (!(why = containerCountPastBound(false, actions, at)).empty()) return Parse::Impossible;
   for (std::uint32_t i = 0; i < actions; ++i) {
     const Parse p = checkAction(c, i, actions, why);
     if (p != Parse::Read) return p;
@@ -368,10 +380,7 @@ Parse checkFrame(Cursor& c, int version, std::string& why) {
   const std::uint64_t at = c.position();
   std::uint32_t count = 0;
   if (!c.value(count)) return Parse::OtherLayout;
-  if (!withinBound("observation count", count, at, kMaxObservationsPerFrame, "observations", why)) {
-    why = "corrupt CSensoryFrame: " + why;
-    return Parse::Impossible;
-  }
+  if (!(why = containerCountPastBound(true, count, at)).empty()) return Parse::Impossible;
   for (std::uint32_t i = 0; i < count; ++i) {
     const Parse p = checkFrameObservation(c, version, i, count, why);
     if (p != Parse::Read) return p;
@@ -415,18 +424,8 @@ bool peekContainerHead(LookaheadStream& in, ContainerHead& head) {
 }
 
 std::string precheckContainerHead(LookaheadStream& in, const ContainerHead& head) {
-  std::string why;
-  const std::uint64_t at = in.getPosition() + head.bytes - sizeof(std::uint32_t);
-  if (head.frame) {
-    if (!withinBound("observation count", head.count, at, kMaxObservationsPerFrame,
-                     "observations", why)) {
-      return "corrupt CSensoryFrame: " + why;
-    }
-  } else if (!withinBound("action count", head.count, at, kMaxActionsPerCollection, "actions",
-                          why)) {
-    return "corrupt CActionCollection: " + why;
-  }
-  return {};
+  return containerCountPastBound(head.frame, head.count,
+                                 in.getPosition() + head.bytes - sizeof(std::uint32_t));
 }
 
 std::string precheckNextElement(LookaheadStream& in, const ContainerHead& head,

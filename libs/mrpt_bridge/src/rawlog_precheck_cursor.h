@@ -100,6 +100,11 @@ Parse checkPose(Cursor& c, std::string& why);
 Parse checkString(Cursor& c, const char* field, std::string& why,
                   std::uint32_t max_bytes = kMaxStringBytes);
 
+/// Rows and columns of an image or matrix (32 bits each), each side and their product bounded as
+/// an image's ("<field> rows 70000 at byte ... (more than 65535 rows)").
+Parse checkSides(Cursor& c, const char* field, std::uint64_t& rows, std::uint64_t& cols,
+                 std::string& why);
+
 /// A list MRPT resizes to the 32-bit count before it, then reads: the count bounded by max (false,
 /// with why naming field and unit, past it), the elements of element_bytes each skipped.
 Parse checkList(Cursor& c, const char* field, std::size_t element_bytes, std::uint64_t max,

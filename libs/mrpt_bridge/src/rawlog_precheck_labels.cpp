@@ -12,17 +12,10 @@ Parse checkPixelLabels(Cursor& c, std::string& why) {
   if (!c.value(version) || version != 1 || !c.value(field_bytes)) return Parse::OtherLayout;
   if (field_bytes < 1 || field_bytes > 8) return Parse::OtherLayout;  // MRPT refuses it
   static constexpr std::uint8_t kLabelBytes[9] = {0, 1, 2, 4, 4, 8, 8, 8, 8};
-  const std::uint64_t at = c.position();
-  std::uint32_t rows = 0, cols = 0;
-  if (!c.value(rows) || !c.value(cols)) return Parse::OtherLayout;
-  if (!withinBound("pixel label rows", rows, at, kMaxImageSide, "rows", why) ||
-      !withinBound("pixel label columns", cols, at + 4, kMaxImageSide, "columns", why) ||
-      !withinBound("pixel labels", std::uint64_t{rows} * cols, at, kMaxImagePixels, "labels",
-                   why)) {
-    return Parse::Impossible;
-  }
-  c.skip(std::uint64_t{rows} * cols * kLabelBytes[field_bytes]);
-  Parse p = Parse::Read;
+  std::uint64_t rows = 0, cols = 0;
+  Parse p = checkSides(c, "pixel label", rows, cols, why);
+  if (p != Parse::Read) return p;
+  c.skip(rows * cols * kLabelBytes[field_bytes]);
   for (const char* field : {"label map container name length", "label map key type name length",
                             "label map value type name length"}) {
     if ((p = checkString(c, field, why)) != Parse::Read) return p;

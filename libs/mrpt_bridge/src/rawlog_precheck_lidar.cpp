@@ -32,10 +32,10 @@ Parse checkVelodyneScan(Cursor& c, int version, std::string& why) {
   if (p != kRead) return p;
   c.skip(2 * sizeof(double));
   if ((p = checkPose(c, why)) != kRead) return p;
-  if ((p = checkList(c, "packet count", sizeof(Scan::TVelodyneRawPacket), kMaxLidarPackets, "packets",
-                why)) != kRead ||
+  if ((p = checkList(c, "packet count", sizeof(Scan::TVelodyneRawPacket), kMaxLidarPackets,
+                     "packets", why)) != kRead ||
       (p = checkList(c, "laser count", sizeof(mrpt::obs::VelodyneCalibration::PerLaserCalib),
-                kMaxLidarLasers, "lasers", why)) != kRead) {
+                     kMaxLidarLasers, "lasers", why)) != kRead) {
     return p;
   }
   static const struct {
@@ -54,12 +54,12 @@ Parse checkVelodyneScan(Cursor& c, int version, std::string& why) {
   }
   if (version < 2) return kRead;
   if ((p = typeNames(c, why)) != kRead ||
-      (p = checkList(c, "point timestamp count", sizeof(std::uint64_t), kMaxImagePixels, "points",
-                why)) != kRead ||
-      (p = checkList(c, "point azimuth count", sizeof(float), kMaxImagePixels, "points", why)) !=
-          kRead ||
+      (p = checkList(c, "point timestamp count", sizeof(std::uint64_t), kMaxImagePixels,
+                     "points", why)) != kRead ||
+      (p = checkList(c, "point azimuth count", sizeof(float), kMaxImagePixels, "points",
+                     why)) != kRead ||
       (p = checkList(c, "point laser ID count", sizeof(std::int16_t), kMaxImagePixels, "points",
-                why)) != kRead ||
+                     why)) != kRead ||
       (p = typeNames(c, why)) != kRead) {
     return p;
   }

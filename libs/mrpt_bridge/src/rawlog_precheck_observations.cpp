@@ -556,6 +556,11 @@ Parse checkString(Cursor& c, const char* field, std::string& why, std::uint32_t 
   return string(c, field, why, max_bytes);
 }
 
+Parse checkSides(Cursor& c, const char* field, std::uint64_t& rows, std::uint64_t& cols,
+                 std::string& why) {
+  return sides(c, field, rows, cols, why);
+}
+
 Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
   // The walk of each observation class, by its name without the namespace.
   static const struct {
