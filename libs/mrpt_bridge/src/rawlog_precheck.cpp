@@ -57,7 +57,10 @@ bool LookaheadStream::peek(std::size_t offset, void* out, std::size_t count) {
     ahead_.resize(have + chunk);
     const std::size_t got = in_.Read(ahead_.data() + have, chunk);
     ahead_.resize(have + got);
-    if (got == 0) return false;
+    if (got == 0) {
+      end_ = in_.getPosition();
+      return false;
+    }
   }
   std::memcpy(out, ahead_.data() + head_ + offset, count);
   return true;
@@ -402,6 +405,15 @@ Parse checkTopLevel(Cursor& c, const ObjectHeader& top, std::string& why) {
   return p;
 }
 
+// Why an object whose walk ran past the end of the stream is damage (MRPT's CArchive takes a short
+// read as data: a count cut by the end of a file is read with bytes that were never there, and a
+// list resized to it), or "" when it did not, or the stream ended before the object's first byte.
+std::string truncation(const Cursor& c, const LookaheadStream& in) {
+  const auto end = in.knownEnd();
+  if (!c.ranOut() || !end || *end <= c.start()) return {};
+  return "truncated, the file ends inside it, at byte " + std::to_string(*end);
+}
+
 }  // namespace
 
 bool peekContainerHead(LookaheadStream& in, ContainerHead& head) {
@@ -434,17 +446,18 @@ std::string precheckNextElement(LookaheadStream& in, const ContainerHead& head,
   std::string why;
   const Parse p = head.frame ? checkFrameObservation(c, head.version, index, head.count, why)
                              : checkAction(c, index, head.count, why);
-  return p == Parse::Impossible ? why : std::string();
+  return p == Parse::Impossible ? why : truncation(c, in);
 }
 
 std::string precheckNextObject(LookaheadStream& in, std::size_t* checked_bytes) {
   if (checked_bytes) *checked_bytes = 0;
   Cursor c(in);
   ObjectHeader top;
-  if (!readHeader(c, top)) return {};
+  if (!readHeader(c, top)) return truncation(c, in);
   std::string why;
   const Parse p = checkTopLevel(c, top, why);
   if (p == Parse::Impossible) return why;
+  if (std::string cut = truncation(c, in); !cut.empty()) return cut;
   if (p == Parse::Read && checked_bytes) *checked_bytes = c.walked();
   return {};
 }

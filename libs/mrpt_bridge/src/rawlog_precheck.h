@@ -22,6 +22,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -89,11 +90,14 @@ class LookaheadStream : public mrpt::io::CStream {
   /// Copies count bytes, starting offset bytes after the position, into out; false when the
   /// stream ends before them.
   bool peek(std::size_t offset, void* out, std::size_t count);
+  /// The stream's length once a peek has run past its end (in the position's bytes), else none.
+  std::optional<std::uint64_t> knownEnd() const { return end_; }
 
  private:
   mrpt::io::CStream& in_;
   std::vector<std::uint8_t> ahead_;  ///< bytes read from in_, not consumed from head_ on
   std::size_t head_ = 0;
+  std::optional<std::uint64_t> end_;
 };
 
 /// Why the next top-level object must not be handed to MRPT ("corrupt CObservation2DRangeScan

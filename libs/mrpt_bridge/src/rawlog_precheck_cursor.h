@@ -26,9 +26,23 @@ class Cursor {
   explicit Cursor(LookaheadStream& in) : in_(in), base_(in.getPosition()) {}
 
   bool bytes(void* out, std::size_t n) {
-    if (!in_.peek(offset_, out, n)) return false;
+    if (!in_.peek(offset_, out, n)) {
+      ran_out_ = true;
+      return false;
+    }
     offset_ += n;
     return true;
+  }
+  /// true when at least n bytes follow the position (reads no more than the stream holds: a
+  /// corrupt size near the end of a file is not allocated ahead of its bytes).
+  bool has(std::uint64_t n) {
+    std::uint8_t last = 0;
+    if (n == 0) return true;
+    const std::size_t at = offset_;
+    offset_ += static_cast<std::size_t>(n - 1);
+    const bool there = bytes(&last, 1);
+    offset_ = at;
+    return there;
   }
   template <typename T>
   bool value(T& v) {
@@ -47,6 +61,10 @@ class Cursor {
   std::uint64_t position() const { return base_ + offset_; }
   /// Bytes walked since the cursor was made.
   std::size_t walked() const { return offset_; }
+  /// true once a read ran past the end of the stream.
+  bool ranOut() const { return ran_out_; }
+  /// The byte the cursor started at.
+  std::uint64_t start() const { return base_; }
   bool endFlag() {
     std::uint8_t f = 0;
     return value(f) && f == 0x88;  // MRPT's SERIALIZATION_END_FLAG after each object
@@ -56,6 +74,7 @@ class Cursor {
   LookaheadStream& in_;
   std::uint64_t base_;
   std::size_t offset_ = 0;
+  bool ran_out_ = false;
 };
 
 struct ObjectHeader {

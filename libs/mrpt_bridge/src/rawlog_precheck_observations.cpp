@@ -179,8 +179,11 @@ Parse colourImage(Cursor& c, int version, std::string& why) {
     // the same bytes are decoded here, not one more (a JPEG whose Huffman table runs past its byte
     // count decodes with zeros after it, but ends the process at its end).
     if (bytes == 0) return kRead;  // nothing to decode: MRPT's reader does not end the process
-    std::vector<std::uint8_t> jpeg(bytes, 0);
-    if (!c.bytes(jpeg.data(), bytes)) {
+    // (Whether the stream holds them is asked first: a byte count far past the end of a file is
+    // not allocated.)
+    std::vector<std::uint8_t> jpeg;
+    if (c.has(bytes)) jpeg.assign(bytes, 0);
+    if (jpeg.empty() || !c.bytes(jpeg.data(), bytes)) {
       // MRPT reads what there is without a complaint (a short read is no error to CArchive)
       // and decodes it: a JPEG cut in its header ends the process in libjpeg.
       why = "image JPEG of " + std::to_string(bytes) + " bytes at byte " +

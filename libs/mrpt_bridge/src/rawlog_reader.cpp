@@ -316,7 +316,14 @@ struct RawlogReader::Impl {
       }
     }
     std::uint8_t end = 0x88;
-    if (head.has_end_flag) archive->ReadBuffer(&end, 1);
+    if (head.has_end_flag) {
+      if (!lookahead->peek(0, &end, 1)) {
+        fail(object_index, position,
+             "truncated, the file ends inside it, at byte " +
+                 std::to_string(lookahead->getPosition()) + " (before its end flag)");
+      }
+      archive->ReadBuffer(&end, 1);
+    }
     if (end != 0x88) {
       fail(object_index, position,
            std::string("corrupt ") + (head.frame ? "CSensoryFrame" : "CActionCollection") +
