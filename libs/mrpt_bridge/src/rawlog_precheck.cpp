@@ -398,8 +398,16 @@ Parse checkTopLevel(Cursor& c, const ObjectHeader& top, std::string& why) {
   if (top.class_name == "CActionRobotMovement2D" || top.class_name == "CActionRobotMovement3D") {
     p = checkMovement(c, top, why);
     if (p == Parse::Read && top.has_end_flag && !c.endFlag()) p = Parse::OtherLayout;
+  } else if (top.class_name.rfind("CPosePDF", 0) == 0) {
+    return checkPosePdf(c, top, why);  // (its reasons name the class)
   } else {
     p = checkObservation(c, top, why);
+    // A part of an observation on its own (a rawlog holds none; a damaged one may): MRPT would
+    // read it before the reader skips it, allocating by its sizes.
+    if (p == Parse::OtherLayout && !c.ranOut()) {
+      c.restart();
+      p = checkPart(c, top.class_name, why);
+    }
   }
   if (p == Parse::Impossible) why = "corrupt " + top.class_name + ": " + why;
   return p;

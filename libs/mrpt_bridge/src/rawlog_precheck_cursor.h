@@ -65,6 +65,11 @@ class Cursor {
   bool ranOut() const { return ran_out_; }
   /// The byte the cursor started at.
   std::uint64_t start() const { return base_; }
+  /// Back to that byte, to walk the same bytes again another way.
+  void restart() {
+    offset_ = 0;
+    ran_out_ = false;
+  }
   bool endFlag() {
     std::uint8_t f = 0;
     return value(f) && f == 0x88;  // MRPT's SERIALIZATION_END_FLAG after each object
@@ -110,6 +115,11 @@ bool withinBound(const char* field, std::uint64_t value, std::uint64_t at, std::
 /// CObservation3DRangeScan, CObservationImage or CObservationStereoImages; any
 /// other class is OtherLayout), up to and including its end flag.
 Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why);
+
+/// A part of an observation stored as an object of its own (a CImage, TCamera, CMatrix, CMatrixF,
+/// CMatrixD, CPose3D, CPose3DQuat, CPose2D or points map), header to end flag, as the
+/// observations' walks read it; OtherLayout for any other class.
+Parse checkPart(Cursor& c, const std::string& class_name, std::string& why);
 
 /// A CPose3D (versions 0-3), CPose3DQuat or CPose2D object, header to end flag.
 Parse checkPose(Cursor& c, std::string& why);

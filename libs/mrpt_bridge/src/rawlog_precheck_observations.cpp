@@ -555,6 +555,15 @@ Parse odometry(Cursor& c, int version, std::string& why) {
 
 Parse checkPose(Cursor& c, std::string& why) { return pose(c, why); }
 
+Parse checkPart(Cursor& c, const std::string& name, std::string& why) {
+  // (Each walk reads the header again and takes only the classes it knows.)
+  if (name == "CImage") return image(c, why);
+  if (name == "TCamera") return camera(c, why);
+  if (name.rfind("CMatrix", 0) == 0) return matrix(c, "matrix", why);
+  if (name.rfind("CPose", 0) == 0) return pose(c, why);
+  return name.find("PointsMap") != std::string::npos ? pointsMap(c, why) : kOther;
+}
+
 Parse checkString(Cursor& c, const char* field, std::string& why, std::uint32_t max_bytes) {
   return string(c, field, why, max_bytes);
 }
