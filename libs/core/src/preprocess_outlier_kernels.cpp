@@ -206,20 +206,25 @@ __attribute__((target("avx2,popcnt,bmi"), noinline)) double dropAndSum(const flo
   __m256 v[NV];
   loadPadded(cand, c, v);
   std::size_t drops = c - want;
-  if (drops > 3) {
-    // Those beyond a bound near the incoming kth (the previous point's) go at once where
-    // at least want lie within it: they are larger than the want-th.
-    const __m256 bound[2] = {_mm256_set1_ps(kth * 0.9f), _mm256_set1_ps(kth * 1.05f)};
-    std::size_t within[2] = {0, 0};
+  if (drops > 2) {
+    // Those beyond the tightest of a few bounds near the incoming kth (the previous point's)
+    // that keeps want go at once: they are larger than the want-th. (The counts against every
+    // bound are independent compares; each drop left after them is a chain of dependent ones.)
+    constexpr int kBounds = 6;
+    constexpr float kFactor[kBounds] = {0.86f, 0.91f, 0.96f, 1.01f, 1.07f, 1.14f};
+    __m256 bound[kBounds];
+    std::size_t within[kBounds] = {};
+    for (int b = 0; b < kBounds; ++b) bound[b] = _mm256_set1_ps(kth * kFactor[b]);
     for (std::size_t i = 0; i < NV; ++i) {
-      for (int b = 0; b < 2; ++b) {
+      for (int b = 0; b < kBounds; ++b) {
         within[b] += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(
             _mm256_movemask_ps(_mm256_cmp_ps(v[i], bound[b], _CMP_LE_OQ)))));
       }
     }
     const std::size_t pad = 8 * NV - c;  // (the padding, -inf, lies within any bound)
-    const int b = within[0] >= want + pad ? 0 : 1;
-    if (within[b] >= want + pad) {
+    int b = 0;
+    while (b < kBounds && within[b] < want + pad) ++b;
+    if (b < kBounds) {
       for (std::size_t i = 0; i < NV; ++i) {
         v[i] = _mm256_blendv_ps(lowest_v, v[i], _mm256_cmp_ps(v[i], bound[b], _CMP_LE_OQ));
       }
