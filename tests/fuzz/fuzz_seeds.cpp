@@ -17,6 +17,7 @@
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationBatteryState.h>
 #include <mrpt/obs/CObservationComment.h>
 #include <mrpt/obs/CObservationGPS.h>
 #include <mrpt/obs/CObservationIMU.h>
@@ -24,6 +25,7 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationRange.h>
+#include <mrpt/obs/CObservationRotatingScan.h>
 #include <mrpt/obs/CObservationVelodyneScan.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
@@ -110,8 +112,8 @@ mrpt::img::CImage gradient(int w, int h) {
 // A plain rawlog object stream of the other sensors a robot records: a frame of an IMU, wheel
 // odometry, a GNSS reading (GGA and RMC fixes, a Novatel frame kept whole, Topcon satellites,
 // empty Novatel ranges), two point clouds (plain and coloured), a range finder, a JPEG camera
-// image, a small 3D scan with a JPEG intensity image and pixel labels, and a Velodyne scan; then
-// the same bare.
+// image, a small 3D scan with a JPEG intensity image and pixel labels, a Velodyne scan, a rotating
+// LiDAR's range images and a battery state; then the same bare.
 void putSensorsRawlog(const fs::path& dir) {
   mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
   auto imu = mrpt::obs::CObservationIMU::Create();
@@ -194,8 +196,20 @@ void putSensorsRawlog(const fs::path& dir) {
     lidar->point_cloud.laser_id.push_back(static_cast<int16_t>(i));
   }
   lidar->point_cloud.pointsForLaserID = {{0, 1}, {2, 3}};
-  const mrpt::obs::CObservation::Ptr all[] = {imu, odometry, gps, plain, colour, range, camera,
-                                              depth, lidar};
+  auto rotating = mrpt::obs::CObservationRotatingScan::Create();
+  rotating->rowCount = 4;
+  rotating->columnCount = 6;
+  rotating->rangeImage.setConstant(4, 6, 1500);
+  rotating->intensityImage.setConstant(4, 6, 80);
+  rotating->rangeOtherLayers["STRONGEST"].setConstant(4, 6, 1400);
+  auto battery = mrpt::obs::CObservationBatteryState::Create();
+  battery->voltageMainRobotBattery = 24.1;
+  battery->voltageOtherBatteries.resize(2);
+  battery->voltageOtherBatteries[0] = 12.0;
+  battery->voltageOtherBatteries[1] = 12.1;
+  battery->voltageOtherBatteriesValid.assign(2, true);
+  const mrpt::obs::CObservation::Ptr all[] = {imu,   odometry, gps,   plain,    colour,  range,
+                                              camera, depth,   lidar, rotating, battery};
   mrpt::obs::CSensoryFrame frame;
   for (const auto& o : all) frame.insert(o);
   mrpt::io::CFileOutputStream out((dir / "sensors.rawlog").string());

@@ -59,4 +59,11 @@ inline std::string damageReason(const TempDir& tmp, const std::string& object, s
   return reason;
 }
 
+// The reason RawlogReader gives for a file of a comment and then `object` with the bytes at `at`
+// replaced by `value`.
+inline std::string reasonWith(const TempDir& tmp, const std::string& object, std::size_t at,
+                              const std::string& value, std::size_t* head_size) {
+  return damageReason(tmp, std::string(object).replace(at, value.size(), value), head_size);
+}
+
 }  // namespace upd::test

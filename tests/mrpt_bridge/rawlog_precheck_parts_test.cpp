@@ -17,15 +17,10 @@
 namespace {
 
 using upd::test::damageReason;
+using upd::test::reasonWith;
 using upd::test::serialized;
 using upd::test::TempDir;
 using upd::test::u32;
-
-// The object with the 4 bytes at `at` replaced by value, after a comment: the reader's reason.
-std::string reasonWith(const TempDir& tmp, const std::string& object, std::size_t at,
-                       std::uint32_t value, std::size_t* head) {
-  return damageReason(tmp, std::string(object).replace(at, 4, u32(value)), head);
-}
 
 }  // namespace
 
@@ -39,7 +34,7 @@ TEST(RawlogPrecheck, PartsOfObservationsOnTheirOwnAreCheckedAsInside) {
   EXPECT_EQ(damageReason(tmp, map, &head), "(read)");
   const std::size_t count_at = map.find("CSimplePointsMap") + 17;  // after the version byte
   ASSERT_EQ(map.substr(count_at, 4), u32(5));
-  EXPECT_EQ(reasonWith(tmp, map, count_at, 0xFFFFFFF0u, &head),
+  EXPECT_EQ(reasonWith(tmp, map, count_at, u32(0xFFFFFFF0u), &head),
             "corrupt CSimplePointsMap: point count 4294967280 at byte " +
                 std::to_string(head + count_at) + " (more than 16777216 points)");
 
@@ -49,7 +44,7 @@ TEST(RawlogPrecheck, PartsOfObservationsOnTheirOwnAreCheckedAsInside) {
   EXPECT_EQ(damageReason(tmp, matrix, &head), "(read)");
   const std::size_t rows_at = matrix.find(u32(2) + u32(3));
   ASSERT_NE(rows_at, std::string::npos);
-  EXPECT_EQ(reasonWith(tmp, matrix, rows_at, 70000, &head),
+  EXPECT_EQ(reasonWith(tmp, matrix, rows_at, u32(70000), &head),
             "corrupt CMatrixD: matrix rows 70000 at byte " + std::to_string(head + rows_at) +
                 " (more than 65535 rows)");
 
@@ -58,7 +53,7 @@ TEST(RawlogPrecheck, PartsOfObservationsOnTheirOwnAreCheckedAsInside) {
   EXPECT_EQ(damageReason(tmp, pdf, &head), "(read)");
   const std::size_t particles_at = pdf.find(u32(3));
   ASSERT_NE(particles_at, std::string::npos);
-  EXPECT_EQ(reasonWith(tmp, pdf, particles_at, 200000000, &head),
+  EXPECT_EQ(reasonWith(tmp, pdf, particles_at, u32(200000000), &head),
             "corrupt CPosePDFParticles: particle count 200000000 at byte " +
                 std::to_string(head + particles_at) + " (more than 100000 particles)");
 
@@ -71,7 +66,7 @@ TEST(RawlogPrecheck, PartsOfObservationsOnTheirOwnAreCheckedAsInside) {
   EXPECT_EQ(damageReason(tmp, image, &head), "(read)");
   const std::size_t jpeg_at = image.find("\xFF\xD8\xFF");
   ASSERT_NE(jpeg_at, std::string::npos);
-  EXPECT_EQ(reasonWith(tmp, image, jpeg_at - 4, 0xFFFFFFF0u, &head),
+  EXPECT_EQ(reasonWith(tmp, image, jpeg_at - 4, u32(0xFFFFFFF0u), &head),
             "corrupt CImage: image JPEG size 4294967280 at byte " +
                 std::to_string(head + jpeg_at - 4) + " (more than 268435456 bytes)");
 

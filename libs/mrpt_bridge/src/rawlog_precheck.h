@@ -69,6 +69,11 @@ constexpr std::uint32_t kMaxLidarPackets = 65536;
 constexpr std::uint32_t kMaxLidarLasers = 4096;
 /// Most label names of a 3D scan's pixel labels (a bit field of 8 bytes names at most 64).
 constexpr std::uint32_t kMaxLabelNames = 65536;
+/// Most range layers of a rotating LiDAR's scan besides its range image (a sensor gives one or two,
+/// each of the range image's size).
+constexpr std::uint32_t kMaxRangeLayers = 256;
+/// Most batteries of a CObservationBatteryState besides the main one and the computer's.
+constexpr std::uint32_t kMaxBatteries = 4096;
 /// Most bytes of a CObservationComment's text (a note, a configuration block).
 constexpr std::uint32_t kMaxCommentBytes = 1u << 24;
 

@@ -111,9 +111,8 @@ inline Parse checkFlag(Cursor& c, const char* field, std::uint8_t& v, std::strin
 bool withinBound(const char* field, std::uint64_t value, std::uint64_t at, std::uint64_t max,
                  const char* unit, std::string& why);
 
-/// An observation object whose header has been read (a CObservation2DRangeScan,
-/// CObservation3DRangeScan, CObservationImage or CObservationStereoImages; any
-/// other class is OtherLayout), up to and including its end flag.
+/// An observation object whose header has been read (of a class in the walks' table of
+/// rawlog_precheck_observations.cpp; any other is OtherLayout), up to and including its end flag.
 Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why);
 
 /// A part of an observation stored as an object of its own (a CImage, TCamera, CMatrix, CMatrixF,
@@ -144,6 +143,12 @@ Parse checkPixelLabels(Cursor& c, std::string& why);
 
 /// A CObservationVelodyneScan's body (versions 0-2; any other is OtherLayout), after its header.
 Parse checkVelodyneScan(Cursor& c, int version, std::string& why);
+
+/// A CObservationRotatingScan's body (version 0; any other is OtherLayout), after its header.
+Parse checkRotatingScan(Cursor& c, int version, std::string& why);
+
+/// A CObservationBatteryState's body (version 2; any other is OtherLayout), after its header.
+Parse checkBatteryState(Cursor& c, int version, std::string& why);
 
 /// The `count` messages of a CObservationGPS (its messages follow its message count).
 Parse checkGnssMessages(Cursor& c, std::uint32_t count, std::string& why);

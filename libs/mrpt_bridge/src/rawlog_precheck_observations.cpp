@@ -583,7 +583,9 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
                 {"CObservationPointCloud", pointCloud}, {"CObservationComment", comment},
                 {"CObservationRange", ranges},        {"CObservationGPS", gnss},
                 {"CObservationIMU", imu},             {"CObservationOdometry", odometry},
-                {"CObservationVelodyneScan", checkVelodyneScan}};
+                {"CObservationVelodyneScan", checkVelodyneScan},
+                {"CObservationRotatingScan", checkRotatingScan},
+                {"CObservationBatteryState", checkBatteryState}};
   for (const auto& w : kWalks) {
     if (h.class_name != w.name) continue;
     const Parse p = w.walk(c, h.version, why);
