@@ -413,16 +413,20 @@ Parse checkTopLevel(Cursor& c, const ObjectHeader& top, std::string& why) {
   return p;
 }
 
-// Why an object whose walk ran past the end of the stream is damage (MRPT's CArchive takes a short
-// read as data: a count cut by the end of a file is read with bytes that were never there, and a
-// list resized to it), or "" when it did not, or the stream ended before the object's first byte.
+// truncatedAt() for an object whose walk ran past the end of the stream (a count cut by the end of
+// a file would be read with bytes that were never there, and a list resized to it), or "" when it
+// did not, or the stream ended before the object's first byte.
 std::string truncation(const Cursor& c, const LookaheadStream& in) {
   const auto end = in.knownEnd();
   if (!c.ranOut() || !end || *end <= c.start()) return {};
-  return "truncated, the file ends inside it, at byte " + std::to_string(*end);
+  return truncatedAt(*end);
 }
 
 }  // namespace
+
+std::string truncatedAt(std::uint64_t end) {
+  return "truncated, the file ends inside it, at byte " + std::to_string(end);
+}
 
 bool peekContainerHead(LookaheadStream& in, ContainerHead& head) {
   Cursor c(in);

@@ -105,6 +105,10 @@ class LookaheadStream : public mrpt::io::CStream {
   std::optional<std::uint64_t> end_;
 };
 
+/// The reason for an object the file ends inside, at byte `end` (MRPT's CArchive takes a short read
+/// as data: such an object is damage before MRPT reads it).
+std::string truncatedAt(std::uint64_t end);
+
 /// Why the next top-level object must not be handed to MRPT ("corrupt CObservation2DRangeScan
 /// (observation 1 of 1 in a CSensoryFrame): scan size 4294967295 at byte 1234 (more than
 /// 1000000 rays)"), or "" when nothing impossible was found. Consumes nothing. checked_bytes,

@@ -37,12 +37,9 @@ class Cursor {
   /// corrupt size near the end of a file is not allocated ahead of its bytes).
   bool has(std::uint64_t n) {
     std::uint8_t last = 0;
-    if (n == 0) return true;
-    const std::size_t at = offset_;
-    offset_ += static_cast<std::size_t>(n - 1);
-    const bool there = bytes(&last, 1);
-    offset_ = at;
-    return there;
+    if (n == 0 || in_.peek(offset_ + static_cast<std::size_t>(n - 1), &last, 1)) return true;
+    ran_out_ = true;
+    return false;
   }
   template <typename T>
   bool value(T& v) {

@@ -181,9 +181,7 @@ Parse colourImage(Cursor& c, int version, std::string& why) {
     if (bytes == 0) return kRead;  // nothing to decode: MRPT's reader does not end the process
     // (Whether the stream holds them is asked first: a byte count far past the end of a file is
     // not allocated.)
-    std::vector<std::uint8_t> jpeg;
-    if (c.has(bytes)) jpeg.assign(bytes, 0);
-    if (jpeg.empty() || !c.bytes(jpeg.data(), bytes)) {
+    if (!c.has(bytes)) {
       // MRPT reads what there is without a complaint (a short read is no error to CArchive)
       // and decodes it: a JPEG cut in its header ends the process in libjpeg.
       why = "image JPEG of " + std::to_string(bytes) + " bytes at byte " +
@@ -192,6 +190,8 @@ Parse colourImage(Cursor& c, int version, std::string& why) {
             "JPEG reader ends the process on a cut header)";
       return kImpossible;
     }
+    std::vector<std::uint8_t> jpeg(bytes);
+    c.bytes(jpeg.data(), bytes);  // (there, as has() found)
     std::uint64_t pixels = 0;
     const std::string failure = jpegFailure(jpeg.data(), jpeg.size(), &pixels);
     if (pixels > kMaxImagePixels) {

@@ -319,8 +319,7 @@ struct RawlogReader::Impl {
     if (head.has_end_flag) {
       if (!lookahead->peek(0, &end, 1)) {
         fail(object_index, position,
-             "truncated, the file ends inside it, at byte " +
-                 std::to_string(lookahead->getPosition()) + " (before its end flag)");
+             detail::truncatedAt(lookahead->getPosition()) + " (before its end flag)");
       }
       archive->ReadBuffer(&end, 1);
     }
