@@ -8,6 +8,7 @@
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CColouredPointsMap.h>
+#include <mrpt/maps/CPointsMapXYZI.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -404,6 +405,70 @@ TEST(ObservationCloud, PointCloudObservationRoundTripsWithSensorPose) {
 
   mrpt::obs::CObservationPointCloud empty;
   EXPECT_FALSE(toCloud(empty).ok());
+}
+
+// Colours and intensities outside MRPT's [0, 1] are clamped; a NaN one (damage) is black. A NaN
+// converted to a byte as it is would be undefined behaviour (UBSan's float-cast-overflow).
+TEST(ObservationCloud, PointCloudColoursAreClampedAndNaNIsBlack) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  auto col = mrpt::maps::CColouredPointsMap::Create();
+  col->insertPointRGB(1.f, 0.f, 0.f, nan, -inf, 2.f);
+  col->insertPointRGB(2.f, 0.f, 0.f, inf, -1.f, 0.5f);
+  mrpt::obs::CObservationPointCloud obs;
+  obs.pointcloud = col;
+  ObservationCloud oc = toCloud(obs);
+  ASSERT_TRUE(oc.ok()) << oc.skipped_reason;
+  ASSERT_TRUE(oc.cloud_in_robot.hasColor());
+  const PointCloud& c = oc.cloud_in_robot;
+  EXPECT_EQ(std::vector<int>({c.r[0], c.g[0], c.b[0]}), std::vector<int>({0, 0, 255}));
+  EXPECT_EQ(std::vector<int>({c.r[1], c.g[1], c.b[1]}), std::vector<int>({255, 0, 128}));
+
+  auto xyzi = mrpt::maps::CPointsMapXYZI::Create();
+  xyzi->insertPointFast(1.f, 0.f, 0.f);
+  xyzi->insertPointFast(2.f, 0.f, 0.f);
+  xyzi->setPointIntensity(0, nan);
+  xyzi->setPointIntensity(1, 0.25f);
+  obs.pointcloud = xyzi;
+  oc = toCloud(obs);
+  ASSERT_TRUE(oc.ok()) << oc.skipped_reason;
+  ASSERT_TRUE(oc.cloud_in_robot.hasColor());
+  EXPECT_EQ(oc.cloud_in_robot.r[0], 0);
+  EXPECT_EQ(oc.cloud_in_robot.r[1], 64);
+}
+
+// Where the intensity camera is apart from the depth camera, each point is projected into it. A
+// damaged intensity calibration (NaN or huge focal length) projects nowhere: every point stays
+// white, as MRPT leaves the points outside the image (converted to an integer first, such a
+// projection became pixel 0).
+TEST(ObservationCloud, RangeScanDamagedIntensityCalibrationColoursNothing) {
+  UPD_REQUIRE_SHARED_FILE(path, "mrpt/test-3d-obs-ground.rawlog");
+  const auto obs = firstObservation(path);
+  ASSERT_TRUE(obs);
+  auto& scan = dynamic_cast<mrpt::obs::CObservation3DRangeScan&>(*obs);
+  // 2.5 cm to the side; the rotation is MRPT's from the depth frame (x forward) to a camera's.
+  scan.relativePoseIntensityWRTDepth =
+      mrpt::poses::CPose3D(0.0, 0.025, 0.0, -M_PI / 2, 0.0, -M_PI / 2);
+  ASSERT_FALSE(scan.doDepthAndIntensityCamerasCoincide());
+  const auto coloured = [](const PointCloud& c) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      n += c.isFinite(i) && (c.r[i] != 255 || c.g[i] != 255 || c.b[i] != 255);
+    }
+    return n;
+  };
+  const ObservationCloud sound = toCloud(*obs);
+  ASSERT_TRUE(sound.ok()) << sound.skipped_reason;
+  ASSERT_TRUE(sound.cloud_in_robot.hasColor());
+  EXPECT_GT(coloured(sound.cloud_in_robot), sound.cloud_in_robot.countFinite() / 2);
+  for (const double fx : {std::numeric_limits<double>::quiet_NaN(), 1e30}) {
+    scan.cameraParamsIntensity.fx(fx);
+    const ObservationCloud oc = toCloud(*obs);
+    ASSERT_TRUE(oc.ok()) << oc.skipped_reason;
+    EXPECT_EQ(oc.cloud_in_robot.countFinite(), sound.cloud_in_robot.countFinite());
+    ASSERT_TRUE(oc.cloud_in_robot.hasColor());
+    EXPECT_EQ(coloured(oc.cloud_in_robot), 0u) << "fx " << fx;
+  }
 }
 
 // A VLP-16 looking at flat ground 1.5 m below it: every return lands on z = 0 in the robot frame.

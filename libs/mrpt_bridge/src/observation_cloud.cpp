@@ -130,10 +130,11 @@ class RangeScanColour {
     }
     const Eigen::Vector3f q = intensity_from_depth_(p_sensor);
     if (!(q.z() > 0.f)) return;
-    const int u = static_cast<int>(std::lround(cx_ + fx_ * q.x() / q.z()));
-    const int v = static_cast<int>(std::lround(cy_ + fy_ * q.y() / q.z()));
-    if (u < 0 || v < 0 || u >= img_->cols || v >= img_->rows) return;
-    pixelColor(*img_, u, v, c.r[pix], c.g[pix], c.b[pix]);
+    // Compared as floats before any conversion: a damaged calibration gives NaN or huge values.
+    const float u = std::round(cx_ + fx_ * q.x() / q.z());
+    const float v = std::round(cy_ + fy_ * q.y() / q.z());
+    if (!(u >= 0.f && v >= 0.f && u < img_->cols && v < img_->rows)) return;
+    pixelColor(*img_, static_cast<int>(u), static_cast<int>(v), c.r[pix], c.g[pix], c.b[pix]);
   }
 
  private:
@@ -244,8 +245,9 @@ void convertPointCloud(const mrpt::obs::CObservationPointCloud& o, const SourceP
   c.sensor_origin = out.sensor_pose_on_robot.translation().cast<float>();
   for (std::size_t i = 0; i < n; ++i) setPoint(c, i, robot_from_sensor({xs[i], ys[i], zs[i]}));
   if (!params.color_enabled || n == 0) return;
+  // MRPT's colours and intensities are in [0, 1]; a NaN (a damaged or unset value) is black.
   const auto toU8 = [](float f) {
-    return static_cast<std::uint8_t>(std::clamp(f, 0.f, 1.f) * 255.f + 0.5f);
+    return f > 0.f ? static_cast<std::uint8_t>(std::min(f, 1.f) * 255.f + 0.5f) : std::uint8_t{0};
   };
   if (const auto* col = dynamic_cast<const mrpt::maps::CColouredPointsMap*>(&map)) {
     allocateColor(c);
