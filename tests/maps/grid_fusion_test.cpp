@@ -277,6 +277,30 @@ TEST(GridFusion, RecentringKeepsCellsAtTheirWorldPosition) {
   EXPECT_NEAR(g.cellCenter(cx, cy).y(), 1.05, 1e-9);
 }
 
+// The window's place is kept in 64-bit world cell indices: a robot (or a centre) so far out that
+// its index would not convert, only ever a corrupt pose, is refused by name, not converted.
+TEST(GridFusion, PositionBeyondTheGridsReachIsRefused) {
+  GridParams params;
+  params.cell_size_m = kCell;
+  params.extent_m = 4.0;
+  params.follow_robot = true;
+  TraversabilityGrid g(params);
+  for (const Eigen::Vector2d& far : {Eigen::Vector2d(1e30, 0.0), Eigen::Vector2d(0.0, -2e14),
+                                    Eigen::Vector2d(std::nan(""), 0.0)}) {
+    try {
+      g.moveTo(far);
+      ADD_FAILURE() << "moved to " << far.transpose();
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("robot_xy = "), std::string::npos) << e.what();
+      EXPECT_LT(std::string(e.what()).size(), 120u) << e.what();
+    }
+  }
+  EXPECT_TRUE(g.moveTo({1e12, -1e12}));  // far, but within reach: the window follows
+  EXPECT_NEAR(0.5 * (g.xMin() + g.xMax()), 1e12, 1.0);
+  params.center_x_m = 1e300;
+  EXPECT_THROW(TraversabilityGrid{params}, std::invalid_argument);
+}
+
 TEST(GridFusion, SameResultFarFromTheOrigin) {
   const double offset = 250000.0;  // 250 km: float world coordinates keep ~2 cm here
   GridParams near_p = smallGrid(), far_p = smallGrid();

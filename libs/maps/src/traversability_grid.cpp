@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -18,6 +19,10 @@ namespace upd::maps {
 namespace {
 // Larger windows would not fit a 32-bit cell index (and would not fit in memory anyway).
 constexpr double kMaxCellsPerSide = 46000;
+// The window's place is kept as 64-bit world cell indices (and in double, exact to 2^53): a
+// centre farther out, only ever a corrupt pose or setting, would overflow the conversion.
+constexpr double kMaxWorldCells = 1e15;
+bool withinReach(double v_m, double cell_m) { return std::abs(v_m / cell_m) <= kMaxWorldCells; }
 }  // namespace
 
 void GridParams::validate() const {
@@ -33,8 +38,10 @@ void GridParams::validate() const {
                      "must be 0 (= extent_m) or from two cells to 46000 cells");
   core::requireParam(tile_cells >= 8 && tile_cells <= 1024, "GridParams", "tile_cells", tile_cells,
                      "must be in [8, 1024]");
-  core::requireParam(std::isfinite(center_x_m), "GridParams", "center_x_m", center_x_m, "must be finite");
-  core::requireParam(std::isfinite(center_y_m), "GridParams", "center_y_m", center_y_m, "must be finite");
+  core::requireParam(withinReach(center_x_m, cell_size_m), "GridParams", "center_x_m", center_x_m,
+                     "must be finite and within 1e15 cells of the origin");
+  core::requireParam(withinReach(center_y_m, cell_size_m), "GridParams", "center_y_m", center_y_m,
+                     "must be finite and within 1e15 cells of the origin");
   core::requireParam(recenter_fraction > 0 && recenter_fraction < 0.5, "GridParams", "recenter_fraction",
                recenter_fraction, "must be in (0, 0.5)");
   core::requireParam(p_nontrav_threshold > 0 && p_nontrav_threshold < 1, "GridParams",
@@ -234,8 +241,11 @@ GridCell* TraversabilityGrid::cellAt(double x_m, double y_m) {
 
 bool TraversabilityGrid::moveTo(const Eigen::Vector2d& robot_xy) {
   if (!params_.follow_robot) return false;
-  core::requireParam(robot_xy.allFinite(), "TraversabilityGrid::moveTo", "robot_xy",
-               std::to_string(robot_xy.x()) + "," + std::to_string(robot_xy.y()), "must be finite");
+  core::requireParam(
+      withinReach(robot_xy.x(), cellSize()) && withinReach(robot_xy.y(), cellSize()),
+      "TraversabilityGrid::moveTo", "robot_xy",
+      (std::ostringstream() << robot_xy.x() << "," << robot_xy.y()).str(),
+      "must be finite and within 1e15 cells of the origin");
   const double ri = std::floor(robot_xy.x() / cellSize());
   const double rj = std::floor(robot_xy.y() / cellSize());
   const int nx = impl_->nx, ny = impl_->ny;
