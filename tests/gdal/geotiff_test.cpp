@@ -7,12 +7,18 @@
 
 #include "../apps/run_upd.h"
 
+#include <gdal_priv.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <functional>
+#include <memory>
 #include <sstream>
+#include <string>
+#include <vector>
 
 namespace upd {
 namespace {
@@ -183,6 +189,66 @@ TEST(GeoTiff, ReadingAnotherFileFailsNamingIt) {
     EXPECT_NE(std::string(e.what()).find("not.tif"), std::string::npos) << e.what();
   }
   EXPECT_THROW(gdal::writeGeoTiff(sampleGrid(), dir.file("missing/map.tif")), std::runtime_error);
+}
+
+// A map file damaged after it was written (a count band edited to a value no count has, the
+// origin moved beyond any grid, a threshold that is not a number) is refused naming the file and
+// what is wrong; nothing is converted that would not fit.
+TEST(GeoTiff, DamagedFileIsRefusedNamingWhatIsWrong) {
+  const test::TempDir dir;
+  const std::string good = dir.file("good.tif");
+  gdal::writeGeoTiff(sampleGrid(), good);
+  GDALAllRegister();
+  struct Damage {
+    const char* name;
+    std::function<void(GDALDataset&)> apply;
+    const char* expected;
+  };
+  const auto setPixel = [](int band, double v) {
+    return [band, v](GDALDataset& ds) {
+      double value = v;
+      ASSERT_EQ(ds.GetRasterBand(band)->RasterIO(GF_Write, 2, 3, 1, 1, &value, 1, 1,
+                                                  GDT_Float64, 0, 0, nullptr),
+                CE_None);
+    };
+  };
+  const auto moveOrigin = [](double x) {
+    return [x](GDALDataset& ds) {
+      double gt[6];
+      ASSERT_EQ(ds.GetGeoTransform(gt), CE_None);
+      gt[0] = x;
+      ASSERT_EQ(ds.SetGeoTransform(gt), CE_None);
+    };
+  };
+  const std::vector<Damage> damages = {
+      {"negative_hits", setPixel(6, -1.0), "band 6 'hits' holds -1 at pixel (2, 3), not a count"},
+      {"huge_count", setPixel(11, 1e20), "band 11 'zeta_count' holds 1e+20"},
+      {"fraction", setPixel(13, 2.5), "band 13 'cost_count' holds 2.5"},
+      {"far_origin", moveOrigin(1e300), "GridParams.center_x_m = "},
+      {"threshold",
+       [](GDALDataset& ds) { ds.SetMetadataItem("UPD_P_NONTRAV_THRESHOLD", "abc"); },
+       "GridParams.p_nontrav_threshold = 0"},
+  };
+  for (const Damage& d : damages) {
+    const std::string path = dir.file(std::string(d.name) + ".tif");
+    std::filesystem::copy_file(good, path);
+    {
+      std::unique_ptr<GDALDataset> ds(
+          static_cast<GDALDataset*>(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_UPDATE,
+                                               nullptr, nullptr, nullptr)));
+      ASSERT_TRUE(ds) << path;
+      d.apply(*ds);
+    }  // closed: written
+    try {
+      gdal::readGeoTiff(path);
+      ADD_FAILURE() << d.name << ": read";
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(path), std::string::npos) << what;
+      EXPECT_NE(what.find(d.expected), std::string::npos) << what;
+    }
+  }
+  EXPECT_NO_THROW(gdal::readGeoTiff(good));
 }
 
 }  // namespace

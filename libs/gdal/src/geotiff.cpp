@@ -13,6 +13,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <stdexcept>
 
 namespace upd::gdal {
@@ -47,7 +48,14 @@ double bandValue(const maps::GridCell& c, int band) {
   }
 }
 
-std::uint32_t count(double v) { return std::isfinite(v) ? static_cast<std::uint32_t>(v) : 0u; }
+bool isCountBand(int band) {
+  return band == kHits || band == kZetaCount || band == kSlopeCount || band == kCostCount;
+}
+
+// A count band's value converts to a cell's 32-bit count only when it is one.
+bool isCount(double v) { return v >= 0 && v <= 4294967295.0 && v == std::floor(v); }
+
+std::uint32_t count(double v) { return static_cast<std::uint32_t>(v); }
 
 void setBandValue(maps::GridCell& c, int band, double v) {
   switch (band) {
@@ -212,6 +220,9 @@ maps::GridParams windowParams(const std::string& path, const double gt[6], int w
   if (!(cell > 0) || gt[2] != 0.0 || gt[4] != 0.0 || std::abs(gt[5] + cell) > 1e-9 * cell) {
     throw std::runtime_error("GeoTIFF " + path + ": not a north-up raster with square cells");
   }
+  if (!std::isfinite(gt[0]) || !std::isfinite(gt[3])) {
+    throw std::runtime_error("GeoTIFF " + path + ": its origin is not finite");
+  }
   const double fi = gt[0] / cell, fj = gt[3] / cell - height;
   if (std::abs(fi - std::round(fi)) > 1e-6 || std::abs(fj - std::round(fj)) > 1e-6) {
     throw std::runtime_error("GeoTIFF " + path + ": origin not aligned to its cell size");
@@ -226,6 +237,11 @@ maps::GridParams windowParams(const std::string& path, const double gt[6], int w
   p.center_y_m = (std::round(fj) + n / 2 + 0.5) * cell;
   if (const char* t = ds.GetMetadataItem("UPD_P_NONTRAV_THRESHOLD")) p.p_nontrav_threshold = std::atof(t);
   if (const char* k = ds.GetMetadataItem("UPD_MIN_HITS_KNOWN")) p.min_hits_known = std::atoi(k);
+  try {
+    p.validate();  // a window beyond the grid's reach, a damaged threshold
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("GeoTIFF " + path + ": " + e.what());
+  }
   return p;
 }
 
@@ -277,7 +293,14 @@ GeoTiffMap readGeoTiff(const std::string& path) {
     for (int row = 0; row < h; ++row) {
       for (int cx = 0; cx < w; ++cx) {
         const double v = buf[static_cast<std::size_t>(row) * w + cx];
-        if (!std::isnan(v)) setBandValue(out.grid.at(cx, h - 1 - row), b, v);
+        if (std::isnan(v)) continue;  // nodata
+        if (isCountBand(b) && !isCount(v)) {
+          std::ostringstream os;
+          os << "GeoTIFF " << path << ": band " << b + 1 << " '" << geoTiffBands()[b].name
+             << "' holds " << v << " at pixel (" << cx << ", " << row << "), not a count";
+          throw std::runtime_error(os.str());
+        }
+        setBandValue(out.grid.at(cx, h - 1 - row), b, v);
       }
     }
   }
