@@ -6,7 +6,9 @@
 #include "upd/io/cloud_io.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -64,16 +66,41 @@ PlyLayout readPlyHeader(std::istream& in, const std::string& path) {
   throw std::runtime_error(path + ": PLY header has no end_header");
 }
 
-float fieldAt(const char* row, const PlyLayout& l, const std::string& name) {
+template <class T>
+double load(const char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  return static_cast<double>(v);
+}
+
+// A vertex property's value in the row (little-endian, any PLY scalar type); NaN when absent.
+double fieldAt(const char* row, const PlyLayout& l, const std::string& name) {
   const auto it = l.props.find(name);
-  if (it == l.props.end()) return std::numeric_limits<float>::quiet_NaN();
+  if (it == l.props.end()) return std::numeric_limits<double>::quiet_NaN();
   const char* p = row + it->second.first;
-  if (it->second.second == "float" || it->second.second == "float32") {
-    float v;
-    std::memcpy(&v, p, 4);
-    return v;
-  }
-  return float(static_cast<unsigned char>(*p));  // the scored PLY's only other type: uchar label
+  const std::string& t = it->second.second;
+  if (t == "float" || t == "float32") return load<float>(p);
+  if (t == "double" || t == "float64") return load<double>(p);
+  if (t == "char" || t == "int8") return load<std::int8_t>(p);
+  if (t == "uchar" || t == "uint8") return load<std::uint8_t>(p);
+  if (t == "short" || t == "int16") return load<std::int16_t>(p);
+  if (t == "ushort" || t == "uint16") return load<std::uint16_t>(p);
+  if (t == "int" || t == "int32") return load<std::int32_t>(p);
+  return load<std::uint32_t>(p);  // uint, uint32 (plyTypeSize admits no other)
+}
+
+// A label as written (0, 1, 2); any other value (a float label edited by hand, NaN) is unknown.
+core::Label labelOf(double v) {
+  if (v == 0.0) return core::Label::Traversable;
+  if (v == 1.0) return core::Label::NonTraversable;
+  return core::Label::Unknown;
+}
+
+// A colour channel: integers clamped to 0..255, floats taken as 0..1 (as io's PLY reader does).
+std::uint8_t colourByte(double v, const std::string& type) {
+  if (type == "float" || type == "float32" || type == "double" || type == "float64") v *= 255.0;
+  if (!(v > 0.0)) return 0;  // NaN too
+  return v >= 255.0 ? 255 : static_cast<std::uint8_t>(std::lround(v));
 }
 
 ScoredCloud readScoredPly(std::istream& in, const PlyLayout& l, const std::string& path) {
@@ -81,23 +108,38 @@ ScoredCloud readScoredPly(std::istream& in, const PlyLayout& l, const std::strin
     if (!l.props.count(f)) throw std::runtime_error(path + ": scored PLY has no vertex property '" + f + "'");
   if (!l.binary_le || !l.vertex_only)
     throw std::runtime_error(path + ": a scored PLY must be binary_little_endian with vertices only");
+  // The vertices must be in the file before anything is allocated for them.
+  const std::streamoff start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff bytes = in.tellg() - start;
+  in.seekg(start);
+  if (start < 0 || bytes < 0 || l.vertices > static_cast<std::size_t>(bytes) / l.stride)
+    throw std::runtime_error(path + ": truncated PLY (the header declares " + std::to_string(l.vertices) +
+                             " vertices of " + std::to_string(l.stride) + " bytes, the file holds " +
+                             std::to_string(std::max<std::streamoff>(bytes, 0)) + " bytes after it)");
   std::vector<char> data(l.vertices * l.stride);
   if (!in.read(data.data(), std::streamsize(data.size())))
     throw std::runtime_error(path + ": truncated PLY (expected " + std::to_string(l.vertices) + " vertices)");
+  const bool rgb = l.props.count("red") && l.props.count("green") && l.props.count("blue");
   ScoredCloud c;
   for (std::size_t i = 0; i < l.vertices; ++i) {
     const char* row = data.data() + i * l.stride;
-    const Eigen::Vector3f p(fieldAt(row, l, "x"), fieldAt(row, l, "y"), fieldAt(row, l, "z"));
+    const auto f = [&](const char* name) { return static_cast<float>(fieldAt(row, l, name)); };
+    const Eigen::Vector3f p(f("x"), f("y"), f("z"));
     if (!p.allFinite()) continue;
     c.points.push_back(p);
-    c.normals.emplace_back(fieldAt(row, l, "nx"), fieldAt(row, l, "ny"), fieldAt(row, l, "nz"));
-    c.zeta.push_back(fieldAt(row, l, "scalar_zeta"));
-    c.cost.push_back(fieldAt(row, l, "scalar_cost"));
-    const float lab = fieldAt(row, l, "scalar_label");
-    c.label.push_back(lab <= 2.0f ? core::Label(std::uint8_t(lab)) : core::Label::Unknown);
-    if (l.props.count("red") && l.props.count("green") && l.props.count("blue"))
-      c.rgb.push_back({std::uint8_t(fieldAt(row, l, "red")), std::uint8_t(fieldAt(row, l, "green")),
-                       std::uint8_t(fieldAt(row, l, "blue"))});
+    c.normals.emplace_back(f("nx"), f("ny"), f("nz"));
+    c.zeta.push_back(f("scalar_zeta"));
+    c.cost.push_back(f("scalar_cost"));
+    c.label.push_back(labelOf(fieldAt(row, l, "scalar_label")));
+    if (rgb) {
+      std::array<std::uint8_t, 3> col{};
+      for (int k = 0; k < 3; ++k) {
+        const char* name = k == 0 ? "red" : k == 1 ? "green" : "blue";
+        col[k] = colourByte(fieldAt(row, l, name), l.props.at(name).second);
+      }
+      c.rgb.push_back(col);
+    }
   }
   return c;
 }
