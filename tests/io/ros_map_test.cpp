@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -83,6 +84,58 @@ TEST(RosMap, ErrorsNameTheFile) {
   std::ofstream(dir.file("p2.yaml")) << "image: p2.pgm\n";
   std::ofstream(dir.file("p2.pgm")) << "P2\n1 1\n255\n0\n";
   EXPECT_THROW(readRosMap(dir.file("p2.yaml")), std::runtime_error);
+}
+
+// A damaged map_server pair is refused naming the file and the key or size that is wrong,
+// before any allocation the header asks for.
+TEST(RosMap, DamagedYamlOrPgmIsRefusedNamingWhatIsWrong) {
+  const test::TempDir dir;
+  writeRosMap(sample(), dir.file("m.yaml"));
+  struct Case {
+    std::string yaml, expected;
+  };
+  const std::string img = "image: m.pgm\n";
+  for (const Case& c : {Case{img + "resolution: abc\norigin: [0, 0, 0]\n",
+                             "resolution 'abc' is not a number > 0"},
+                        Case{img + "resolution: 0\norigin: [0, 0, 0]\n", "resolution '0' is not"},
+                        Case{img + "resolution: nan\norigin: [0, 0, 0]\n", "resolution 'nan'"},
+                        Case{img + "resolution: 0.05 m\norigin: [0, 0, 0]\n", "resolution '0.05 m'"},
+                        Case{img + "resolution: 0.05\norigin: [x, 0, 0]\n", "origin is not"},
+                        Case{img + "resolution: 0.05\norigin: [inf, 0, 0]\n", "origin is not"},
+                        Case{img + "origin: [0, 0, 0]\n", "no resolution key"},
+                        Case{img + "resolution: 0.05\n", "no origin key"}}) {
+    const std::string path = dir.file("bad.yaml");
+    std::ofstream(path) << c.yaml;
+    try {
+      readRosMap(path);
+      ADD_FAILURE() << c.yaml << ": read";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("ROS map " + path + ": " + c.expected),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // A PGM whose header claims 100000 x 100000 pixels (10 GB) over 6 bytes of data.
+  std::ofstream(dir.file("huge.yaml")) << "image: huge.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n";
+  std::ofstream(dir.file("huge.pgm"), std::ios::binary) << "P5\n100000 100000\n255\n" << std::string(6, '\xfe');
+  try {
+    readRosMap(dir.file("huge.yaml"));
+    ADD_FAILURE() << "huge.pgm read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("huge.pgm: truncated (100000 x 100000 pixels, 6 bytes"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// A world position far from the map (beyond any int cell index) is outside it, not converted.
+TEST(RosMap, PositionFarOffTheMapIsUnknown) {
+  const RosMap m = sample();
+  EXPECT_EQ(m.labelAt(-0.975, 2.025), core::Label::Traversable);
+  for (const double x : {1e12, -1e12, 1e300, std::nan("")}) {
+    EXPECT_EQ(m.labelAt(x, 2.025), core::Label::Unknown) << x;
+    EXPECT_EQ(m.labelAt(-0.975, x), core::Label::Unknown) << x;
+  }
 }
 
 }  // namespace

@@ -32,10 +32,11 @@ core::Label labelOfRosPixel(std::uint8_t value) {
 }
 
 core::Label RosMap::labelAt(double x, double y) const {
-  const int ix = static_cast<int>(std::floor((x - origin_xy.x()) / resolution_m));
-  const int iy = static_cast<int>(std::floor((y - origin_xy.y()) / resolution_m));
-  if (ix < 0 || iy < 0 || ix >= width || iy >= height) return core::Label::Unknown;
-  return at(ix, iy);
+  // Compared in double before the conversion: a position far off the map has no int cell.
+  const double fx = std::floor((x - origin_xy.x()) / resolution_m);
+  const double fy = std::floor((y - origin_xy.y()) / resolution_m);
+  if (!(fx >= 0 && fy >= 0 && fx < width && fy < height)) return core::Label::Unknown;
+  return at(static_cast<int>(fx), static_cast<int>(fy));
 }
 
 namespace {
@@ -105,11 +106,16 @@ void writeRosScaleMap(const RosScaleMap& map, const std::string& yaml_path) {
 
 namespace {
 
-// image, resolution and origin from the YAML; returns the image's file name.
+// image, resolution and origin from the YAML; returns the image's file name. The resolution
+// must be a number > 0 and the origin's x and y finite numbers (the map's cells follow from them).
 std::string readRosYaml(const std::string& yaml_path, RosMap& map) {
   std::ifstream in(yaml_path);
   if (!in) throw std::runtime_error("ROS map " + yaml_path + ": cannot be opened");
+  const auto fail = [&](const std::string& why) {
+    throw std::runtime_error("ROS map " + yaml_path + ": " + why);
+  };
   std::string line, image;
+  bool resolution = false, origin = false;
   while (std::getline(in, line)) {
     const auto colon = line.find(':');
     if (colon == std::string::npos) continue;
@@ -118,14 +124,28 @@ std::string readRosYaml(const std::string& yaml_path, RosMap& map) {
     if (key == "image") {
       std::istringstream(value) >> image;
     } else if (key == "resolution") {
-      map.resolution_m = std::stod(value);
+      std::istringstream is(value);
+      std::string rest;
+      if (!(is >> map.resolution_m) || (is >> rest) || !std::isfinite(map.resolution_m) ||
+          !(map.resolution_m > 0)) {
+        const auto first = value.find_first_not_of(' ');
+        fail("resolution '" + (first == std::string::npos ? "" : value.substr(first)) +
+             "' is not a number > 0");
+      }
+      resolution = true;
     } else if (key == "origin") {
       std::replace_if(
           value.begin(), value.end(), [](char c) { return c == '[' || c == ']' || c == ','; }, ' ');
-      std::istringstream(value) >> map.origin_xy.x() >> map.origin_xy.y();
+      if (!(std::istringstream(value) >> map.origin_xy.x() >> map.origin_xy.y()) ||
+          !map.origin_xy.allFinite()) {
+        fail("origin is not [x, y, yaw] of finite numbers");
+      }
+      origin = true;
     }
   }
-  if (image.empty()) throw std::runtime_error("ROS map " + yaml_path + ": no image key");
+  if (image.empty()) fail("no image key");
+  if (!resolution) fail("no resolution key");
+  if (!origin) fail("no origin key");
   return image;
 }
 
@@ -143,7 +163,19 @@ RosMap readRosMap(const std::string& yaml_path) {
     throw std::runtime_error("ROS map " + pgm_path.string() + ": not an 8-bit P5 PGM");
   }
   pgm.get();
-  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(map.width) * map.height);
+  // The pixels must be in the file before they are allocated (a damaged header's size).
+  const std::streamoff start = pgm.tellg();
+  pgm.seekg(0, std::ios::end);
+  const std::streamoff bytes = pgm.tellg() - start;
+  pgm.seekg(start);
+  const std::size_t cells = static_cast<std::size_t>(map.width) * map.height;
+  if (start < 0 || bytes < 0 || cells > static_cast<std::size_t>(bytes)) {
+    throw std::runtime_error("ROS map " + pgm_path.string() + ": truncated (" +
+                             std::to_string(map.width) + " x " + std::to_string(map.height) +
+                             " pixels, " + std::to_string(std::max<std::streamoff>(bytes, 0)) +
+                             " bytes after the header)");
+  }
+  std::vector<std::uint8_t> pixels(cells);
   if (!pgm.read(reinterpret_cast<char*>(pixels.data()),
                 static_cast<std::streamsize>(pixels.size()))) {
     throw std::runtime_error("ROS map " + pgm_path.string() + ": truncated");
