@@ -2,6 +2,8 @@
 
 #include "upd/ros1/conversions.h"
 
+#include "bag_check.h"
+
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -11,15 +13,33 @@
 #include <tf2/exceptions.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <algorithm>
+#include <new>
+
 namespace upd::ros1 {
 
 namespace {
 
+// The message as type M (null when it is another type). A message of type M whose data does not
+// deserialize (a damaged length: roscpp throws at the end of its data, or cannot allocate what
+// it says) is null too, and counted under its reason.
+template <class M>
+boost::shared_ptr<M> instantiate(const rosbag::MessageInstance& m, BagReadStats& stats) {
+  try {
+    return m.instantiate<M>();
+  } catch (const ros::Exception& e) {
+    ++stats.skipped["a message on " + m.getTopic() + " that does not deserialize (" + e.what() + ")"];
+  } catch (const std::bad_alloc&) {
+    ++stats.skipped["a message on " + m.getTopic() + " that does not deserialize (a length beyond memory)"];
+  }
+  return nullptr;
+}
+
 // Every transform of the bag in a buffer that keeps them all.
-void loadTf(rosbag::Bag& bag, tf2::BufferCore& tf) {
+void loadTf(rosbag::Bag& bag, tf2::BufferCore& tf, BagReadStats& stats) {
   rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf", "/tf_static"}));
   for (const rosbag::MessageInstance& m : view) {
-    const auto msg = m.instantiate<tf2_msgs::TFMessage>();
+    const auto msg = instantiate<tf2_msgs::TFMessage>(m, stats);
     if (!msg) continue;
     const bool is_static = m.getTopic() == "/tf_static";
     for (const auto& t : msg->transforms) tf.setTransform(t, "bag", is_static);
@@ -30,7 +50,9 @@ std::optional<Eigen::Isometry3d> lookup(const tf2::BufferCore& tf, const std::st
                                         const std::string& source, const ros::Time& stamp) {
   try {
     return isometryFromTransform(tf.lookupTransform(target, source, stamp).transform);
-  } catch (const tf2::TransformException&) {
+  } catch (const std::runtime_error&) {
+    // tf2::TransformException, and ros::Duration's range error where a damaged stamp lies
+    // more than 2^31 s from the transforms (tf2 throws it while it words its extrapolation)
     return std::nullopt;
   }
 }
@@ -64,6 +86,11 @@ bool isBagPath(const std::string& path) {
 
 BagReadStats readBag(const std::string& path, const BagTopics& topics,
                      const std::function<void(const BagFrame&)>& on_frame) {
+  try {
+    detail::checkBag(path);  // before rosbag trusts its lengths and offsets
+  } catch (const detail::BagDamage& e) {
+    throw std::runtime_error(path + ": damaged bag: " + e.what());
+  }
   rosbag::Bag bag;
   try {
     bag.open(path, rosbag::bagmode::Read);
@@ -73,31 +100,35 @@ BagReadStats readBag(const std::string& path, const BagTopics& topics,
   BagReadStats stats;
   try {
     rosbag::View all(bag);
-    const double span_s = (all.getEndTime() - all.getBeginTime()).toSec();
-    tf2::BufferCore tf(ros::Duration(span_s + 60.0));
-    loadTf(bag, tf);
+    // In seconds first: a span beyond ros::Duration's 2^31 s (a damaged stamp) would throw.
+    const double span_s = all.getEndTime().toSec() - all.getBeginTime().toSec();
+    tf2::BufferCore tf(ros::Duration(std::clamp(span_s + 60.0, 60.0, 2e9)));
+    loadTf(bag, tf, stats);
     // The first CameraInfo serves the images before it: a bag orders messages of the same
     // stamp by connection, so an image may come just before its info.
     sensor_msgs::CameraInfo::ConstPtr info;
     for (const rosbag::MessageInstance& m :
          rosbag::View(bag, rosbag::TopicQuery(topics.camera_info_topic))) {
-      if ((info = m.instantiate<sensor_msgs::CameraInfo>())) break;
+      BagReadStats counted_below;  // the loop below meets this message again
+      if ((info = instantiate<sensor_msgs::CameraInfo>(m, counted_below))) break;
     }
     rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{
                                topics.depth_topic, topics.camera_info_topic, topics.points_topic}));
     BagFrame frame;
     for (const rosbag::MessageInstance& m : view) {
-      if (auto i = m.instantiate<sensor_msgs::CameraInfo>()) {
-        info = i;
+      if (m.isType<sensor_msgs::CameraInfo>()) {
+        if (auto i = instantiate<sensor_msgs::CameraInfo>(m, stats)) info = i;
         continue;
       }
       ++stats.messages;
-      const auto image = m.instantiate<sensor_msgs::Image>();
-      const auto points = image ? nullptr : m.instantiate<sensor_msgs::PointCloud2>();
-      if (!image && !points) {
+      const bool is_image = m.isType<sensor_msgs::Image>();
+      if (!is_image && !m.isType<sensor_msgs::PointCloud2>()) {
         ++stats.skipped["unexpected type " + m.getDataType() + " on " + m.getTopic()];
         continue;
       }
+      const auto image = is_image ? instantiate<sensor_msgs::Image>(m, stats) : nullptr;
+      const auto points = is_image ? nullptr : instantiate<sensor_msgs::PointCloud2>(m, stats);
+      if (!image && !points) continue;  // counted: its data does not deserialize
       const std_msgs::Header& header = image ? image->header : points->header;
       frame.stamp_s = header.stamp.toSec();
       frame.sensor_frame = header.frame_id;

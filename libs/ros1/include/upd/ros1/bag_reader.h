@@ -48,7 +48,9 @@ struct BagReadStats {
 
 /// Calls on_frame for every frame in time order. A message that does not convert, or whose
 /// sensor has no transform to base_frame, is skipped and counted under its reason. Throws
-/// std::runtime_error naming the file when the bag cannot be opened or read.
+/// std::runtime_error naming the file when the bag cannot be opened or read, and before any
+/// frame when it is damaged ("F: damaged bag: <what> (byte N)": the whole bag is walked first,
+/// since rosbag trusts its lengths and offsets) or has no index.
 BagReadStats readBag(const std::string& path, const BagTopics& topics,
                      const std::function<void(const BagFrame&)>& on_frame);
 

@@ -1,0 +1,329 @@
+#include "bag_check.h"
+
+#include <bzlib.h>
+#include <roslz4/lz4s.h>
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace upd::ros1::detail {
+
+namespace {
+
+// Record ops of the format (rosbag/constants.h).
+constexpr std::uint8_t kOpMessageData = 0x02;
+constexpr std::uint8_t kOpFileHeader = 0x03;
+constexpr std::uint8_t kOpIndexData = 0x04;
+constexpr std::uint8_t kOpChunk = 0x05;
+constexpr std::uint8_t kOpChunkInfo = 0x06;
+constexpr std::uint8_t kOpConnection = 0x07;
+
+// A record's header holds a few fields, a connection's its message definition: kilobytes.
+constexpr std::uint32_t kMaxHeaderBytes = 1u << 24;
+// rosbag closes a chunk at 768 kB by default; a chunk holds at least one whole message.
+constexpr std::uint32_t kMaxChunkBytes = 1u << 30;
+
+[[noreturn]] void damage(const std::string& what, std::uint64_t byte) {
+  throw BagDamage(what + " (byte " + std::to_string(byte) + ")");
+}
+
+// Bytes of the file, or of one chunk's data.
+class Bytes {
+ public:
+  virtual ~Bytes() = default;
+  virtual std::uint64_t size() const = 0;
+  /// The n bytes at pos into out; false when they are not all there.
+  virtual bool read(std::uint64_t pos, std::size_t n, char* out) const = 0;
+  /// The byte of the file a position stands for (for the messages).
+  virtual std::uint64_t fileByte(std::uint64_t pos) const = 0;
+};
+
+class FileBytes : public Bytes {
+ public:
+  FileBytes(std::ifstream& in, std::uint64_t begin, std::uint64_t size)
+      : in_(in), begin_(begin), size_(size) {}
+  std::uint64_t size() const override { return size_; }
+  bool read(std::uint64_t pos, std::size_t n, char* out) const override {
+    if (pos > size_ || n > size_ - pos) return false;
+    in_.clear();
+    in_.seekg(static_cast<std::streamoff>(begin_ + pos));
+    return static_cast<bool>(in_.read(out, static_cast<std::streamsize>(n)));
+  }
+  std::uint64_t fileByte(std::uint64_t pos) const override { return begin_ + pos; }
+
+ private:
+  std::ifstream& in_;
+  std::uint64_t begin_, size_;
+};
+
+class BufferBytes : public Bytes {
+ public:
+  BufferBytes(const std::vector<char>& data, std::uint64_t chunk_byte)
+      : data_(data), chunk_byte_(chunk_byte) {}
+  std::uint64_t size() const override { return data_.size(); }
+  bool read(std::uint64_t pos, std::size_t n, char* out) const override {
+    if (pos > data_.size() || n > data_.size() - pos) return false;
+    std::memcpy(out, data_.data() + pos, n);
+    return true;
+  }
+  std::uint64_t fileByte(std::uint64_t) const override { return chunk_byte_; }
+
+ private:
+  const std::vector<char>& data_;
+  std::uint64_t chunk_byte_;
+};
+
+std::uint32_t u32At(const Bytes& b, std::uint64_t pos, const std::string& what) {
+  char c[4];
+  if (!b.read(pos, 4, c)) damage(what + ": the data ends inside it", b.fileByte(pos));
+  std::uint32_t v;
+  std::memcpy(&v, c, 4);
+  return v;
+}
+
+using Fields = std::map<std::string, std::string>;
+
+// A header at pos: its length, then fields "name=value", each after its own length. next is
+// the position after it.
+Fields headerAt(const Bytes& b, std::uint64_t pos, std::uint64_t& next, const std::string& what) {
+  const std::uint32_t len = u32At(b, pos, what);
+  if (len > kMaxHeaderBytes || len > b.size() - pos - 4) {
+    damage(what + ": a header of " + std::to_string(len) + " bytes runs past the end",
+           b.fileByte(pos));
+  }
+  std::string h(len, '\0');
+  b.read(pos + 4, len, h.data());
+  Fields fields;
+  for (std::size_t i = 0; i < len;) {
+    std::uint32_t field_len = 0;
+    if (len - i < 4) damage(what + ": a header field's length is cut", b.fileByte(pos));
+    std::memcpy(&field_len, h.data() + i, 4);
+    i += 4;
+    if (field_len > len - i) damage(what + ": a header field runs past its header", b.fileByte(pos));
+    const std::string field = h.substr(i, field_len);
+    i += field_len;
+    const auto eq = field.find('=');
+    if (eq == std::string::npos) damage(what + ": a header field without '='", b.fileByte(pos));
+    fields[field.substr(0, eq)] = field.substr(eq + 1);
+  }
+  next = pos + 4 + len;
+  return fields;
+}
+
+// A numeric field as rosbag reads it: present and exactly its size.
+template <class T>
+T field(const Fields& f, const char* name, const std::string& what, std::uint64_t byte) {
+  const auto it = f.find(name);
+  if (it == f.end() || it->second.size() != sizeof(T)) {
+    damage(what + ": no " + std::to_string(sizeof(T)) + "-byte field '" + name + "'", byte);
+  }
+  T v;
+  std::memcpy(&v, it->second.data(), sizeof(T));
+  return v;
+}
+
+struct Record {
+  std::uint8_t op = 0;
+  Fields fields;
+  std::uint64_t data_pos = 0;
+  std::uint32_t data_len = 0;
+  std::uint64_t end() const { return data_pos + data_len; }
+};
+
+// A record at pos (a header, then its data after its length), whose data lies within b.
+Record recordAt(const Bytes& b, std::uint64_t pos, const std::string& what) {
+  Record r;
+  std::uint64_t next = 0;
+  r.fields = headerAt(b, pos, next, what);
+  r.op = field<std::uint8_t>(r.fields, "op", what, b.fileByte(pos));
+  r.data_len = u32At(b, next, what);
+  r.data_pos = next + 4;
+  if (r.data_len > b.size() - r.data_pos) {
+    damage(what + ": its " + std::to_string(r.data_len) + " bytes of data run past the end",
+           b.fileByte(next));
+  }
+  return r;
+}
+
+Record recordAt(const Bytes& b, std::uint64_t pos, std::uint8_t op, const std::string& what) {
+  Record r = recordAt(b, pos, what);
+  if (r.op != op) {
+    damage(what + ": a record of op " + std::to_string(r.op) + " where op " + std::to_string(op) +
+               " belongs",
+           b.fileByte(pos));
+  }
+  return r;
+}
+
+struct ChunkInfo {
+  std::uint64_t pos = 0;
+  std::size_t connections = 0;  // index records after the chunk
+};
+
+// A compressed chunk's data, decompressed as rosbag decompresses it (BZ2 or LZ4).
+std::vector<char> decompressed(const Bytes& file, const Record& chunk, const std::string& compression,
+                               std::uint32_t size, std::uint64_t chunk_pos) {
+  std::vector<char> in(chunk.data_len);
+  file.read(chunk.data_pos, in.size(), in.data());
+  std::vector<char> out(size);
+  unsigned int out_len = size;
+  const bool ok =
+      compression == "bz2"
+          ? BZ2_bzBuffToBuffDecompress(out.data(), &out_len, in.data(),
+                                       static_cast<unsigned int>(in.size()), 0, 0) == BZ_OK
+          : roslz4_buffToBuffDecompress(in.data(), static_cast<unsigned int>(in.size()),
+                                        out.data(), &out_len) == ROSLZ4_OK;
+  if (!ok || out_len != size) {
+    damage("the chunk (" + compression + ") does not decompress to its " + std::to_string(size) +
+               " bytes",
+           chunk_pos);
+  }
+  return out;
+}
+
+// The records of a chunk's data, which must fill it: the op at each record's start.
+std::map<std::uint64_t, std::uint8_t> chunkRecords(const Bytes& data, std::uint64_t chunk_pos) {
+  std::map<std::uint64_t, std::uint8_t> ops;
+  const std::string what = "a record in the chunk at byte " + std::to_string(chunk_pos);
+  for (std::uint64_t p = 0; p < data.size();) {
+    const Record r = recordAt(data, p, what);
+    if (r.op != kOpMessageData && r.op != kOpConnection) {
+      damage(what + ": op " + std::to_string(r.op) + ", not a message or a connection", chunk_pos);
+    }
+    ops[p] = r.op;
+    p = r.end();
+  }
+  return ops;
+}
+
+// The index at pos: a record per connection (a header, then the connection's own header), then
+// a chunk info per chunk. Each takes at least 8 bytes: a damaged count runs into the end.
+std::vector<ChunkInfo> readIndex(const Bytes& file, std::uint64_t pos, std::uint32_t connections,
+                                 std::uint32_t chunks, std::set<std::uint32_t>& declared) {
+  for (std::uint32_t i = 0; i < connections; ++i) {
+    std::uint64_t next = 0;
+    const Fields f = headerAt(file, pos, next, "a connection record");
+    if (field<std::uint8_t>(f, "op", "a connection record", pos) != kOpConnection) {
+      damage("a connection record of another op", pos);
+    }
+    declared.insert(field<std::uint32_t>(f, "conn", "a connection record", pos));
+    headerAt(file, next, pos, "a connection's header");
+  }
+  std::vector<ChunkInfo> infos;
+  for (std::uint32_t i = 0; i < chunks; ++i) {
+    const std::string what = "a chunk info record";
+    const Record r = recordAt(file, pos, kOpChunkInfo, what);
+    if (field<std::uint32_t>(r.fields, "ver", what, pos) != 1) damage(what + " of another version", pos);
+    field<std::uint64_t>(r.fields, "start_time", what, pos);
+    field<std::uint64_t>(r.fields, "end_time", what, pos);
+    const auto count = field<std::uint32_t>(r.fields, "count", what, pos);
+    if (r.data_len != 8ull * count) damage(what + ": its data is not 8 bytes a connection", pos);
+    for (std::uint32_t k = 0; k < count; ++k) {
+      const std::uint32_t id = u32At(file, r.data_pos + 8ull * k, what);
+      if (!declared.count(id)) damage(what + ": connection " + std::to_string(id) + " is not declared", pos);
+    }
+    infos.push_back({field<std::uint64_t>(r.fields, "chunk_pos", what, pos), count});
+    pos = r.end();
+  }
+  return infos;
+}
+
+// The index records after a chunk: the offset of each message in the chunk's data.
+std::vector<std::uint32_t> messageOffsets(const Bytes& file, std::uint64_t p, std::size_t records,
+                                          const std::set<std::uint32_t>& declared) {
+  std::vector<std::uint32_t> offsets;
+  for (std::size_t k = 0; k < records; ++k) {
+    const std::string what = "an index record";
+    const Record r = recordAt(file, p, kOpIndexData, what);
+    if (field<std::uint32_t>(r.fields, "ver", what, p) != 1) damage(what + " of another version", p);
+    const auto id = field<std::uint32_t>(r.fields, "conn", what, p);
+    if (!declared.count(id)) damage(what + ": connection " + std::to_string(id) + " is not declared", p);
+    const auto count = field<std::uint32_t>(r.fields, "count", what, p);
+    if (r.data_len != 12ull * count) damage(what + ": its data is not 12 bytes a message", p);
+    for (std::uint32_t m = 0; m < count; ++m) offsets.push_back(u32At(file, r.data_pos + 12ull * m + 8, what));
+    p = r.end();
+  }
+  return offsets;
+}
+
+// One chunk and its index records: every record in its data (read in place when it is not
+// compressed), and every message offset of the index on a message.
+void checkChunk(std::ifstream& in, const Bytes& file, const ChunkInfo& info,
+                const std::set<std::uint32_t>& declared) {
+  const Record chunk = recordAt(file, info.pos, kOpChunk, "a chunk");
+  const auto compression = chunk.fields.find("compression");
+  if (compression == chunk.fields.end() ||
+      (compression->second != "none" && compression->second != "bz2" && compression->second != "lz4")) {
+    damage("a chunk without a known compression (none, bz2, lz4)", info.pos);
+  }
+  const std::vector<std::uint32_t> offsets = messageOffsets(file, chunk.end(), info.connections, declared);
+  const auto size = field<std::uint32_t>(chunk.fields, "size", "a chunk", info.pos);
+  if (size > kMaxChunkBytes) damage("a chunk of " + std::to_string(size) + " bytes (more than 2^30)", info.pos);
+  std::map<std::uint64_t, std::uint8_t> ops;
+  if (compression->second == "none") {
+    if (chunk.data_len != size) {
+      damage("an uncompressed chunk of " + std::to_string(chunk.data_len) + " bytes whose size says " +
+                 std::to_string(size),
+             info.pos);
+    }
+    ops = chunkRecords(FileBytes(in, chunk.data_pos, chunk.data_len), info.pos);
+  } else {
+    const std::vector<char> data = decompressed(file, chunk, compression->second, size, info.pos);
+    ops = chunkRecords(BufferBytes(data, info.pos), info.pos);
+  }
+  for (const std::uint32_t offset : offsets) {
+    auto it = ops.find(offset);
+    while (it != ops.end() && it->second == kOpConnection) ++it;  // as rosbag skips them
+    if (it == ops.end() || it->second != kOpMessageData) {
+      damage("the index points at byte " + std::to_string(offset) + " of the chunk, not at a message",
+             info.pos);
+    }
+  }
+}
+
+}  // namespace
+
+void checkBag(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return;  // rosbag says why
+  in.seekg(0, std::ios::end);
+  const std::uint64_t file_size = static_cast<std::uint64_t>(in.tellg());
+  const std::string magic = "#ROSBAG V2.0\n";
+  std::string head(magic.size(), '\0');
+  in.seekg(0);
+  if (!in.read(head.data(), static_cast<std::streamsize>(head.size())) || head != magic) return;
+  const FileBytes file(in, 0, file_size);
+
+  const std::uint64_t header_pos = magic.size();
+  const Record header = recordAt(file, header_pos, kOpFileHeader, "the file header");
+  const auto index_pos = field<std::uint64_t>(header.fields, "index_pos", "the file header", header_pos);
+  if (index_pos == 0) {
+    throw BagDamage("the bag has no index: its recording did not end (`rosbag reindex` writes one)");
+  }
+  if (index_pos >= file_size) {
+    throw BagDamage("the file ends at byte " + std::to_string(file_size) + ", before its index (at byte " +
+                    std::to_string(index_pos) + "): it is cut short");
+  }
+  if (index_pos < header.end()) {
+    damage("the file header's index position " + std::to_string(index_pos) +
+               " lies outside the file's records",
+           header_pos);
+  }
+  std::set<std::uint32_t> declared;
+  const std::vector<ChunkInfo> infos =
+      readIndex(file, index_pos, field<std::uint32_t>(header.fields, "conn_count", "the file header", header_pos),
+                field<std::uint32_t>(header.fields, "chunk_count", "the file header", header_pos), declared);
+  for (const ChunkInfo& info : infos) {
+    if (info.pos < header.end() || info.pos >= index_pos) {
+      damage("a chunk position " + std::to_string(info.pos) + " outside the chunks", index_pos);
+    }
+    checkChunk(in, file, info, declared);
+  }
+}
+
+}  // namespace upd::ros1::detail
