@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of tests/fuzz with clang 14 under ASan and UBSan into
 # build-fuzz/, and runs each for SECONDS (default 30): the four cloud readers (pcd, ply, xyz,
-# kitti_bin), the robot config (ini), a rawlog object stream (rawlog) and the core pipeline on
-# arbitrary float clouds (pipeline). docs/RELIABILITY.md, "Fuzzing".
+# kitti_bin), the robot config (ini), a rawlog object stream (rawlog), a ROS 1 bag (bag: built
+# when the ROS 1 packages are there) and the core pipeline on arbitrary float clouds (pipeline).
+# docs/RELIABILITY.md, "Fuzzing".
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     e.g. scripts/fuzz.sh 600 pcd ply
 # UPD_FUZZ_RUNS=N stops each target after N inputs as well (what comes first), and
 # UPD_FUZZ_SEED=S fixes libFuzzer's random seed: with both, a run covers about the same inputs
@@ -20,7 +21,7 @@ UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${UPD_FUZZ_BUILD:-$UPD_ROOT/build-fuzz}"
 SECS="${1:-30}"
 [ $# -gt 0 ] && shift
-ALL=(pcd ply xyz kitti_bin ini rawlog pipeline)
+ALL=(pcd ply xyz kitti_bin ini rawlog bag pipeline)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=("${ALL[@]}")
 SHARED="${UPD_SHARED_DATA_DIR:-$UPD_ROOT/../shared/data}"
@@ -34,6 +35,12 @@ cmake -S "$UPD_ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
       -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14 \
       -DUPD_FUZZ=ON -DUPD_SANITIZE=address,undefined -DUPD_BUILD_TESTS=OFF -DUPD_BUILD_BENCH=OFF \
       "${launcher[@]}" >/dev/null
+# fuzz_bag exists only with the ROS 1 packages (scripts/setup.sh installs them).
+if [[ " ${TARGETS[*]} " == *" bag "* ]] &&
+   ! grep -q '\bfuzz_bag\b' <<<"$(cmake --build "$BUILD" --target help)"; then
+  echo "fuzz: bag: not built (no ROS 1 packages): left out"
+  TARGETS=($(printf '%s\n' "${TARGETS[@]}" | grep -vx bag))
+fi
 cmake --build "$BUILD" -j"${UPD_JOBS:-$(nproc)}" --target fuzz_seeds \
       $(printf 'fuzz_%s ' "${TARGETS[@]}")
 

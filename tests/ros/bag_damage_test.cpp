@@ -8,14 +8,20 @@
 #include "upd/ros1/bag_reader.h"
 #include "upd/ros1/conversions.h"
 
+#include "../../libs/ros1/src/bag_messages.h"
+
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace {
 
@@ -143,6 +149,53 @@ TEST_P(BagDamage, FlippedBytesEndInFramesOrOneErrorNamingTheFile) {
     ASSERT_EQ(error.rfind(bad + ": ", 0), 0u) << "trial " << trial << ": " << error;
   }
   EXPECT_GT(failed, 0);
+}
+
+// The serialized data of a message.
+template <class M>
+std::vector<std::uint8_t> serialized(const M& msg) {
+  std::vector<std::uint8_t> raw(ros::serialization::serializationLength(msg));
+  ros::serialization::OStream stream(raw.data(), static_cast<std::uint32_t>(raw.size()));
+  ros::serialization::serialize(stream, msg);
+  return raw;
+}
+
+// Every message type the reader instantiates: whole, its lengths fit; cut anywhere, or with a
+// length raised past its data, they do not (roscpp would allocate what the length says).
+TEST(BagMessages, LengthsThatRunPastTheDataAreFound) {
+  core::DepthImage depth;
+  depth.width = 4;
+  depth.height = 3;
+  depth.depth_m.assign(12, 1.f);
+  core::CameraIntrinsics k;
+  k.width = 4;
+  k.height = 3;
+  k.fx = k.fy = 5;
+  core::PointCloud cloud;
+  cloud.push_back(1.f, 2.f, 3.f);
+  tf2_msgs::TFMessage tf;
+  tf.transforms.push_back(stamped("map", "base_link", 1.0));
+  tf.transforms.push_back(stamped("base_link", "camera", 1.0));
+  const std::vector<std::pair<std::string, std::vector<std::uint8_t>>> messages = {
+      {"sensor_msgs/Image", serialized(ros1::imageFromDepth(depth, "16UC1"))},
+      {"sensor_msgs/CameraInfo", serialized(ros1::cameraInfoFromIntrinsics(k))},
+      {"sensor_msgs/PointCloud2", serialized(ros1::pointCloud2FromCloud(cloud))},
+      {"tf2_msgs/TFMessage", serialized(tf)}};
+  for (const auto& [type, raw] : messages) {
+    EXPECT_TRUE(ros1::detail::lengthsFit(type, raw.data(), raw.size())) << type;
+    for (std::size_t cut = 0; cut < raw.size(); ++cut) {
+      EXPECT_FALSE(ros1::detail::lengthsFit(type, raw.data(), cut)) << type << " cut at " << cut;
+    }
+  }
+  // The image's data length (its last 4 bytes before the 24 bytes of data) raised to 2^32 - 1.
+  std::vector<std::uint8_t> image = messages[0].second;
+  std::memset(image.data() + image.size() - 24 - 4, 0xff, 4);
+  EXPECT_FALSE(ros1::detail::lengthsFit("sensor_msgs/Image", image.data(), image.size()));
+  // The transform count raised to 2^32 - 1: roscpp would resize to 4 G transforms.
+  std::vector<std::uint8_t> many = messages[3].second;
+  std::memset(many.data(), 0xff, 4);
+  EXPECT_FALSE(ros1::detail::lengthsFit("tf2_msgs/TFMessage", many.data(), many.size()));
+  EXPECT_TRUE(ros1::detail::lengthsFit("std_msgs/String", nullptr, 0));  // not walked
 }
 
 INSTANTIATE_TEST_SUITE_P(Compressions, BagDamage,

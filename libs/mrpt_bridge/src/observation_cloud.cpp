@@ -23,7 +23,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 namespace upd::mrpt_bridge {
@@ -50,8 +49,6 @@ void SourceParams::validate() const {
 }
 
 namespace {
-
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 struct Transform {
   Eigen::Matrix3f r;

@@ -3,7 +3,9 @@
 #include <bzlib.h>
 #include <roslz4/lz4s.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -286,6 +288,30 @@ void checkChunk(std::ifstream& in, const Bytes& file, const ChunkInfo& info,
   }
 }
 
+// The format version of the bag's first line, read as rosbag reads it (fgets of at most 1,023
+// bytes, then sscanf "#ROS%s V%d.%d" into a 100-byte word), and the byte after that line.
+// 0 when it is not a bag's version line; rosbag then says so.
+int bagVersion(std::ifstream& in, std::uint64_t& after) {
+  std::string line(1023, '\0');
+  in.seekg(0);
+  in.read(line.data(), static_cast<std::streamsize>(line.size()));
+  line.resize(static_cast<std::size_t>(in.gcount()));
+  in.clear();
+  const auto newline = line.find('\n');
+  after = newline == std::string::npos ? line.size() : newline + 1;
+  line.resize(std::min<std::size_t>(after, line.find('\0')));  // as sscanf sees it
+  if (line.rfind("#ROS", 0) != 0) return 0;
+  // rosbag's unbounded %s writes a longer word past its 100-byte buffer.
+  const auto word_end = line.find_first_of(" \t\n\v\f\r", 4);
+  if ((word_end == std::string::npos ? line.size() : word_end) - 4 >= 100) {
+    throw BagDamage("the version line's word after '#ROS' has 100 or more characters");
+  }
+  char word[100];
+  int major = 0, minor = 0;
+  if (std::sscanf(line.c_str(), "#ROS%99s V%d.%d", word, &major, &minor) != 3) return 0;
+  return major * 100 + minor;
+}
+
 }  // namespace
 
 void checkBag(const std::string& path) {
@@ -293,13 +319,15 @@ void checkBag(const std::string& path) {
   if (!in) return;  // rosbag says why
   in.seekg(0, std::ios::end);
   const std::uint64_t file_size = static_cast<std::uint64_t>(in.tellg());
-  const std::string magic = "#ROSBAG V2.0\n";
-  std::string head(magic.size(), '\0');
-  in.seekg(0);
-  if (!in.read(head.data(), static_cast<std::streamsize>(head.size())) || head != magic) return;
+  std::uint64_t header_pos = 0;
+  const int version = bagVersion(in, header_pos);
+  if (version == 0) return;  // not a bag: rosbag says so
+  if (version != 200) {
+    throw BagDamage("bag format " + std::to_string(version / 100) + "." + std::to_string(version % 100) +
+                    ": only format 2.0 (ROS since 2010) is read");
+  }
   const FileBytes file(in, 0, file_size);
 
-  const std::uint64_t header_pos = magic.size();
   const Record header = recordAt(file, header_pos, kOpFileHeader, "the file header");
   const auto index_pos = field<std::uint64_t>(header.fields, "index_pos", "the file header", header_pos);
   if (index_pos == 0) {

@@ -3,6 +3,7 @@
 #include "upd/ros1/conversions.h"
 
 #include "bag_check.h"
+#include "bag_messages.h"
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -14,23 +15,36 @@
 #include <tf2_msgs/TFMessage.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <new>
+#include <vector>
 
 namespace upd::ros1 {
 
 namespace {
 
 // The message as type M (null when it is another type). A message of type M whose data does not
-// deserialize (a damaged length: roscpp throws at the end of its data, or cannot allocate what
-// it says) is null too, and counted under its reason.
+// deserialize is null too, and counted under its reason: a string or array length that runs past
+// its data (checked first: roscpp would allocate what it says), or what roscpp throws.
 template <class M>
 boost::shared_ptr<M> instantiate(const rosbag::MessageInstance& m, BagReadStats& stats) {
+  if (!m.isType<M>()) return nullptr;
+  const auto count = [&](const std::string& why) {
+    ++stats.skipped["a message on " + m.getTopic() + " that does not deserialize (" + why + ")"];
+  };
   try {
+    std::vector<std::uint8_t> raw(m.size());
+    ros::serialization::OStream stream(raw.data(), static_cast<std::uint32_t>(raw.size()));
+    m.write(stream);
+    if (!detail::lengthsFit(m.getDataType(), raw.data(), raw.size())) {
+      count("a length runs past its data");
+      return nullptr;
+    }
     return m.instantiate<M>();
   } catch (const ros::Exception& e) {
-    ++stats.skipped["a message on " + m.getTopic() + " that does not deserialize (" + e.what() + ")"];
+    count(e.what());
   } catch (const std::bad_alloc&) {
-    ++stats.skipped["a message on " + m.getTopic() + " that does not deserialize (a length beyond memory)"];
+    count("a length beyond memory");
   }
   return nullptr;
 }
