@@ -151,6 +151,33 @@ TEST_P(BagDamage, FlippedBytesEndInFramesOrOneErrorNamingTheFile) {
   EXPECT_GT(failed, 0);
 }
 
+// rosbag reads the first line with fgets and sscanf("#ROS%s V%d.%d") into a 100-byte word: a
+// line that goes on after "#ROSBAG V2.0" is still a bag of format 2.0 to it (its file header then
+// starts later: garbage lengths), a longer word overflows its buffer, and 1.2 is another reader.
+TEST(BagVersionLine, IsReadAsRosbagReadsIt) {
+  const test::TempDir dir("bag_version");
+  const std::string bytes = writeBag(dir.file("good.bag"), rosbag::compression::Uncompressed);
+  const std::string bad = dir.file("bad.bag");
+  struct Case {
+    std::string bytes, expected;
+  };
+  const std::string rest = bytes.substr(13);
+  for (const Case& c :
+       {Case{"#ROSBAG V2.0 " + rest, "damaged bag: "},
+        Case{"#ROS" + std::string(150, 'A') + " V2.0\n" + rest, "word after '#ROS' has 100 or more"},
+        Case{"#ROSBAG V1.2\n" + rest, "damaged bag: bag format 1.2: only format 2.0"}}) {
+    write(bad, c.bytes);
+    std::string error;
+    ASSERT_EQ(framesOf(bad, error), -1) << c.expected;
+    EXPECT_EQ(error.rfind(bad + ": ", 0), 0u) << error;
+    EXPECT_NE(error.find(c.expected), std::string::npos) << error;
+  }
+  write(bad, "not a bag\n");
+  std::string error;
+  ASSERT_EQ(framesOf(bad, error), -1);
+  EXPECT_NE(error.find(bad + ": cannot open as a ROS 1 bag"), std::string::npos) << error;
+}
+
 // The serialized data of a message.
 template <class M>
 std::vector<std::uint8_t> serialized(const M& msg) {
