@@ -278,9 +278,10 @@ void checkChunk(std::ifstream& in, const Bytes& file, const ChunkInfo& info,
     const std::vector<char> data = decompressed(file, chunk, compression->second, size, info.pos);
     ops = chunkRecords(BufferBytes(data, info.pos), info.pos);
   }
+  // rosbag writes each offset at its message record. (Where one lands on a connection record,
+  // rosbag reads on from inside that record's second header: a record to refuse too.)
   for (const std::uint32_t offset : offsets) {
-    auto it = ops.find(offset);
-    while (it != ops.end() && it->second == kOpConnection) ++it;  // as rosbag skips them
+    const auto it = ops.find(offset);
     if (it == ops.end() || it->second != kOpMessageData) {
       damage("the index points at byte " + std::to_string(offset) + " of the chunk, not at a message",
              info.pos);
