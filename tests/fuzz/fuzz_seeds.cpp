@@ -38,10 +38,7 @@
 #include <mrpt/serialization/CArchive.h>
 
 #ifdef UPD_FUZZ_HAVE_ROS1
-#include "upd/ros1/conversions.h"
-
-#include <rosbag/bag.h>
-#include <tf2_msgs/TFMessage.h>
+#include "ros/small_bag.h"
 #endif
 
 #include <cstdio>
@@ -227,52 +224,6 @@ void putSensorsRawlog(const fs::path& dir) {
   for (const auto& o : all) ar << *o;
 }
 
-#ifdef UPD_FUZZ_HAVE_ROS1
-// A bag of two 16 x 12 depth frames with their camera info, a point cloud, and the transforms
-// that place them (static and moving), in chunks of about 1 kB.
-void putBag(const fs::path& dir, const std::string& name, rosbag::compression::CompressionType c) {
-  fs::create_directories(dir);
-  upd::core::DepthImage depth;
-  depth.width = 16;
-  depth.height = 12;
-  depth.depth_m.assign(16 * 12, 1.5f);
-  upd::core::CameraIntrinsics k;
-  k.width = 16;
-  k.height = 12;
-  k.fx = k.fy = 12;
-  k.cx = 8;
-  k.cy = 6;
-  upd::core::PointCloud cloud;
-  for (int i = 0; i < 8; ++i) cloud.push_back(1.f + 0.1f * i, 0.f, -0.5f);
-  rosbag::Bag bag((dir / name).string(), rosbag::bagmode::Write);
-  bag.setCompression(c);
-  bag.setChunkThreshold(1000);
-  const auto stamped = [](const std::string& parent, const std::string& child, double t) {
-    geometry_msgs::TransformStamped s;
-    s.header.frame_id = parent;
-    s.header.stamp = ros::Time(t);
-    s.child_frame_id = child;
-    s.transform.rotation.w = 1.0;
-    return s;
-  };
-  tf2_msgs::TFMessage statics;
-  statics.transforms.push_back(stamped("base_link", "camera", 1.0));
-  bag.write("/tf_static", ros::Time(1.0), statics);
-  sensor_msgs::CameraInfo info = upd::ros1::cameraInfoFromIntrinsics(k);
-  sensor_msgs::Image image = upd::ros1::imageFromDepth(depth, "16UC1");
-  sensor_msgs::PointCloud2 points = upd::ros1::pointCloud2FromCloud(cloud);
-  info.header.frame_id = image.header.frame_id = points.header.frame_id = "camera";
-  for (int i = 1; i <= 2; ++i) {
-    tf2_msgs::TFMessage tf;
-    tf.transforms.push_back(stamped("map", "base_link", i));
-    bag.write("/tf", ros::Time(i), tf);
-    info.header.stamp = image.header.stamp = points.header.stamp = ros::Time(i);
-    bag.write("/camera/depth/camera_info", ros::Time(i), info);
-    bag.write("/camera/depth/image_raw", ros::Time(i), image);
-    bag.write("/points", ros::Time(i + 0.5), points);
-  }
-}
-#endif
 
 }  // namespace
 
@@ -313,9 +264,20 @@ int main(int argc, char** argv) {
   putActionsRawlog(out / "rawlog");
   putSensorsRawlog(out / "rawlog");
 #ifdef UPD_FUZZ_HAVE_ROS1
-  putBag(out / "bag", "none.bag", rosbag::compression::Uncompressed);
-  putBag(out / "bag", "bz2.bag", rosbag::compression::BZ2);
-  putBag(out / "bag", "lz4.bag", rosbag::compression::LZ4);
+  // Two 16 x 12 depth frames and point clouds in chunks of about 1 kB, in each compression.
+  fs::create_directories(out / "bag");
+  upd::test::SmallBag bag;
+  bag.width = 16;
+  bag.height = 12;
+  bag.frames = 2;
+  bag.chunk_bytes = 1000;
+  bag.with_points = true;
+  for (const auto& [name, compression] :
+       {std::pair{"none.bag", rosbag::compression::Uncompressed},
+        std::pair{"bz2.bag", rosbag::compression::BZ2}, std::pair{"lz4.bag", rosbag::compression::LZ4}}) {
+    bag.compression = compression;
+    upd::test::writeSmallBag((out / "bag" / name).string(), bag);
+  }
 #endif
   return 0;
 }

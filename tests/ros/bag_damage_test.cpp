@@ -3,6 +3,7 @@
 // chunks: three depth frames with their camera info and transforms) is cut short, left without
 // its index, and has bytes flipped at random; every read ends in its frames or in one
 // std::runtime_error that names the file, and never ends the process.
+#include "small_bag.h"
 #include "temp_dir.h"
 
 #include "upd/ros1/bag_reader.h"
@@ -11,8 +12,6 @@
 #include "../../libs/ros1/src/bag_messages.h"
 
 #include <gtest/gtest.h>
-#include <rosbag/bag.h>
-#include <tf2_msgs/TFMessage.h>
 
 #include <cstdint>
 #include <cstring>
@@ -27,46 +26,13 @@ namespace {
 
 using namespace upd;
 
-geometry_msgs::TransformStamped stamped(const std::string& parent, const std::string& child, double t) {
-  geometry_msgs::TransformStamped s;
-  s.header.frame_id = parent;
-  s.header.stamp = ros::Time(t);
-  s.child_frame_id = child;
-  s.transform = ros1::transformFromIsometry(Eigen::Isometry3d::Identity());
-  return s;
-}
+using test::stamped;
 
 // Three small depth frames (a wall 1.5 m ahead) in chunks of about 4 kB; the file's bytes.
 std::string writeBag(const std::string& path, rosbag::compression::CompressionType compression) {
-  core::DepthImage depth;
-  depth.width = 64;
-  depth.height = 48;
-  depth.depth_m.assign(64 * 48, 1.5f);
-  core::CameraIntrinsics k;
-  k.width = 64;
-  k.height = 48;
-  k.fx = k.fy = 50;
-  k.cx = 32;
-  k.cy = 24;
-  {
-    rosbag::Bag bag(path, rosbag::bagmode::Write);
-    bag.setCompression(compression);
-    bag.setChunkThreshold(4000);
-    tf2_msgs::TFMessage statics;
-    statics.transforms.push_back(stamped("base_link", "camera", 1.0));
-    bag.write("/tf_static", ros::Time(1.0), statics);
-    sensor_msgs::CameraInfo info = ros1::cameraInfoFromIntrinsics(k);
-    sensor_msgs::Image image = ros1::imageFromDepth(depth, "16UC1");
-    info.header.frame_id = image.header.frame_id = "camera";
-    for (int i = 1; i <= 3; ++i) {
-      tf2_msgs::TFMessage tf;
-      tf.transforms.push_back(stamped("map", "base_link", i));
-      bag.write("/tf", ros::Time(i), tf);
-      info.header.stamp = image.header.stamp = ros::Time(i);
-      bag.write("/camera/depth/camera_info", ros::Time(i), info);
-      bag.write("/camera/depth/image_raw", ros::Time(i), image);
-    }
-  }
+  test::SmallBag b;
+  b.compression = compression;
+  test::writeSmallBag(path, b);
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
@@ -201,8 +167,9 @@ TEST(BagMessages, LengthsThatRunPastTheDataAreFound) {
   core::PointCloud cloud;
   cloud.push_back(1.f, 2.f, 3.f);
   tf2_msgs::TFMessage tf;
-  tf.transforms.push_back(stamped("map", "base_link", 1.0));
-  tf.transforms.push_back(stamped("base_link", "camera", 1.0));
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  tf.transforms.push_back(stamped(identity, "map", "base_link", 1.0));
+  tf.transforms.push_back(stamped(identity, "base_link", "camera", 1.0));
   const std::vector<std::pair<std::string, std::vector<std::uint8_t>>> messages = {
       {"sensor_msgs/Image", serialized(ros1::imageFromDepth(depth, "16UC1"))},
       {"sensor_msgs/CameraInfo", serialized(ros1::cameraInfoFromIntrinsics(k))},

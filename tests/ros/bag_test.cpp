@@ -2,6 +2,7 @@
 // the camera on base_link in /tf_static, the robot moving in /tf) reads back frame by frame with
 // its poses, and `upd playback RUN.bag` turns it into a map as it does a rawlog.
 #include "real_frame.h"
+#include "small_bag.h"
 #include "temp_dir.h"
 #include "test_data.h"
 #include "apps/run_upd.h"
@@ -21,15 +22,7 @@ namespace {
 
 using namespace upd;
 
-geometry_msgs::TransformStamped stamped(const Eigen::Isometry3d& p, const std::string& parent,
-                                        const std::string& child, double t) {
-  geometry_msgs::TransformStamped s;
-  s.header.frame_id = parent;
-  s.header.stamp = ros::Time(t);
-  s.child_frame_id = child;
-  s.transform = ros1::transformFromIsometry(p);
-  return s;
-}
+using test::stamped;
 
 // Three copies of the frame at t = 1, 2, 3 s with the robot 0.1 m further along x each time,
 // and one malformed image between them.

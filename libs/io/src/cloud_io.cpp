@@ -81,6 +81,14 @@ std::string lowerExtension(const std::string& path) {
   return ext;
 }
 
+std::uint64_t bytesLeft(std::istream& in) {
+  const std::streamoff start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff end = in.tellg();
+  in.seekg(start);
+  return start < 0 || end < start ? 0 : static_cast<std::uint64_t>(end - start);
+}
+
 core::PointCloud readCloud(const std::string& path) {
   const std::string ext = lowerExtension(path);
   const bool known = ext == ".pcd" || ext == ".ply" || ext == ".xyz" || ext == ".txt" ||

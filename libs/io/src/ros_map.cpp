@@ -1,6 +1,7 @@
 #include "upd/io/ros_map.h"
 
 #include "upd/io/atomic_file.h"
+#include "upd/io/cloud_io.h"
 
 #include <algorithm>
 #include <cmath>
@@ -164,16 +165,12 @@ RosMap readRosMap(const std::string& yaml_path) {
   }
   pgm.get();
   // The pixels must be in the file before they are allocated (a damaged header's size).
-  const std::streamoff start = pgm.tellg();
-  pgm.seekg(0, std::ios::end);
-  const std::streamoff bytes = pgm.tellg() - start;
-  pgm.seekg(start);
+  const std::uint64_t bytes = bytesLeft(pgm);
   const std::size_t cells = static_cast<std::size_t>(map.width) * map.height;
-  if (start < 0 || bytes < 0 || cells > static_cast<std::size_t>(bytes)) {
+  if (cells > bytes) {
     throw std::runtime_error("ROS map " + pgm_path.string() + ": truncated (" +
                              std::to_string(map.width) + " x " + std::to_string(map.height) +
-                             " pixels, " + std::to_string(std::max<std::streamoff>(bytes, 0)) +
-                             " bytes after the header)");
+                             " pixels, " + std::to_string(bytes) + " bytes after the header)");
   }
   std::vector<std::uint8_t> pixels(cells);
   if (!pgm.read(reinterpret_cast<char*>(pixels.data()),

@@ -109,14 +109,11 @@ ScoredCloud readScoredPly(std::istream& in, const PlyLayout& l, const std::strin
   if (!l.binary_le || !l.vertex_only)
     throw std::runtime_error(path + ": a scored PLY must be binary_little_endian with vertices only");
   // The vertices must be in the file before anything is allocated for them.
-  const std::streamoff start = in.tellg();
-  in.seekg(0, std::ios::end);
-  const std::streamoff bytes = in.tellg() - start;
-  in.seekg(start);
-  if (start < 0 || bytes < 0 || l.vertices > static_cast<std::size_t>(bytes) / l.stride)
+  const std::uint64_t bytes = io::bytesLeft(in);
+  if (l.vertices > bytes / l.stride)
     throw std::runtime_error(path + ": truncated PLY (the header declares " + std::to_string(l.vertices) +
                              " vertices of " + std::to_string(l.stride) + " bytes, the file holds " +
-                             std::to_string(std::max<std::streamoff>(bytes, 0)) + " bytes after it)");
+                             std::to_string(bytes) + " bytes after it)");
   std::vector<char> data(l.vertices * l.stride);
   if (!in.read(data.data(), std::streamsize(data.size())))
     throw std::runtime_error(path + ": truncated PLY (expected " + std::to_string(l.vertices) + " vertices)");

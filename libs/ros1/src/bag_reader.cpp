@@ -14,6 +14,8 @@
 #include <tf2/exceptions.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <boost/make_shared.hpp>
+
 #include <algorithm>
 #include <cstdint>
 #include <new>
@@ -40,7 +42,11 @@ boost::shared_ptr<M> instantiate(const rosbag::MessageInstance& m, BagReadStats&
       count("a length runs past its data");
       return nullptr;
     }
-    return m.instantiate<M>();
+    // From the data just read and walked, not read from the bag again.
+    auto msg = boost::make_shared<M>();
+    ros::serialization::IStream in(raw.data(), static_cast<std::uint32_t>(raw.size()));
+    ros::serialization::deserialize(in, *msg);
+    return msg;
   } catch (const ros::Exception& e) {
     count(e.what());
   } catch (const std::bad_alloc&) {

@@ -1,0 +1,69 @@
+// A small ROS 1 bag written with the rosbag API, for the bag tests and the bag fuzzer's seeds:
+// depth frames of a wall 1.5 m ahead with their camera info (and, when asked, a point cloud
+// half a second after each), the camera on base_link in /tf_static, base_link in map on /tf.
+#pragma once
+
+#include "upd/ros1/conversions.h"
+
+#include <rosbag/bag.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <cstdint>
+#include <string>
+
+namespace upd::test {
+
+inline geometry_msgs::TransformStamped stamped(const Eigen::Isometry3d& pose, const std::string& parent,
+                                               const std::string& child, double t) {
+  geometry_msgs::TransformStamped s;
+  s.header.frame_id = parent;
+  s.header.stamp = ros::Time(t);
+  s.child_frame_id = child;
+  s.transform = ros1::transformFromIsometry(pose);
+  return s;
+}
+
+struct SmallBag {
+  int width = 64, height = 48;  ///< of the depth image [px]
+  int frames = 3;               ///< at t = 1, 2, ... s
+  std::uint32_t chunk_bytes = 4000;
+  bool with_points = false;  ///< a PointCloud2 on /points after each frame
+  rosbag::compression::CompressionType compression = rosbag::compression::Uncompressed;
+};
+
+inline void writeSmallBag(const std::string& path, const SmallBag& b) {
+  core::DepthImage depth;
+  depth.width = b.width;
+  depth.height = b.height;
+  depth.depth_m.assign(static_cast<std::size_t>(b.width) * b.height, 1.5f);
+  core::CameraIntrinsics k;
+  k.width = b.width;
+  k.height = b.height;
+  k.fx = k.fy = 0.78125 * b.width;  // a 79 degree field of view
+  k.cx = b.width / 2.0;
+  k.cy = b.height / 2.0;
+  core::PointCloud cloud;
+  for (int i = 0; i < 8; ++i) cloud.push_back(1.f + 0.1f * i, 0.f, -0.5f);
+  rosbag::Bag bag(path, rosbag::bagmode::Write);
+  bag.setCompression(b.compression);
+  bag.setChunkThreshold(b.chunk_bytes);
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  tf2_msgs::TFMessage statics;
+  statics.transforms.push_back(stamped(identity, "base_link", "camera", 1.0));
+  bag.write("/tf_static", ros::Time(1.0), statics);
+  sensor_msgs::CameraInfo info = ros1::cameraInfoFromIntrinsics(k);
+  sensor_msgs::Image image = ros1::imageFromDepth(depth, "16UC1");
+  sensor_msgs::PointCloud2 points = ros1::pointCloud2FromCloud(cloud);
+  info.header.frame_id = image.header.frame_id = points.header.frame_id = "camera";
+  for (int i = 1; i <= b.frames; ++i) {
+    tf2_msgs::TFMessage tf;
+    tf.transforms.push_back(stamped(identity, "map", "base_link", i));
+    bag.write("/tf", ros::Time(i), tf);
+    info.header.stamp = image.header.stamp = points.header.stamp = ros::Time(i);
+    bag.write("/camera/depth/camera_info", ros::Time(i), info);
+    bag.write("/camera/depth/image_raw", ros::Time(i), image);
+    if (b.with_points) bag.write("/points", ros::Time(i + 0.5), points);
+  }
+}
+
+}  // namespace upd::test
