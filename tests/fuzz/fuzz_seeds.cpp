@@ -9,6 +9,7 @@
 //   fuzz_seeds OUTDIR   ->  OUTDIR/{pcd,ply,xyz,kitti_bin,pipeline,rawlog,bag}/...
 #include "io/cloud_samples.h"
 
+#include "upd/io/cloud_io.h"
 #include "upd/sim/scenes.h"
 
 #include <mrpt/io/CFileOutputStream.h>
@@ -56,6 +57,25 @@ void put(const fs::path& dir, const std::string& name, const std::string& bytes)
   fs::create_directories(dir);
   std::ofstream(dir / name, std::ios::binary)
       .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// A scored PLY of the points (writeScoredPly's file), for readScoredPly.
+void putScoredPly(const fs::path& dir, const std::vector<samples::Xyz>& p) {
+  fs::create_directories(dir);
+  std::vector<float> x, y, z, n(p.size(), 0.5f);
+  std::vector<upd::core::Label> label(p.size(), upd::core::Label::NonTraversable);
+  for (const auto& q : p) {
+    x.push_back(q.x);
+    y.push_back(q.y);
+    z.push_back(q.z);
+  }
+  upd::io::ScoredPoints s;
+  s.x = x;
+  s.y = y;
+  s.z = z;
+  s.nx = s.ny = s.nz = s.rx = s.ry = s.rz = s.zeta = s.cost = n;
+  s.label = label;
+  upd::io::writeScoredPly((dir / "scored.ply").string(), s);
 }
 
 // The pipeline fuzzer's input: a flags byte, then x, y, z floats.
@@ -241,6 +261,7 @@ int main(int argc, char** argv) {
   put(out / "ply", "ascii.ply", samples::plyAscii(small));
   put(out / "ply", "le.ply", samples::plyBinary(small, false));
   put(out / "ply", "be.ply", samples::plyBinary(small, true));
+  putScoredPly(out / "ply", small);
   put(out / "xyz", "grid.xyz", samples::xyzText(small));
   put(out / "xyz", "colour.xyz", "x,y,z,r,g,b\n0 0 0 255 0 0\n1,0,0,0,255,0\n0 1 0 0 0 255 # c\n");
   put(out / "kitti_bin", "grid.bin", samples::kittiBin(small));

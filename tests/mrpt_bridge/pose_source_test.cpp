@@ -81,6 +81,8 @@ TEST(TumTrajectory, BadLinesNameFileAndLine) {
   expectError("1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n", "gt.txt:2", "does not increase");
   expectError("1 0 0 0 0 0 0 1 7\n", "gt.txt:1", "9 values");
   expectError("1 nan 0 0 0 0 0 1\n", "gt.txt:1", "not finite");
+  expectError("1 0 0 0 0 0 0 1\n2 0 1e30 0 0 0 0 1\n", "gt.txt:2",
+              "position y = 1e+30 m is farther than 1e+09 m from the origin");
   try {
     TumTrajectory::load("/nonexistent/dir/gt.tum");
     FAIL();

@@ -1,6 +1,7 @@
-// The scored PLY as `upd render` and `upd view` read it: any PLY scalar type per property (a file
-// re-saved by another tool), labels and colours converted only where the value is one, and a
-// header that declares more vertices than the file holds refused before anything is allocated.
+// The scored PLY as `upd render` and `upd view` read it (io::readScoredPly): any PLY scalar type
+// per property (a file re-saved by another tool), labels and colours converted only where the
+// value is one, and a header that declares more vertices than the file holds refused before
+// anything is allocated.
 #include "temp_dir.h"
 #include "upd/nav/figure.h"
 
@@ -78,10 +79,10 @@ TEST(ScoredPly, MoreVerticesThanTheFileHoldsIsRefusedNamingIt) {
       ADD_FAILURE() << count << " vertices: read";
     } catch (const std::runtime_error& e) {
       const std::string what = e.what();
-      EXPECT_NE(what.find(path + ": truncated PLY (the header declares " + count + " vertices"),
-                std::string::npos)
+      const std::string declared = "': truncated PLY: the header declares " + std::string(count);
+      EXPECT_NE(what.find("'" + path + declared + " vertices"), std::string::npos)
           << what;
-      EXPECT_NE(what.find("the file holds 120 bytes"), std::string::npos) << what;
+      EXPECT_NE(what.find("only 120 bytes of data follow"), std::string::npos) << what;
     }
   }
   const std::string whole = dir.file("whole.ply");

@@ -1,6 +1,9 @@
-// The binary little-endian PLY writer shared by writePly and writeScoredPly (not installed):
-// one routine writes every PLY the project produces, so their headers cannot drift apart.
+// The binary little-endian PLY writer shared by writePly and writeScoredPly, and the vertex
+// reader shared by readPly and readScoredPly (not installed): one routine writes every PLY the
+// project produces and one parses every PLY it reads, so they cannot drift apart.
 #pragma once
+
+#include "upd/core/point_cloud.h"
 
 #include <Eigen/Core>
 
@@ -33,5 +36,18 @@ void writeBinaryPly(const std::string& path, std::size_t n, const std::vector<Pl
 /// restores: the "towards the sensor" orientation of vertical normals needs it.
 std::vector<std::string> withOriginComment(std::vector<std::string> comments,
                                            const Eigen::Vector3f& origin);
+
+/// A PLY's vertices: the cloud as readPly reads it, and beside it the requested extra vertex
+/// properties (any scalar type, as float), one value per vertex where has_extra[k] (empty where
+/// the file lacks the property).
+struct PlyVertices {
+  core::PointCloud cloud;
+  std::vector<std::vector<float>> extra;
+  std::vector<bool> has_extra;
+};
+
+/// Reads the vertices of a PLY in any of its three encodings, with the properties named in
+/// extra; throws std::runtime_error naming the file and what is wrong, as readPly does.
+PlyVertices readPlyVertices(const std::string& path, const std::vector<std::string>& extra);
 
 }  // namespace upd::io::detail

@@ -213,11 +213,14 @@ PlyHeader readHeader(const std::string& path, std::ifstream& in) {
   return h;
 }
 
-/// Where the vertex properties we use sit in an element's property list (-1: absent).
+/// Where the vertex properties we use sit in an element's property list (-1: absent), the
+/// requested extra properties (any scalar type, read as float) among them.
 struct VertexLayout {
   int x = -1, y = -1, z = -1, r = -1, g = -1, b = -1;
+  std::vector<int> extra;
 
-  explicit VertexLayout(const PlyElement& e) {
+  VertexLayout(const PlyElement& e, const std::vector<std::string>& extra_names)
+      : extra(extra_names.size(), -1) {
     for (int i = 0; i < static_cast<int>(e.properties.size()); ++i) {
       const PlyProperty& p = e.properties[i];
       if (p.is_list) continue;
@@ -227,6 +230,9 @@ struct VertexLayout {
       else if (p.name == "red") r = i;
       else if (p.name == "green") g = i;
       else if (p.name == "blue") b = i;
+      for (std::size_t k = 0; k < extra_names.size(); ++k) {
+        if (p.name == extra_names[k]) extra[k] = i;
+      }
     }
   }
   bool hasXyz() const { return x >= 0 && y >= 0 && z >= 0; }
@@ -235,7 +241,8 @@ struct VertexLayout {
 
 // Appends one vertex whose property values (in the element's order) are v.
 void appendVertex(const std::vector<double>& v, const PlyElement& e, const VertexLayout& lay,
-                  bool color, core::PointCloud& cloud) {
+                  bool color, detail::PlyVertices& out) {
+  core::PointCloud& cloud = out.cloud;
   cloud.x.push_back(static_cast<float>(v[lay.x]));
   cloud.y.push_back(static_cast<float>(v[lay.y]));
   cloud.z.push_back(static_cast<float>(v[lay.z]));
@@ -244,11 +251,23 @@ void appendVertex(const std::vector<double>& v, const PlyElement& e, const Verte
     cloud.g.push_back(toColor(v[lay.g], e.properties[lay.g].type));
     cloud.b.push_back(toColor(v[lay.b], e.properties[lay.b].type));
   }
+  for (std::size_t k = 0; k < lay.extra.size(); ++k) {
+    if (lay.extra[k] >= 0) out.extra[k].push_back(static_cast<float>(v[lay.extra[k]]));
+  }
 }
 
-void prepareCloud(core::PointCloud& cloud, std::size_t n, bool color) {
-  cloud.resize(n, color);
-  cloud.width = n;
+void prepareVertices(detail::PlyVertices& out, const VertexLayout& lay, std::size_t n,
+                     bool color) {
+  out.cloud.resize(n, color);
+  out.cloud.width = n;
+  out.cloud.height = 1;
+  for (std::size_t k = 0; k < lay.extra.size(); ++k) {
+    if (lay.extra[k] >= 0) out.extra[k].resize(n);
+  }
+}
+
+void setUnorganized(core::PointCloud& cloud) {
+  cloud.width = cloud.x.size();
   cloud.height = 1;
 }
 
@@ -316,7 +335,7 @@ void skipBinaryElement(BinaryReader& rd, const PlyElement& e) {
 }
 
 void readBinaryVertices(const std::string& path, std::ifstream& in, BinaryReader& rd,
-                        const PlyElement& e, const VertexLayout& lay, core::PointCloud& cloud) {
+                        const PlyElement& e, const VertexLayout& lay, detail::PlyVertices& out) {
   const bool color = lay.hasColor();
   const std::size_t np = e.properties.size();
   if (e.fixedSize()) {
@@ -334,12 +353,12 @@ void readBinaryVertices(const std::string& path, std::ifstream& in, BinaryReader
                                      : 0;
     if (stride > 0 && e.count > avail / stride) {
       throw fileError(path, "truncated PLY: the header declares " + std::to_string(e.count) +
-                                " vertices (" + std::to_string(e.count * stride) +
-                                " bytes) but only " + std::to_string(avail) +
-                                " bytes of data follow");
+                                " vertices of " + std::to_string(stride) + " bytes but only " +
+                                std::to_string(avail) + " bytes of data follow");
     }
     const std::size_t n = static_cast<std::size_t>(e.count);
-    prepareCloud(cloud, n, color);
+    prepareVertices(out, lay, n, color);
+    core::PointCloud& cloud = out.cloud;
     const auto& P = e.properties;
     const bool swap = rd.swap();
     constexpr std::size_t kChunk = 1 << 16;
@@ -358,6 +377,11 @@ void readBinaryVertices(const std::string& path, std::ifstream& in, BinaryReader
           cloud.g[i] = toColor(decode(rec + offset[lay.g], P[lay.g].type, swap), P[lay.g].type);
           cloud.b[i] = toColor(decode(rec + offset[lay.b], P[lay.b].type, swap), P[lay.b].type);
         }
+        for (std::size_t k = 0; k < lay.extra.size(); ++k) {
+          const int p = lay.extra[k];
+          if (p < 0) continue;
+          out.extra[k][i] = static_cast<float>(decode(rec + offset[p], P[p].type, swap));
+        }
       }
     }
     return;
@@ -375,10 +399,9 @@ void readBinaryVertices(const std::string& path, std::ifstream& in, BinaryReader
         v[k] = rd.value(p.type, instanceName(e, i));
       }
     }
-    appendVertex(v, e, lay, color, cloud);
+    appendVertex(v, e, lay, color, out);
   }
-  cloud.width = cloud.x.size();
-  cloud.height = 1;
+  setUnorganized(out.cloud);
 }
 
 // ---- ascii ----
@@ -418,12 +441,12 @@ class AsciiReader {
 };
 
 void readAsciiVertices(const std::string& path, AsciiReader& rd, const PlyElement& e,
-                       const VertexLayout& lay, core::PointCloud& cloud) {
+                       const VertexLayout& lay, detail::PlyVertices& out) {
   const bool color = lay.hasColor();
   const std::size_t np = e.properties.size();
   std::vector<double> v(np, 0.0);
   // Reserve only what a plausible file could hold: the count may be corrupt.
-  cloud.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(e.count, 1u << 20)));
+  out.cloud.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(e.count, 1u << 20)));
   for (std::uint64_t i = 0; i < e.count; ++i) {
     const auto& w = rd.nextLine(instanceName(e, i));
     std::size_t t = 0;
@@ -454,42 +477,67 @@ void readAsciiVertices(const std::string& path, AsciiReader& rd, const PlyElemen
       throw fileError(path, rd.where() + "more values than the " + std::to_string(np) +
                                 " properties of element '" + e.name + "'");
     }
-    appendVertex(v, e, lay, color, cloud);
+    appendVertex(v, e, lay, color, out);
   }
-  cloud.width = cloud.x.size();
-  cloud.height = 1;
+  setUnorganized(out.cloud);
+}
+
+const PlyElement& vertexElement(const std::string& path, const PlyHeader& h) {
+  const auto vertex = std::find_if(h.elements.begin(), h.elements.end(),
+                                   [](const PlyElement& e) { return e.name == "vertex"; });
+  if (vertex == h.elements.end()) throw fileError(path, "PLY has no vertex element");
+  return *vertex;
 }
 
 }  // namespace
 
-core::PointCloud readPly(const std::string& path) {
+namespace detail {
+
+PlyVertices readPlyVertices(const std::string& path, const std::vector<std::string>& extra) {
   detail::requireReadableFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw fileError(path, "cannot open for reading");
   const PlyHeader h = readHeader(path, in);
-
-  const auto vertex = std::find_if(h.elements.begin(), h.elements.end(),
-                                   [](const PlyElement& e) { return e.name == "vertex"; });
-  if (vertex == h.elements.end()) throw fileError(path, "PLY has no vertex element");
-  const VertexLayout lay(*vertex);
+  const PlyElement& vertex = vertexElement(path, h);
+  const VertexLayout lay(vertex, extra);
   if (!lay.hasXyz()) throw fileError(path, "PLY vertex element has no x/y/z properties");
 
-  core::PointCloud cloud;
-  cloud.sensor_origin = h.sensor_origin;
+  PlyVertices out;
+  out.cloud.sensor_origin = h.sensor_origin;
+  out.extra.resize(extra.size());
+  for (std::size_t k = 0; k < extra.size(); ++k) out.has_extra.push_back(lay.extra[k] >= 0);
   if (h.format == PlyFormat::Ascii) {
     AsciiReader rd(path, in, h.lines);
-    for (auto e = h.elements.begin(); e != vertex; ++e) {
+    for (const PlyElement* e = h.elements.data(); e != &vertex; ++e) {
       for (std::uint64_t i = 0; i < e->count; ++i) rd.nextLine(instanceName(*e, i));
     }
-    readAsciiVertices(path, rd, *vertex, lay, cloud);
+    readAsciiVertices(path, rd, vertex, lay, out);
   } else {
     const bool file_le = h.format == PlyFormat::BinaryLittleEndian;
     BinaryReader rd(path, in, file_le != detail::kHostIsLittleEndian);
-    for (auto e = h.elements.begin(); e != vertex; ++e) skipBinaryElement(rd, *e);
-    readBinaryVertices(path, in, rd, *vertex, lay, cloud);
+    for (const PlyElement* e = h.elements.data(); e != &vertex; ++e) skipBinaryElement(rd, *e);
+    readBinaryVertices(path, in, rd, vertex, lay, out);
   }
   // Elements after the vertices (faces) are not needed: a point cloud is the vertices.
-  return cloud;
+  return out;
+}
+
+}  // namespace detail
+
+core::PointCloud readPly(const std::string& path) {
+  return detail::readPlyVertices(path, {}).cloud;
+}
+
+std::vector<std::string> plyVertexProperties(const std::string& path) {
+  detail::requireReadableFile(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw fileError(path, "cannot open for reading");
+  const PlyHeader h = readHeader(path, in);
+  std::vector<std::string> names;
+  for (const PlyProperty& p : vertexElement(path, h).properties) {
+    names.push_back(p.name);
+  }
+  return names;
 }
 
 }  // namespace upd::io

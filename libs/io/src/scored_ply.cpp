@@ -1,9 +1,12 @@
 #include "upd/io/cloud_io.h"
 
+#include "io_detail.h"
 #include "ply_detail.h"
 
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace upd::io {
 
@@ -132,6 +135,38 @@ void writeScoredPly(const std::string& path, const ScoredPoints& p,
     comments.push_back("height " + std::to_string(p.height));
   }
   detail::writeBinaryPly(path, p.size(), cols, comments, !options.organized);
+}
+
+ScoredPly readScoredPly(const std::string& path) {
+  // The order of the columns below; the first six are required, the rest read when present.
+  static const std::vector<std::string> kColumns = {"nx",          "ny",           "nz",
+                                                    "scalar_zeta", "scalar_label", "scalar_cost",
+                                                    "scalar_rx",   "scalar_ry",    "scalar_rz"};
+  detail::PlyVertices v = detail::readPlyVertices(path, kColumns);
+  for (std::size_t k = 0; k < 6; ++k) {
+    if (!v.has_extra[k]) {
+      throw detail::fileError(path, "not a scored PLY: no vertex property '" + kColumns[k] + "'");
+    }
+  }
+  const std::size_t n = v.cloud.size();
+  for (std::size_t k = 6; k < kColumns.size(); ++k) {
+    if (!v.has_extra[k]) v.extra[k].assign(n, std::numeric_limits<float>::quiet_NaN());
+  }
+  ScoredPly out;
+  out.cloud = std::move(v.cloud);
+  std::vector<float>* const dst[] = {&out.nx,   &out.ny, &out.nz, &out.zeta, nullptr,
+                                     &out.cost, &out.rx, &out.ry, &out.rz};
+  for (std::size_t k = 0; k < kColumns.size(); ++k) {
+    if (dst[k]) *dst[k] = std::move(v.extra[k]);
+  }
+  out.label.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float l = v.extra[4][i];
+    out.label[i] = l == 0.f   ? core::Label::Traversable
+                   : l == 1.f ? core::Label::NonTraversable
+                              : core::Label::Unknown;
+  }
+  return out;
 }
 
 void writeScoredPly(const std::string& path, const core::PipelineResult& result,

@@ -46,6 +46,10 @@ Eigen::Isometry3d sensorPoseOnRobot(const mrpt::obs::CObservation& obs) {
 // ---------------------------------------------------------------------------------------------
 // TUM trajectories
 
+namespace {
+constexpr double kMaxPositionM = 1e9;
+}  // namespace
+
 TumTrajectory TumTrajectory::load(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("ground-truth file " + path + ": not found or unreadable");
@@ -82,6 +86,16 @@ TumTrajectory TumTrajectory::parse(std::istream& in, const std::string& name) {
     if (v.size() != 8) fail(std::to_string(v.size()) + " values instead of 8");
     for (double d : v) {
       if (!std::isfinite(d)) fail("a value is not finite");
+    }
+    // Beyond any place on Earth (UTM northings are below 1e7 m): a damaged line, which the maps
+    // would otherwise refuse later without the file's name.
+    for (int k = 1; k <= 3; ++k) {
+      if (std::abs(v[k]) > kMaxPositionM) {
+        std::ostringstream os;
+        os << "position " << "xyz"[k - 1] << " = " << v[k] << " m is farther than "
+           << kMaxPositionM << " m from the origin";
+        fail(os.str());
+      }
     }
     Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     if (std::abs(q.norm() - 1.0) > 1e-2) {

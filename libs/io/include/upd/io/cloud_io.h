@@ -141,6 +141,27 @@ void writeScoredPly(const std::string& path, const core::PipelineResult& result,
 /// The vertex property names writeScoredPly writes, in order (colour not included).
 const std::vector<std::string>& scoredPlyProperties();
 
+/// A scored PLY read back: the cloud (colour and sensor_origin when the file has them) and its
+/// per-point results, one entry per vertex.
+struct ScoredPly {
+  core::PointCloud cloud;
+  std::vector<float> nx, ny, nz;
+  std::vector<float> rx, ry, rz;  ///< NaN for every vertex when the file lacks scalar_rx/ry/rz
+  std::vector<float> zeta, cost;
+  std::vector<core::Label> label;  ///< 0, 1, 2 as written; any other value (NaN, -5, 0.5) Unknown
+};
+
+/// Reads a scored PLY (writeScoredPly's file, or one another tool re-saved: any PLY encoding,
+/// any scalar type per property, other properties and elements skipped) through readPly's
+/// parser. x y z nx ny nz scalar_zeta scalar_label scalar_cost are required: a file without one
+/// throws std::runtime_error naming the file and the property, as readPly does for bad data.
+/// Organized files come back unorganized (width = n, height = 1).
+ScoredPly readScoredPly(const std::string& path);
+
+/// The names of a PLY file's vertex properties, in order (its header checked as readPly checks
+/// it): what tells a scored PLY (scalar_zeta) from a raw cloud.
+std::vector<std::string> plyVertexProperties(const std::string& path);
+
 /// Lower-cased extension of path including the dot (".pcd"), or "" when it has none.
 std::string lowerExtension(const std::string& path);
 
