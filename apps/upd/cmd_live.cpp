@@ -17,6 +17,7 @@
 #include "run_config.h"
 #include "stop_signal.h"
 
+#include "upd/core/version.h"
 #include "upd/io/json_io.h"
 #include "upd/maps/grid_export.h"
 #include "upd/mrpt_bridge/observation_cloud.h"
@@ -124,6 +125,7 @@ void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTa
   maps::writeColourPng(grid, (fs::path(dir) / "map.png").string());
   maps::writeRosMap(grid, (fs::path(dir) / "map").string());
   nlohmann::json j;
+  j["upd_nav_version"] = core::version();
   j["source"] = t.source;
   j["end"] = t.end;
   j["frames"] = t.frames;

@@ -20,6 +20,7 @@
 #include "stop_signal.h"
 
 #include "upd/core/stopwatch.h"
+#include "upd/core/version.h"
 #include "upd/gdal/geotiff.h"
 #include "upd/io/atomic_file.h"
 #include "upd/io/cloud_io.h"
@@ -473,6 +474,7 @@ json summaryJson(const PlaybackOptions& o, const RunConfig& config, Playback& ru
   if (o.rawlogs.size() > 1) summary["rawlogs"] = o.rawlogs;
   if (o.epsg != 0) summary["epsg"] = o.epsg;
   summary["outputs"] = mapFileNames();
+  summary["upd_nav_version"] = core::version();
   return summary;
 }
 

@@ -2,16 +2,36 @@
 // them are caught here and printed as one line, with a non-zero exit code.
 #include "cli.h"
 #include "commands.h"
+#include "upd/core/version.h"
 #include "upd/nav/viewer.h"
+
+#include <Eigen/Core>
+#include <mrpt/system/os.h>
 
 #include <malloc.h>
 
 #include <cstring>
 #include <iostream>
 
+// The optional parts: defined as 1 by CMake where built (apps/upd/CMakeLists.txt), 0 here else.
+#ifndef UPD_HAVE_OPENNI2
+#define UPD_HAVE_OPENNI2 0
+#endif
+#ifndef UPD_HAVE_FREENECT
+#define UPD_HAVE_FREENECT 0
+#endif
+#ifndef UPD_HAVE_ROS1
+#define UPD_HAVE_ROS1 0
+#endif
+#ifndef UPD_HAVE_LEARN
+#define UPD_HAVE_LEARN 0
+#endif
+
 namespace {
 
 using upd::app::Command;
+
+const char* const kBuilt[] = {"no", "yes"};  // by UPD_HAVE_*
 
 const Command kCommands[] = {
     {"analyze", "score a point cloud (.pcd, .ply, .xyz, KITTI .bin) or a depth PNG with the UPD",
@@ -50,9 +70,21 @@ const Command kCommands[] = {
      upd::app::kParamsUsage, upd::app::runParams},
 };
 
+// The release, the libraries it was built against and the optional parts built in: what a bug
+// report needs.
+void printVersion(std::ostream& os) {
+  os << "upd (UPD-Nav) " << upd::core::version() << "\n"
+     << "built with Eigen " << EIGEN_WORLD_VERSION << "." << EIGEN_MAJOR_VERSION << "."
+     << EIGEN_MINOR_VERSION << ", " << mrpt::system::MRPT_getVersion() << "\n"
+     << "optional parts: OpenNI2 " << kBuilt[UPD_HAVE_OPENNI2] << ", libfreenect "
+     << kBuilt[UPD_HAVE_FREENECT] << ", ROS 1 " << kBuilt[UPD_HAVE_ROS1] << ", learned classifier "
+     << kBuilt[UPD_HAVE_LEARN] << "\n";
+}
+
 void printHelp(std::ostream& os) {
   os << "upd: terrain traversability with the Unevenness Point Descriptor (UPD-Nav)\n\n"
-        "usage: upd COMMAND [ARGS...]   (upd COMMAND --help for its options)\n\ncommands:\n";
+        "usage: upd COMMAND [ARGS...]   (upd COMMAND --help for its options; upd --version)\n\n"
+        "commands:\n";
   for (const auto& c : kCommands) os << "  " << c.name << std::string(17 - std::strlen(c.name), ' ') << c.summary << "\n";
 }
 
@@ -69,6 +101,10 @@ int main(int argc, char** argv) {
       !std::strcmp(argv[1], "help")) {
     printHelp(std::cout);
     return argc < 2 ? 2 : 0;
+  }
+  if (!std::strcmp(argv[1], "--version") || !std::strcmp(argv[1], "version")) {
+    printVersion(std::cout);
+    return 0;
   }
   upd::app::registerClassifierLoader();
   const std::string name = argv[1];

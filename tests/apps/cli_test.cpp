@@ -3,6 +3,7 @@
 // non-zero exit, and no output file (not even half of one).
 #include "run_upd.h"
 #include "test_data.h"
+#include "upd/core/version.h"
 #include "upd/io/cloud_io.h"
 #include "upd/mrpt_bridge/robot_config.h"
 
@@ -13,7 +14,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
+#include <regex>
 #include <sys/wait.h>
 #include <utility>
 
@@ -52,6 +55,40 @@ TEST_F(Cli, HelpListsTheCommands) {
   const CmdResult a = runUpd("analyze --help");
   EXPECT_EQ(a.exit_code, 0);
   EXPECT_NE(a.output.find("--radius-m"), std::string::npos);
+}
+
+// The release CMake's project() names, what `upd --version` and every summary report.
+std::string projectVersion() {
+  std::ifstream in(std::string(UPD_SOURCE_DIR) + "/CMakeLists.txt");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::smatch m;
+  std::regex_search(text, m, std::regex(R"(project\(upd_nav VERSION ([0-9.]+))"));
+  return m.size() > 1 ? m[1].str() : "(no project version in CMakeLists.txt)";
+}
+
+TEST_F(Cli, VersionNamesTheReleaseAndWhatItWasBuiltWith) {
+  const std::string v = projectVersion();
+  EXPECT_EQ(core::version(), v);
+  for (const char* arg : {"--version", "version"}) {
+    const CmdResult r = runUpd(arg);
+    EXPECT_EQ(r.exit_code, 0) << arg;
+    EXPECT_NE(r.output.find("upd (UPD-Nav) " + v + "\n"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("MRPT 2."), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("optional parts: OpenNI2 "), std::string::npos) << r.output;
+  }
+  // The scored cloud's stats name the release that made them, as its PLY header does.
+  const std::string ply = path("ramp.ply"), json_path = path("ramp.json");
+  ASSERT_EQ(runUpd("scene ramp --spacing-m 0.05 --output " + ply).exit_code, 0);
+  ASSERT_EQ(runUpd("analyze " + ply + " --output " + path("out.ply") + " --stats-json " +
+                   json_path).exit_code,
+            0);
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(json_path))["upd_nav_version"], v);
+  std::ifstream scored(path("out.ply"));
+  std::string line;
+  std::getline(scored, line);
+  std::getline(scored, line);
+  std::getline(scored, line);
+  EXPECT_EQ(line, "comment UPD-Nav " + v);
 }
 
 TEST_F(Cli, EveryGeneratedSceneIsAnalysed) {

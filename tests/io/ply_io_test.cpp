@@ -1,6 +1,7 @@
 // PLY reader and writers: binary round trips, hand-made ascii and big-endian files with elements
 // and list properties to skip, the scored PLY's exact header and body, and clean failures.
 #include "io_test_util.h"
+#include "upd/core/version.h"
 #include "upd/io/cloud_io.h"
 
 #include <gtest/gtest.h>
@@ -27,6 +28,9 @@ using upd::core::PointCloud;
 
 /// A fresh directory per test, removed afterwards.
 using upd::test::TempDir;
+
+// The first comment of every PLY the project writes: the release that wrote it.
+const std::string kMadeBy = std::string("comment UPD-Nav ") + upd::core::version();
 
 void writeBytes(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
@@ -157,7 +161,7 @@ TEST(PlyIo, BinaryRoundTripWithColourAndLabels) {
   std::size_t body = 0;
   const auto h = headerLines(bytes, &body);
   const std::vector<std::string> expected = {
-      "ply",           "format binary_little_endian 1.0", "comment UPD-Nav",
+      "ply",           "format binary_little_endian 1.0", kMadeBy,
       "element vertex 777", "property float x",           "property float y",
       "property float z",   "property uchar label",       "property uchar red",
       "property uchar green", "property uchar blue",      "end_header"};
@@ -453,7 +457,7 @@ TEST(ScoredPly, HeaderListsExactlyThePropertiesInOrder) {
   const std::vector<std::string> expected = {
       "ply",
       "format binary_little_endian 1.0",
-      "comment UPD-Nav",
+      kMadeBy,
       "element vertex 4",
       "property float x",
       "property float y",
@@ -579,7 +583,7 @@ TEST(ScoredPly, OrganizedKeepsEveryPixelWithWidthAndHeight) {
   const std::string bytes = readBytes(f);
   std::size_t body = 0;
   const auto h = headerLines(bytes, &body);
-  EXPECT_EQ(h[2], "comment UPD-Nav");
+  EXPECT_EQ(h[2], kMadeBy);
   EXPECT_EQ(h[3], "comment width 3");
   EXPECT_EQ(h[4], "comment height 2");
   EXPECT_EQ(h[5], "element vertex 6");

@@ -1,4 +1,5 @@
 #include "upd/io/json_io.h"
+#include "upd/core/version.h"
 
 #include "upd/io/atomic_file.h"
 
@@ -204,6 +205,7 @@ json summaryJson(const core::PipelineResult& result, const core::PipelineParams&
   j["preprocess"] = preprocessJson(result.preprocess_stats);
   j["normals_invalid"] = result.normals.invalid;
   j["params"] = paramsJson(params);
+  j["upd_nav_version"] = core::version();
   return j;
 }
 

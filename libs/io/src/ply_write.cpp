@@ -2,6 +2,7 @@
 // writePly and the scored PLY. Written through a temporary file, so a failed write leaves none.
 #include "upd/io/atomic_file.h"
 #include "upd/io/cloud_io.h"
+#include "upd/core/version.h"
 
 #include "io_detail.h"
 #include "ply_detail.h"
@@ -34,7 +35,8 @@ void writeBinaryPly(const std::string& path, std::size_t n, const std::vector<Pl
   std::size_t kept = 0;
   for (std::size_t i = 0; i < n; ++i) kept += keep(i) ? 1 : 0;
 
-  std::string header = "ply\nformat binary_little_endian 1.0\ncomment UPD-Nav\n";
+  std::string header = "ply\nformat binary_little_endian 1.0\ncomment UPD-Nav " +
+                       std::string(core::version()) + "\n";
   for (std::string c : comments) {
     std::replace(c.begin(), c.end(), '\n', ' ');
     std::replace(c.begin(), c.end(), '\r', ' ');

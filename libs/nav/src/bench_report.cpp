@@ -2,6 +2,7 @@
 // summary.json, and the comparison of a run with the expected rows (upd/nav/bench.h).
 #include "upd/nav/bench.h"
 
+#include "upd/core/version.h"
 #include "upd/io/atomic_file.h"
 
 #include <algorithm>
@@ -55,6 +56,7 @@ nlohmann::json benchSummary(const std::vector<BenchRow>& rows) {
     if (r.cause != FailureCause::None) ++causes[toString(r.cause)];
   }
   nlohmann::json j;
+  j["upd_nav_version"] = core::version();
   j["worlds"] = rows.size();
   if (!rows.empty()) {
     j["difficulty"] = rows.front().difficulty;

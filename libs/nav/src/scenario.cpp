@@ -1,6 +1,7 @@
 #include "upd/nav/scenario.h"
 
 #include "upd/core/stopwatch.h"
+#include "upd/core/version.h"
 #include "upd/io/atomic_file.h"
 #include "upd/io/json_io.h"
 #include "upd/maps/grid_export.h"
@@ -202,6 +203,7 @@ ScenarioResult runScenario(const sim::WorldSpec& world, const std::string& name,
 
 nlohmann::json summaryJson(const ScenarioResult& r) {
   nlohmann::json j;
+  j["upd_nav_version"] = core::version();
   j["scenario"] = r.scenario;
   j["obstacles"] = r.perception.empty() ? std::string(toString(r.detector)) : r.perception;
   j["reached"] = r.reached;
