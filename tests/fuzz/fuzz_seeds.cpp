@@ -3,9 +3,9 @@
 // spacing as raw floats, and for the rawlog reader what the recorded rawlogs lack: a stream of
 // actions (scan matching with each pose distribution, a 3D movement) and one of the other
 // sensors a robot records beside its depth camera (IMU, odometry, GNSS, point clouds, range
-// finders, JPEG camera images); with ROS 1, small bags (uncompressed, BZ2 and LZ4 chunks) of
-// depth frames and point clouds with their transforms. scripts/fuzz.sh adds the seeds taken from
-// ../shared/data.
+// finders, JPEG camera images, a 360-degree RGB-D rig); with ROS 1, small bags (uncompressed,
+// BZ2 and LZ4 chunks) of depth frames and point clouds with their transforms. scripts/fuzz.sh
+// adds the seeds taken from ../shared/data.
 //   fuzz_seeds OUTDIR   ->  OUTDIR/{pcd,ply,xyz,kitti_bin,pipeline,rawlog,bag}/...
 #include "io/cloud_samples.h"
 
@@ -27,6 +27,7 @@
 #include <mrpt/obs/CObservationImage.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationRGBD360.h>
 #include <mrpt/obs/CObservationRange.h>
 #include <mrpt/obs/CObservationRotatingScan.h>
 #include <mrpt/obs/CObservationVelodyneScan.h>
@@ -234,8 +235,12 @@ void putSensorsRawlog(const fs::path& dir) {
   battery->voltageOtherBatteries[0] = 12.0;
   battery->voltageOtherBatteries[1] = 12.1;
   battery->voltageOtherBatteriesValid.assign(2, true);
-  const mrpt::obs::CObservation::Ptr all[] = {imu,   odometry, gps,   plain,    colour,  range,
-                                              camera, depth,   lidar, rotating, battery};
+  auto rig = mrpt::obs::CObservationRGBD360::Create();
+  rig->hasRangeImage = rig->hasIntensityImage = true;
+  for (auto& r : rig->rangeImages) r.setConstant(6, 8, 1200);
+  for (auto& image : rig->intensityImages) image = gradient(8, 6);
+  const mrpt::obs::CObservation::Ptr all[] = {imu,    odometry, gps,   plain,    colour,  range,
+                                              camera, depth,    lidar, rotating, battery, rig};
   mrpt::obs::CSensoryFrame frame;
   for (const auto& o : all) frame.insert(o);
   mrpt::io::CFileOutputStream out((dir / "sensors.rawlog").string());

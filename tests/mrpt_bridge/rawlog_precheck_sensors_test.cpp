@@ -15,6 +15,7 @@
 #include <mrpt/obs/gnss_messages.h>
 #include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CObservationRGBD360.h>
 #include <mrpt/obs/CObservationRange.h>
 #include <mrpt/obs/CObservationVelodyneScan.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -228,6 +229,46 @@ TEST(RawlogPrecheck, VelodyneScanCountsAreBounded) {
     EXPECT_EQ(damageReason(tmp, std::string(good).replace(k.at, 4, u32(k.corrupt)), &before),
               "corrupt CObservationVelodyneScan: " + k.field + " at byte " +
                   std::to_string(before + k.at) + " (more than " + k.bound + ")");
+  }
+}
+
+// A CObservationRGBD360 keeps its cameras' range images in MRPT's aligned matrices, sized from
+// the rows and columns before the pixels (a corrupt size can end the process there): each
+// camera's sides are bounded as an image's.
+TEST(RawlogPrecheck, Rgbd360RangeImageSizesAreBounded) {
+  TempDir tmp;
+  mrpt::obs::CObservationRGBD360 rig;
+  rig.hasRangeImage = true;
+  rig.rangeImages[0].setZero(31, 41);
+  rig.rangeImages[1].setZero(23, 19);
+  rig.hasIntensityImage = true;
+  for (auto& image : rig.intensityImages) {
+    image.resize(12, 10, mrpt::img::CH_GRAY);
+    image.filledRectangle(0, 0, 11, 9, mrpt::img::TColor(0, 0, 0));
+  }
+  rig.sensorLabel = "RIG360";
+  const std::string good = serialized(rig);
+  std::string why;
+  EXPECT_EQ(walked(good, &why), good.size()) << why;
+  std::size_t before = 0;
+  EXPECT_EQ(damageReason(tmp, good, &before), "(read)");
+  const std::size_t first = good.find(u32(31) + u32(41)), second = good.find(u32(23) + u32(19));
+  ASSERT_NE(first, std::string::npos);
+  ASSERT_NE(second, std::string::npos);
+  const struct {
+    std::size_t at;
+    std::string corrupt, field, bound;
+    std::size_t named_at;
+  } cases[] = {
+      {first, u32(70000), "range image rows 70000", "65535 rows", first},
+      {second + 4, u32(0xFFFFFFFFu), "range image columns 4294967295", "65535 columns", second + 4},
+      {second, u32(60000) + u32(60000), "range image pixels 3600000000", "16777216 pixels", second},
+  };
+  for (const auto& k : cases) {
+    EXPECT_EQ(damageReason(tmp, std::string(good).replace(k.at, k.corrupt.size(), k.corrupt),
+                           &before),
+              "corrupt CObservationRGBD360: " + k.field + " at byte " +
+                  std::to_string(before + k.named_at) + " (more than " + k.bound + ")");
   }
 }
 

@@ -147,6 +147,13 @@ Parse checkRotatingScan(Cursor& c, int version, std::string& why);
 /// A CObservationBatteryState's body (version 2; any other is OtherLayout), after its header.
 Parse checkBatteryState(Cursor& c, int version, std::string& why);
 
+/// A CObservationRGBD360's body (version 1; any other is OtherLayout), after its header.
+Parse checkRgbd360(Cursor& c, int version, std::string& why);
+
+/// The flags and file names of points and range images stored outside the rawlog, which a
+/// CObservation3DRangeScan (from version 3) and a CObservationRGBD360 end with.
+Parse checkExternalFiles(Cursor& c, std::string& why);
+
 /// The `count` messages of a CObservationGPS (its messages follow its message count).
 Parse checkGnssMessages(Cursor& c, std::uint32_t count, std::string& why);
 

@@ -364,15 +364,7 @@ Parse scan3D(Cursor& c, int version, std::string& why) {
   if (p != kRead) return p;
   c.skip(sizeof(float) + sizeof(std::uint64_t));  // stdError, timestamp
   if ((p = string(c, "sensor label length", why)) != kRead) return p;
-  if (version >= 3) {
-    for (const auto& [flag, field] :
-         {std::pair{"points stored externally", "external points file name length"},
-          std::pair{"range stored externally", "external range file name length"}}) {
-      std::uint8_t external = 0;
-      if ((p = checkFlag(c, flag, external, why)) != kRead) return p;
-      if ((p = string(c, field, why)) != kRead) return p;
-    }
-  }
+  if (version >= 3 && (p = checkExternalFiles(c, why)) != kRead) return p;
   std::uint8_t range_is_depth = 0;
   if (version >= 5 && (p = checkFlag(c, "range is depth", range_is_depth, why)) != kRead) {
     return p;
@@ -585,7 +577,8 @@ Parse checkObservation(Cursor& c, const ObjectHeader& h, std::string& why) {
                 {"CObservationIMU", imu},             {"CObservationOdometry", odometry},
                 {"CObservationVelodyneScan", checkVelodyneScan},
                 {"CObservationRotatingScan", checkRotatingScan},
-                {"CObservationBatteryState", checkBatteryState}};
+                {"CObservationBatteryState", checkBatteryState},
+                {"CObservationRGBD360", checkRgbd360}};
   for (const auto& w : kWalks) {
     if (h.class_name != w.name) continue;
     const Parse p = w.walk(c, h.version, why);
