@@ -114,7 +114,7 @@ void sumPointsWithin(const CellPoints& p, const std::uint32_t* begin, const std:
       for (int l = 0; l < kLanes; ++l) {
         const std::size_t j = j0 + static_cast<std::size_t>(l);
         const float dx = x[j] - X, dy = y[j] - Y, dz = z[j] - Z;
-        const float w = (dx * dx + dy * dy + dz * dz <= r2) & (l < valid) ? 1.f : 0.f;
+        const float w = ((dx * dx + dy * dy + dz * dz <= r2) & (l < valid)) ? 1.f : 0.f;
         a[0][l] += w * nx[j];
         a[1][l] += w * ny[j];
         a[2][l] += w * nz[j];

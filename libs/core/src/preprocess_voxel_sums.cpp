@@ -183,8 +183,8 @@ void prepareMap(VoxelScratch& s) {
 class VoxelPass {
  public:
   VoxelPass(VoxelScratch& s, const PointCloud& in, const Eigen::Vector3d& ref,
-            const KeyPassParams& k, double voxel_m)
-      : s_(s), in_(in), ref_(ref), voxel_m_(voxel_m), k_(k) {}
+            const KeyPassParams& k)
+      : s_(s), in_(in), ref_(ref), k_(k) {}
 
   // Points [b, e) of one row: their keys, then their sums (of an organized cloud: keys holds
   // the row's voxel keys and ids for the next row, above the previous row's; else all null).
@@ -281,7 +281,6 @@ class VoxelPass {
   VoxelScratch& s_;
   const PointCloud& in_;
   Eigen::Vector3d ref_;
-  double voxel_m_;
   KeyPassParams k_;
   std::uint64_t last_key_ = kNoKey;
   std::uint32_t last_id_ = 0;
@@ -315,7 +314,7 @@ UPD_NOIPA CropCounts voxelizeWith(VoxelScratch& s, const PointCloud& in, const S
   const std::size_t first = st.first;
   const Eigen::Vector3d& ref = st.ref;
   prepareMap(s);
-  VoxelPass pass(s, in, ref, st.k, st.voxel_m);
+  VoxelPass pass(s, in, ref, st.k);
   if (!in.isOrganized()) {
     constexpr std::size_t kChunk = 4096;  // (the keys of a chunk stay in the cache)
     for (std::size_t b = first; b < in.size(); b += kChunk) {
@@ -491,7 +490,7 @@ std::size_t sumTeamVoxels(VoxelScratch& s, const Team& t, int team, int me, std:
 #pragma omp barrier
 #pragma omp single
   splitRows(t, team);
-  VoxelPass pass(s, t.in, t.st.ref, t.st.k, t.st.voxel_m);
+  VoxelPass pass(s, t.in, t.st.ref, t.st.k);
   sumShare(s, pass, t, t.starts[me], t.starts[me + 1]);
   t.scratch[me] = &s;
   t.voxels[me] = pass.voxels();
