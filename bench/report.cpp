@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "upd/core/stopwatch.h"
+#include "upd/core/version.h"
 
 namespace core = upd::core;
 
@@ -134,9 +135,11 @@ void describeMachine(Report& report, double bandwidth) {
                             {"logical_cpus", omp_get_num_procs()},
                             {"copy_bandwidth_GBps", bandwidth},
                             {"compiler", __VERSION__},
-                            {"omp_wait_policy", policy}};
-  std::printf("machine: %s, %d logical CPUs, copy bandwidth %.1f GB/s, OMP_WAIT_POLICY %s\n",
-              cpuModel().c_str(), omp_get_num_procs(), bandwidth, policy.c_str());
+                            {"omp_wait_policy", policy},
+                            {"upd_nav_version", core::version()}};
+  std::printf("machine: %s, %d logical CPUs, copy bandwidth %.1f GB/s, OMP_WAIT_POLICY %s; "
+              "UPD-Nav %s\n",
+              cpuModel().c_str(), omp_get_num_procs(), bandwidth, policy.c_str(), core::version());
 }
 
 int finish(Report& report, const Options& o, double bandwidth) {
