@@ -72,6 +72,14 @@ void requireContentMatchesExtension(const std::string& path, const std::string& 
 
 }  // namespace
 
+std::uint64_t bytesLeft(std::istream& in) {
+  const std::streamoff start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamoff end = in.tellg();
+  in.seekg(start);
+  return start < 0 || end < start ? 0 : static_cast<std::uint64_t>(end - start);
+}
+
 }  // namespace detail
 
 std::string lowerExtension(const std::string& path) {
@@ -79,14 +87,6 @@ std::string lowerExtension(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
-}
-
-std::uint64_t bytesLeft(std::istream& in) {
-  const std::streamoff start = in.tellg();
-  in.seekg(0, std::ios::end);
-  const std::streamoff end = in.tellg();
-  in.seekg(start);
-  return start < 0 || end < start ? 0 : static_cast<std::uint64_t>(end - start);
 }
 
 core::PointCloud readCloud(const std::string& path) {

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <istream>
 #include <stdexcept>
 #include <string>
 
@@ -16,6 +17,10 @@ inline std::runtime_error fileError(const std::string& path, const std::string& 
 
 /// Throws fileError unless path names an existing regular file.
 void requireReadableFile(const std::string& path);
+
+/// The bytes from the stream's position to its end, the position kept (0 when the stream cannot
+/// tell): what a header's count is checked against before anything is allocated for it.
+std::uint64_t bytesLeft(std::istream& in);
 
 /// What the first bytes of a file (head) say it is: "a PLY file", "a PCD file",
 /// "gzip-compressed data", "text", or "" when none of these (binary data of no known kind).

@@ -12,7 +12,6 @@
 #include <cstdlib>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -346,11 +345,7 @@ void readBinaryVertices(const std::string& path, std::ifstream& in, BinaryReader
       stride += typeSize(e.properties[i].type);
     }
     // Check the declared count against what the file holds before allocating for it.
-    const std::streamoff here = in.tellg();
-    const std::uintmax_t file_size = std::filesystem::file_size(path);
-    const std::uintmax_t avail = file_size > static_cast<std::uintmax_t>(here)
-                                     ? file_size - static_cast<std::uintmax_t>(here)
-                                     : 0;
+    const std::uint64_t avail = detail::bytesLeft(in);
     if (stride > 0 && e.count > avail / stride) {
       throw fileError(path, "truncated PLY: the header declares " + std::to_string(e.count) +
                                 " vertices of " + std::to_string(stride) + " bytes but only " +
@@ -482,6 +477,14 @@ void readAsciiVertices(const std::string& path, AsciiReader& rd, const PlyElemen
   setUnorganized(out.cloud);
 }
 
+// Opens path into in and reads its header: the stream is left at the first element's data.
+PlyHeader openHeader(const std::string& path, std::ifstream& in) {
+  detail::requireReadableFile(path);
+  in.open(path, std::ios::binary);
+  if (!in) throw fileError(path, "cannot open for reading");
+  return readHeader(path, in);
+}
+
 const PlyElement& vertexElement(const std::string& path, const PlyHeader& h) {
   const auto vertex = std::find_if(h.elements.begin(), h.elements.end(),
                                    [](const PlyElement& e) { return e.name == "vertex"; });
@@ -494,10 +497,8 @@ const PlyElement& vertexElement(const std::string& path, const PlyHeader& h) {
 namespace detail {
 
 PlyVertices readPlyVertices(const std::string& path, const std::vector<std::string>& extra) {
-  detail::requireReadableFile(path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw fileError(path, "cannot open for reading");
-  const PlyHeader h = readHeader(path, in);
+  std::ifstream in;
+  const PlyHeader h = openHeader(path, in);
   const PlyElement& vertex = vertexElement(path, h);
   const VertexLayout lay(vertex, extra);
   if (!lay.hasXyz()) throw fileError(path, "PLY vertex element has no x/y/z properties");
@@ -529,10 +530,8 @@ core::PointCloud readPly(const std::string& path) {
 }
 
 std::vector<std::string> plyVertexProperties(const std::string& path) {
-  detail::requireReadableFile(path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw fileError(path, "cannot open for reading");
-  const PlyHeader h = readHeader(path, in);
+  std::ifstream in;
+  const PlyHeader h = openHeader(path, in);
   std::vector<std::string> names;
   for (const PlyProperty& p : vertexElement(path, h).properties) {
     names.push_back(p.name);

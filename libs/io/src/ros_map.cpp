@@ -1,7 +1,8 @@
 #include "upd/io/ros_map.h"
 
 #include "upd/io/atomic_file.h"
-#include "upd/io/cloud_io.h"
+
+#include "io_detail.h"
 
 #include <algorithm>
 #include <cmath>
@@ -165,7 +166,7 @@ RosMap readRosMap(const std::string& yaml_path) {
   }
   pgm.get();
   // The pixels must be in the file before they are allocated (a damaged header's size).
-  const std::uint64_t bytes = bytesLeft(pgm);
+  const std::uint64_t bytes = detail::bytesLeft(pgm);
   const std::size_t cells = static_cast<std::size_t>(map.width) * map.height;
   if (cells > bytes) {
     throw std::runtime_error("ROS map " + pgm_path.string() + ": truncated (" +

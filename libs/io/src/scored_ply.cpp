@@ -138,7 +138,7 @@ void writeScoredPly(const std::string& path, const ScoredPoints& p,
 }
 
 ScoredPly readScoredPly(const std::string& path) {
-  // The order of the columns below; the first six are required, the rest read when present.
+  // The columns read beside the cloud: the first six are required, r is read when present.
   static const std::vector<std::string> kColumns = {"nx",          "ny",           "nz",
                                                     "scalar_zeta", "scalar_label", "scalar_cost",
                                                     "scalar_rx",   "scalar_ry",    "scalar_rz"};
@@ -154,11 +154,14 @@ ScoredPly readScoredPly(const std::string& path) {
   }
   ScoredPly out;
   out.cloud = std::move(v.cloud);
-  std::vector<float>* const dst[] = {&out.nx,   &out.ny, &out.nz, &out.zeta, nullptr,
-                                     &out.cost, &out.rx, &out.ry, &out.rz};
-  for (std::size_t k = 0; k < kColumns.size(); ++k) {
-    if (dst[k]) *dst[k] = std::move(v.extra[k]);
-  }
+  out.nx = std::move(v.extra[0]);
+  out.ny = std::move(v.extra[1]);
+  out.nz = std::move(v.extra[2]);
+  out.zeta = std::move(v.extra[3]);
+  out.cost = std::move(v.extra[5]);
+  out.rx = std::move(v.extra[6]);
+  out.ry = std::move(v.extra[7]);
+  out.rz = std::move(v.extra[8]);
   out.label.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const float l = v.extra[4][i];

@@ -165,8 +165,4 @@ std::vector<std::string> plyVertexProperties(const std::string& path);
 /// Lower-cased extension of path including the dot (".pcd"), or "" when it has none.
 std::string lowerExtension(const std::string& path);
 
-/// The bytes from the stream's position to its end, the position kept (0 when the stream cannot
-/// tell): what a header's count is checked against before anything is allocated for it.
-std::uint64_t bytesLeft(std::istream& in);
-
 }  // namespace upd::io
