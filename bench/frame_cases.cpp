@@ -32,18 +32,20 @@ json frameTimingCase(const Frame& fr, const Options& o, Report& report, core::Pi
   c["two_core_stages"] = t2.stages;
   c["two_core_speedup"] = num(t1.total_ms / t2.total_ms);
   c["machine_two_core_speedup"] = num(probe.speedup());
+  c["machine_core_round_trip_ns"] = num(probe.roundTripNs());
   c["normals_method"] = result.organized_normals ? "image-window scans" : "hash grid";
   // UpdParams::fast_cells_per_point: the lattice's cells per d_m on this frame.
   c["lattice_cells_per_radius"] = result.fast_cells_per_radius;
   report.target(fr.name + ": frame pipeline, one core (median)", t1.total_ms, kFrameBudgetMs,
                 true, "ms");
   report.target(fr.name + ": second core speedup", t1.total_ms / t2.total_ms, kMinTwoCoreSpeedup,
-                false, "x", machineNote(probe.speedup()));
+                false, "x", machineNote(probe.speedup(), probe.roundTripNs()));
   std::printf(
-      "%-30s %7zu px %7zu scored  one core %7.2f ms  two cores %7.2f ms (x%.2f; machine x%.2f)  "
+      "%-30s %7zu px %7zu scored  one core %7.2f ms  two cores %7.2f ms (x%.2f; machine x%.2f, "
+      "%.0f ns)  "
       "[normals %.2f, UPD %.2f, labels %.2f, map %.2f ms]\n",
       fr.name.c_str(), t1.points, t1.scored, t1.total_ms, t2.total_ms, t1.total_ms / t2.total_ms,
-      probe.speedup(), t1.stages["normals_ms"].get<double>(), t1.stages["upd_ms"].get<double>(),
+      probe.speedup(), probe.roundTripNs(), t1.stages["normals_ms"].get<double>(), t1.stages["upd_ms"].get<double>(),
       t1.stages["classify_ms"].get<double>(), t1.stages["map_update_ms"].get<double>());
   std::fflush(stdout);
   return c;

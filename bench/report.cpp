@@ -4,6 +4,8 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -93,6 +95,46 @@ double timeProbe() {
   return ms;
 }
 
+// The mean round trip of a cache line between the two threads of a team [ns]: thread 0 writes
+// an odd number, thread 1 answers with the next even one, kTrips times. NaN when the team is not
+// two threads, or when the answers do not come within kMaxMs (the two threads on one CPU, each
+// answer waiting for the other's time slice).
+double timeRoundTripNs() {
+  constexpr int kTrips = 4000;
+  constexpr double kMaxMs = 20;
+  alignas(64) std::atomic<int> line{0};
+  alignas(64) std::atomic<bool> give_up{false};
+  double ns = kNaN;
+#pragma omp parallel num_threads(2)
+  {
+    if (omp_get_num_threads() == 2) {
+#pragma omp barrier
+      if (omp_get_thread_num() == 0) {
+        const core::Stopwatch watch;
+        int i = 0;
+        for (; i < kTrips && !give_up.load(std::memory_order_relaxed); ++i) {
+          line.store(2 * i + 1, std::memory_order_release);
+          while (line.load(std::memory_order_acquire) != 2 * i + 2) {
+            if (watch.elapsedMs() > kMaxMs) {
+              give_up.store(true, std::memory_order_relaxed);
+              break;
+            }
+          }
+        }
+        if (!give_up.load()) ns = watch.elapsedMs() * 1e6 / kTrips;
+      } else {
+        for (int i = 0; i < kTrips && !give_up.load(std::memory_order_relaxed); ++i) {
+          while (line.load(std::memory_order_acquire) != 2 * i + 1) {
+            if (give_up.load(std::memory_order_relaxed)) break;
+          }
+          line.store(2 * i + 2, std::memory_order_release);
+        }
+      }
+    }
+  }
+  return ns;
+}
+
 }  // namespace
 
 void CoreProbe::sample() {
@@ -100,13 +142,18 @@ void CoreProbe::sample() {
   one_ms_.push_back(timeProbe());
   omp_set_num_threads(2);
   two_ms_.push_back(timeProbe());
+  const double trip = timeRoundTripNs();
+  if (std::isfinite(trip)) trip_ns_.push_back(trip);
 }
 
 double CoreProbe::speedup() const { return median(one_ms_) / median(two_ms_); }
 
-std::string machineNote(double s) {
-  char text[32];
-  std::snprintf(text, sizeof text, "(machine x%.2f)", s);
+double CoreProbe::roundTripNs() const { return median(trip_ns_); }
+
+std::string machineNote(double s, double trip_ns) {
+  char text[64];
+  std::snprintf(text, sizeof text, "(machine x%.2f, a line between the cores %.0f ns)", s,
+                trip_ns);
   return text;
 }
 

@@ -79,8 +79,9 @@ double peakRssMb();
 /// Sustained copy bandwidth of this machine [GB/s] (read + write counted), for the floor.
 double copyBandwidthGBs();
 
-/// "machine xS": CoreProbe's speedup s, for a target's note.
-std::string machineNote(double s);
+/// "(machine xS, a line between the cores T ns)": CoreProbe's speedup s and round trip t, for a
+/// target's note.
+std::string machineNote(double s, double trip_ns);
 
 /// What this machine's second core gives at the moment, as a peer for the pipelines' second
 /// core: work of compute alone (independent multiply-adds, no memory, no serial part) in 24
@@ -89,15 +90,25 @@ std::string machineNote(double s);
 /// shared (a VM's vCPU whose sibling or host is busy), a region waits for the slower thread
 /// and the probe falls below 2 with the pipelines; the two read together tell the code's
 /// scaling from the machine's.
+///
+/// Beside it, the round trip of a cache line between the two threads (one writes, the other
+/// answers, a few thousand times): what every hand-over of data between the cores costs. On a
+/// VM the host places the two vCPUs near each other (a shared L3: ~80 ns on an AMD EPYC VM) or
+/// apart (~340 ns on the same VM a minute later), and a pipeline whose stages read what the
+/// other thread wrote gains less from its second core when they are apart, where the compute
+/// probe does not move.
 class CoreProbe {
  public:
-  /// One run on one thread and one on two.
+  /// One run on one thread and one on two, and a round trip.
   void sample();
   /// median(one thread) / median(two threads); NaN before the first sample.
   double speedup() const;
+  /// The median round trip of a cache line between the two threads [ns]; NaN before the first
+  /// sample, or when the two threads shared one CPU (no answer within a few milliseconds).
+  double roundTripNs() const;
 
  private:
-  std::vector<double> one_ms_, two_ms_;
+  std::vector<double> one_ms_, two_ms_, trip_ns_;
 };
 
 /// The machine, the compiler and the OpenMP wait policy: printed and stored under "machine".
