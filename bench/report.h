@@ -93,7 +93,7 @@ std::string machineNote(double s, double trip_ns);
 ///
 /// Beside it, the round trip of a cache line between the two threads (one writes, the other
 /// answers, a few thousand times): what every hand-over of data between the cores costs. On a
-/// VM the host places the two vCPUs near each other (a shared L3: ~80 ns on an AMD EPYC VM) or
+/// VM the host places the two vCPUs near each other (~80 ns on an AMD EPYC VM, as within one L3) or
 /// apart (~340 ns on the same VM a minute later), and a pipeline whose stages read what the
 /// other thread wrote gains less from its second core when they are apart, where the compute
 /// probe does not move.
