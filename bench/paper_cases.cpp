@@ -123,12 +123,14 @@ json paperCase(const Frame& fr, const Options& o, Report& report) {
   report.target(fr.name + ": paper pipeline, pre-processing share", pre / t.one_ms,
                 kMaxPreprocessShare, true, "");
   report.target(fr.name + ": paper pipeline, second core", t.one_ms / t.two_ms,
-                kMinPipelineTwoCoreSpeedup, false, "x", machineNote(t.machine_speedup, t.machine_trip_ns));
+                kMinPipelineTwoCoreSpeedup, false, "x",
+                machineNote(t.machine_speedup, t.machine_trip_ns));
   std::printf(
       "%-30s %7zu scored  ours %7.2f ms [pre %.2f, normals %.2f, UPD %.2f]  two cores %6.2f ms "
       "(x%.2f; machine x%.2f, %.0f ns)  PCL %8.1f ms",
       fr.name.c_str(), t.scored, t.one_ms, pre, t.stages["normals_ms"].get<double>(),
-      t.stages["upd_ms"].get<double>(), t.two_ms, t.one_ms / t.two_ms, t.machine_speedup, t.machine_trip_ns, pcl_ms);
+      t.stages["upd_ms"].get<double>(), t.two_ms, t.one_ms / t.two_ms, t.machine_speedup,
+      t.machine_trip_ns, pcl_ms);
   if (std::isfinite(pcl_ms)) {
     const json& q = c["pcl"];
     std::printf(" [voxel %.1f, SOR %.1f, normals %.1f, UPD %.1f]  PCL/ours %.0fx",

@@ -93,10 +93,10 @@ std::string machineNote(double s, double trip_ns);
 ///
 /// Beside it, the round trip of a cache line between the two threads (one writes, the other
 /// answers, a few thousand times): what every hand-over of data between the cores costs. On a
-/// VM the host places the two vCPUs near each other (~80 ns on an AMD EPYC VM, as within one L3) or
-/// apart (~340 ns on the same VM a minute later), and a pipeline whose stages read what the
-/// other thread wrote gains less from its second core when they are apart, where the compute
-/// probe does not move.
+/// VM the host places the two vCPUs near each other (~80 ns on an AMD EPYC VM, as within one
+/// L3) or apart (~340 ns on the same VM a minute later), and a pipeline whose stages read what
+/// the other thread wrote gains less from its second core when they are apart, where the
+/// compute probe does not move.
 class CoreProbe {
  public:
   /// One run on one thread and one on two, and a round trip.
