@@ -45,7 +45,8 @@ json frameTimingCase(const Frame& fr, const Options& o, Report& report, core::Pi
       "%.0f ns)  "
       "[normals %.2f, UPD %.2f, labels %.2f, map %.2f ms]\n",
       fr.name.c_str(), t1.points, t1.scored, t1.total_ms, t2.total_ms, t1.total_ms / t2.total_ms,
-      probe.speedup(), probe.roundTripNs(), t1.stages["normals_ms"].get<double>(), t1.stages["upd_ms"].get<double>(),
+      probe.speedup(), probe.roundTripNs(), t1.stages["normals_ms"].get<double>(),
+      t1.stages["upd_ms"].get<double>(),
       t1.stages["classify_ms"].get<double>(), t1.stages["map_update_ms"].get<double>());
   std::fflush(stdout);
   return c;
