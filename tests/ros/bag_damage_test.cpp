@@ -120,6 +120,8 @@ TEST_P(BagDamage, FlippedBytesEndInFramesOrOneErrorNamingTheFile) {
 // rosbag reads the first line with fgets and sscanf("#ROS%s V%d.%d") into a 100-byte word: a
 // line that goes on after "#ROSBAG V2.0" is still a bag of format 2.0 to it (its file header then
 // starts later: garbage lengths), a longer word overflows its buffer, and 1.2 is another reader.
+// Its version is major * 100 + minor, so "V1.100" is 2.0 too; a major of 13 digits is not (the
+// reader's own arithmetic overflowed on it, found by fuzz_bag), and is named as written.
 TEST(BagVersionLine, IsReadAsRosbagReadsIt) {
   const test::TempDir dir("bag_version");
   const std::string bytes = writeBag(dir.file("good.bag"), rosbag::compression::Uncompressed);
@@ -131,12 +133,19 @@ TEST(BagVersionLine, IsReadAsRosbagReadsIt) {
   for (const Case& c :
        {Case{"#ROSBAG V2.0 " + rest, "damaged bag: "},
         Case{"#ROS" + std::string(150, 'A') + " V2.0\n" + rest, "word after '#ROS' has 100 or more"},
-        Case{"#ROSBAG V1.2\n" + rest, "damaged bag: bag format 1.2: only format 2.0"}}) {
+        Case{"#ROSBAG V1.2\n" + rest, "damaged bag: bag format 1.2: only format 2.0"},
+        Case{"#ROSBAG V4444444444442.4444\n" + rest,
+             "damaged bag: bag format 4444444444442.4444: only format 2.0"},
+        Case{"#ROSBAG V-2147483648.0\n" + rest, "damaged bag: bag format -2147483648.0: only"},
+        Case{"#ROSBAG V1.100\n" + rest, "damaged bag: "}}) {
     write(bad, c.bytes);
     std::string error;
     ASSERT_EQ(framesOf(bad, error), -1) << c.expected;
     EXPECT_EQ(error.rfind(bad + ": ", 0), 0u) << error;
     EXPECT_NE(error.find(c.expected), std::string::npos) << error;
+    if (c.bytes.rfind("#ROSBAG V1.100", 0) == 0) {
+      EXPECT_EQ(error.find("bag format"), std::string::npos) << "read as format 2.0: " << error;
+    }
   }
   write(bad, "not a bag\n");
   std::string error;

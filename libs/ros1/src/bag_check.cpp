@@ -4,11 +4,13 @@
 #include <roslz4/lz4s.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -289,10 +291,38 @@ void checkChunk(std::ifstream& in, const Bytes& file, const ChunkInfo& info,
   }
 }
 
-// The format version of the bag's first line, read as rosbag reads it (fgets of at most 1,023
-// bytes, then sscanf "#ROS%s V%d.%d" into a 100-byte word), and the byte after that line.
-// 0 when it is not a bag's version line; rosbag then says so.
-int bagVersion(std::ifstream& in, std::uint64_t& after) {
+// sscanf's %d at p (white space, a sign, digits) as its text, p moved past it; empty, p left,
+// without a digit. The text, not the number: %d into an int is undefined past its range, and
+// rosbag's version arithmetic overflows with it.
+std::string intText(const char*& p) {
+  const char* s = p;
+  while (std::isspace(static_cast<unsigned char>(*s))) ++s;
+  const char* start = s;
+  if (*s == '+' || *s == '-') ++s;
+  const char* digits = s;
+  while (std::isdigit(static_cast<unsigned char>(*s))) ++s;
+  if (s == digits) return {};
+  p = s;
+  return std::string(start, s);
+}
+
+// The value of intText's text where it has at most 9 digits (an int's range); else nullopt.
+std::optional<long long> smallInt(const std::string& text) {
+  const std::size_t digits = text.size() - (text[0] == '+' || text[0] == '-' ? 1 : 0);
+  if (digits > 9) return std::nullopt;
+  return std::stoll(text);
+}
+
+// The bag's first line as rosbag reads it (fgets of at most 1,023 bytes, then sscanf
+// "#ROS%s V%d.%d" into a 100-byte word, the version major * 100 + minor), and the byte after
+// that line. found false: it is not a bag's version line, and rosbag says so.
+struct VersionLine {
+  bool found = false;
+  bool is_2_0 = false;  // the version rosbag reads is 200
+  std::string text;     // "MAJOR.MINOR" as written
+};
+
+VersionLine bagVersion(std::ifstream& in, std::uint64_t& after) {
   std::string line(1023, '\0');
   in.seekg(0);
   in.read(line.data(), static_cast<std::streamsize>(line.size()));
@@ -301,16 +331,28 @@ int bagVersion(std::ifstream& in, std::uint64_t& after) {
   const auto newline = line.find('\n');
   after = newline == std::string::npos ? line.size() : newline + 1;
   line.resize(std::min<std::size_t>(after, line.find('\0')));  // as sscanf sees it
-  if (line.rfind("#ROS", 0) != 0) return 0;
+  VersionLine v;
+  if (line.rfind("#ROS", 0) != 0) return v;
   // rosbag's unbounded %s writes a longer word past its 100-byte buffer.
   const auto word_end = line.find_first_of(" \t\n\v\f\r", 4);
   if ((word_end == std::string::npos ? line.size() : word_end) - 4 >= 100) {
     throw BagDamage("the version line's word after '#ROS' has 100 or more characters");
   }
   char word[100];
-  int major = 0, minor = 0;
-  if (std::sscanf(line.c_str(), "#ROS%99s V%d.%d", word, &major, &minor) != 3) return 0;
-  return major * 100 + minor;
+  int end_of_word = 0;
+  if (std::sscanf(line.c_str(), "#ROS%99s%n", word, &end_of_word) != 1) return v;
+  const char* p = line.c_str() + end_of_word;
+  while (std::isspace(static_cast<unsigned char>(*p))) ++p;  // the format's " V"
+  if (*p++ != 'V') return v;
+  const std::string major = intText(p);
+  if (major.empty() || *p++ != '.') return v;
+  const std::string minor = intText(p);
+  if (minor.empty()) return v;
+  v.found = true;
+  v.text = major + "." + minor;
+  const auto ma = smallInt(major), mi = smallInt(minor);
+  v.is_2_0 = ma && mi && *ma * 100 + *mi == 200;
+  return v;
 }
 
 }  // namespace
@@ -321,11 +363,10 @@ void checkBag(const std::string& path) {
   in.seekg(0, std::ios::end);
   const std::uint64_t file_size = static_cast<std::uint64_t>(in.tellg());
   std::uint64_t header_pos = 0;
-  const int version = bagVersion(in, header_pos);
-  if (version == 0) return;  // not a bag: rosbag says so
-  if (version != 200) {
-    throw BagDamage("bag format " + std::to_string(version / 100) + "." + std::to_string(version % 100) +
-                    ": only format 2.0 (ROS since 2010) is read");
+  const VersionLine version = bagVersion(in, header_pos);
+  if (!version.found) return;  // not a bag: rosbag says so
+  if (!version.is_2_0) {
+    throw BagDamage("bag format " + version.text + ": only format 2.0 (ROS since 2010) is read");
   }
   const FileBytes file(in, 0, file_size);
 
