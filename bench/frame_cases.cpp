@@ -31,15 +31,14 @@ json frameTimingCase(const Frame& fr, const Options& o, Report& report, core::Pi
   c["two_core_ms"] = num(t2.total_ms);
   c["two_core_stages"] = t2.stages;
   c["two_core_speedup"] = num(t1.total_ms / t2.total_ms);
-  c["machine_two_core_speedup"] = num(probe.speedup());
-  c["machine_core_round_trip_ns"] = num(probe.roundTripNs());
+  probe.addTo(c);
   c["normals_method"] = result.organized_normals ? "image-window scans" : "hash grid";
   // UpdParams::fast_cells_per_point: the lattice's cells per d_m on this frame.
   c["lattice_cells_per_radius"] = result.fast_cells_per_radius;
   report.target(fr.name + ": frame pipeline, one core (median)", t1.total_ms, kFrameBudgetMs,
                 true, "ms");
   report.target(fr.name + ": second core speedup", t1.total_ms / t2.total_ms, kMinTwoCoreSpeedup,
-                false, "x", machineNote(probe.speedup(), probe.roundTripNs()));
+                false, "x", machineNote(probe));
   std::printf(
       "%-30s %7zu px %7zu scored  one core %7.2f ms  two cores %7.2f ms (x%.2f; machine x%.2f, "
       "%.0f ns)  "

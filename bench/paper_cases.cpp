@@ -37,7 +37,7 @@ struct StageMedians {
 // run); the stage medians of each into stages and two_stages.
 struct PaperTiming {
   double one_ms = kNaN, two_ms = kNaN;
-  double machine_speedup = kNaN, machine_trip_ns = kNaN;  // CoreProbe's, beside each pair
+  CoreProbe probe;  // sampled beside each pair
   json stages, two_stages;
   std::size_t scored = 0;
 };
@@ -47,9 +47,9 @@ PaperTiming timePaperPipeline(const core::PointCloud& cloud, const core::Pipelin
   core::PipelineResult one, two;
   std::vector<double> t1, t2;
   StageMedians s1, s2;
-  CoreProbe probe;
+  PaperTiming t;
   for (int run = -1; run < repeats; ++run) {
-    if (run >= 0) probe.sample();
+    if (run >= 0) t.probe.sample();
     omp_set_num_threads(1);
     const core::Stopwatch w1;
     core::runPipeline(cloud, p, one);
@@ -62,10 +62,7 @@ PaperTiming timePaperPipeline(const core::PointCloud& cloud, const core::Pipelin
     t1.push_back(ms1), t2.push_back(ms2);
     s1.add(one.timings), s2.add(two.timings);
   }
-  PaperTiming t;
   t.one_ms = median(t1), t.two_ms = median(t2);
-  t.machine_speedup = probe.speedup();
-  t.machine_trip_ns = probe.roundTripNs();
   t.stages = s1.toJson(), t.two_stages = s2.toJson();
   t.scored = one.cloud.size();
   return t;
@@ -108,8 +105,7 @@ json paperCase(const Frame& fr, const Options& o, Report& report) {
   c["two_core_ms"] = num(t.two_ms);
   c["two_core_stages"] = t.two_stages;
   c["two_core_speedup"] = num(t.one_ms / t.two_ms);
-  c["machine_two_core_speedup"] = num(t.machine_speedup);
-  c["machine_core_round_trip_ns"] = num(t.machine_trip_ns);
+  t.probe.addTo(c);
   c["preprocess_share"] = num(pre / t.one_ms);
   double pcl_ms = kNaN;
   if (o.quick) {
@@ -123,14 +119,13 @@ json paperCase(const Frame& fr, const Options& o, Report& report) {
   report.target(fr.name + ": paper pipeline, pre-processing share", pre / t.one_ms,
                 kMaxPreprocessShare, true, "");
   report.target(fr.name + ": paper pipeline, second core", t.one_ms / t.two_ms,
-                kMinPipelineTwoCoreSpeedup, false, "x",
-                machineNote(t.machine_speedup, t.machine_trip_ns));
+                kMinPipelineTwoCoreSpeedup, false, "x", machineNote(t.probe));
   std::printf(
       "%-30s %7zu scored  ours %7.2f ms [pre %.2f, normals %.2f, UPD %.2f]  two cores %6.2f ms "
       "(x%.2f; machine x%.2f, %.0f ns)  PCL %8.1f ms",
       fr.name.c_str(), t.scored, t.one_ms, pre, t.stages["normals_ms"].get<double>(),
-      t.stages["upd_ms"].get<double>(), t.two_ms, t.one_ms / t.two_ms, t.machine_speedup,
-      t.machine_trip_ns, pcl_ms);
+      t.stages["upd_ms"].get<double>(), t.two_ms, t.one_ms / t.two_ms,
+      t.probe.speedup(), t.probe.roundTripNs(), pcl_ms);
   if (std::isfinite(pcl_ms)) {
     const json& q = c["pcl"];
     std::printf(" [voxel %.1f, SOR %.1f, normals %.1f, UPD %.1f]  PCL/ours %.0fx",
@@ -168,8 +163,7 @@ json sensorRateCase(const Frame& fr, const Options& o, Report& report) {
   c["two_core_ms"] = num(t2.total_ms);
   c["two_core_stages"] = t2.stages;
   c["two_core_speedup"] = num(t1.total_ms / t2.total_ms);
-  c["machine_two_core_speedup"] = num(probe.speedup());
-  c["machine_core_round_trip_ns"] = num(probe.roundTripNs());
+  probe.addTo(c);
   c["pcl_integral_normals_ms"] = num(pcl);
   c["ratio_ours_over_pcl_integral"] = num(t1.total_ms / pcl);
   c["agreement"] = a.toJson();
@@ -177,7 +171,7 @@ json sensorRateCase(const Frame& fr, const Options& o, Report& report) {
   report.target(n + " / PCL integral-image normals", t1.total_ms / pcl, kMaxSensorRateOverIntegral,
                 true, "x");
   report.target(n + ", second core", t1.total_ms / t2.total_ms, kMinPipelineTwoCoreSpeedup, false,
-                "x", machineNote(probe.speedup(), probe.roundTripNs()));
+                "x", machineNote(probe));
   report.target(n + ", mean |dzeta| vs exact", a.mean_abs_dzeta, kMaxMeanDzeta, true, "");
   report.target(n + ", same label vs exact", a.same_label, kMinSameLabel, false, "");
   std::printf(

@@ -111,8 +111,7 @@ double timeRoundTripNs() {
 #pragma omp barrier
       if (omp_get_thread_num() == 0) {
         const core::Stopwatch watch;
-        int i = 0;
-        for (; i < kTrips && !give_up.load(std::memory_order_relaxed); ++i) {
+        for (int i = 0; i < kTrips && !give_up.load(std::memory_order_relaxed); ++i) {
           line.store(2 * i + 1, std::memory_order_release);
           while (line.load(std::memory_order_acquire) != 2 * i + 2) {
             if (watch.elapsedMs() > kMaxMs) {
@@ -150,10 +149,15 @@ double CoreProbe::speedup() const { return median(one_ms_) / median(two_ms_); }
 
 double CoreProbe::roundTripNs() const { return median(trip_ns_); }
 
-std::string machineNote(double s, double trip_ns) {
+void CoreProbe::addTo(json& c) const {
+  c["machine_two_core_speedup"] = num(speedup());
+  c["machine_core_round_trip_ns"] = num(roundTripNs());
+}
+
+std::string machineNote(const CoreProbe& probe) {
   char text[64];
-  std::snprintf(text, sizeof text, "(machine x%.2f, a line between the cores %.0f ns)", s,
-                trip_ns);
+  std::snprintf(text, sizeof text, "(machine x%.2f, a line between the cores %.0f ns)",
+                probe.speedup(), probe.roundTripNs());
   return text;
 }
 

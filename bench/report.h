@@ -79,10 +79,6 @@ double peakRssMb();
 /// Sustained copy bandwidth of this machine [GB/s] (read + write counted), for the floor.
 double copyBandwidthGBs();
 
-/// "(machine xS, a line between the cores T ns)": CoreProbe's speedup s and round trip t, for a
-/// target's note.
-std::string machineNote(double s, double trip_ns);
-
 /// What this machine's second core gives at the moment, as a peer for the pipelines' second
 /// core: work of compute alone (independent multiply-adds, no memory, no serial part) in 24
 /// parallel regions of equal halves, as many regions a run as a frame's stages, run on one
@@ -106,10 +102,16 @@ class CoreProbe {
   /// The median round trip of a cache line between the two threads [ns]; NaN before the first
   /// sample, or when the two threads shared one CPU (no answer within a few milliseconds).
   double roundTripNs() const;
+  /// Both into a case's JSON: machine_two_core_speedup, machine_core_round_trip_ns.
+  void addTo(json& c) const;
 
  private:
   std::vector<double> one_ms_, two_ms_, trip_ns_;
 };
+
+/// "(machine xS, a line between the cores T ns)": the probe's speedup and round trip, for a
+/// target's note.
+std::string machineNote(const CoreProbe& probe);
 
 /// The machine, the compiler and the OpenMP wait policy: printed and stored under "machine".
 void describeMachine(Report& report, double bandwidth);

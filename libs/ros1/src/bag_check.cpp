@@ -5,10 +5,13 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -291,26 +294,22 @@ void checkChunk(std::ifstream& in, const Bytes& file, const ChunkInfo& info,
   }
 }
 
-// sscanf's %d at p (white space, a sign, digits) as its text, p moved past it; empty, p left,
-// without a digit. The text, not the number: %d into an int is undefined past its range, and
-// rosbag's version arithmetic overflows with it.
-std::string intText(const char*& p) {
-  const char* s = p;
-  while (std::isspace(static_cast<unsigned char>(*s))) ++s;
-  const char* start = s;
-  if (*s == '+' || *s == '-') ++s;
-  const char* digits = s;
-  while (std::isdigit(static_cast<unsigned char>(*s))) ++s;
-  if (s == digits) return {};
-  p = s;
-  return std::string(start, s);
-}
-
-// The value of intText's text where it has at most 9 digits (an int's range); else nullopt.
-std::optional<long long> smallInt(const std::string& text) {
-  const std::size_t digits = text.size() - (text[0] == '+' || text[0] == '-' ? 1 : 0);
-  if (digits > 9) return std::nullopt;
-  return std::stoll(text);
+// sscanf's %d at p, read as strtoll reads it (white space, a sign, digits: the same grammar,
+// but defined past an int's range, where %d is not): its text without the white space, and its
+// value where that fits an int (rosbag's version arithmetic overflows beyond). p moves past it;
+// false, p left, without a digit.
+bool readIntField(const char*& p, std::string& text, std::optional<long long>& value) {
+  while (std::isspace(static_cast<unsigned char>(*p))) ++p;
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(p, &end, 10);
+  if (end == p) return false;
+  const bool fits = errno != ERANGE && v >= std::numeric_limits<int>::min() &&
+                    v <= std::numeric_limits<int>::max();
+  text.assign(p, static_cast<std::size_t>(end - p));
+  value = fits ? std::optional<long long>(v) : std::nullopt;
+  p = end;
+  return true;
 }
 
 // The bag's first line as rosbag reads it (fgets of at most 1,023 bytes, then sscanf
@@ -344,13 +343,11 @@ VersionLine bagVersion(std::ifstream& in, std::uint64_t& after) {
   const char* p = line.c_str() + end_of_word;
   while (std::isspace(static_cast<unsigned char>(*p))) ++p;  // the format's " V"
   if (*p++ != 'V') return v;
-  const std::string major = intText(p);
-  if (major.empty() || *p++ != '.') return v;
-  const std::string minor = intText(p);
-  if (minor.empty()) return v;
+  std::string major, minor;
+  std::optional<long long> ma, mi;
+  if (!readIntField(p, major, ma) || *p++ != '.' || !readIntField(p, minor, mi)) return v;
   v.found = true;
   v.text = major + "." + minor;
-  const auto ma = smallInt(major), mi = smallInt(minor);
   v.is_2_0 = ma && mi && *ma * 100 + *mi == 200;
   return v;
 }
