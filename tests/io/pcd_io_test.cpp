@@ -11,11 +11,13 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 
 namespace core = upd::core;
 
@@ -209,6 +211,36 @@ TEST(PcdIo, PointCountTheFileCannotHoldFailsBeforePclAllocates) {
   const core::PointCloud c = upd::io::readCloud(two);
   ASSERT_EQ(c.size(), 2u);
   EXPECT_EQ(c.z[1], 6.f);
+}
+
+// PCL finds a header line by the first letters of its first word and reads the count after it
+// as an istream does (a sign, digits, the rest ignored; "-1" and a count past the range read as
+// the largest number): each of these asks PCL for more than the file can hold, and is refused
+// naming the count PCL would read, before PCL allocates (fuzz_pcd found the first two).
+TEST(PcdIo, PointCountIsReadAsPclReadsIt) {
+  TempDir dir;
+  const std::string head = "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                           "WIDTH 1\nHEIGHT 1\n";
+  const std::string max = std::to_string(std::numeric_limits<std::uint64_t>::max());
+  const std::pair<std::string, std::string> cases[] = {
+      {"POINTS 6666666666# .PCD v0.7", "POINTS 6666666666 "},
+      {"POINTSX 6666666666", "POINTS 6666666666 "},
+      {"  POINTS\t+6666666666 7", "POINTS 6666666666 "},
+      {"POINTS -1", "POINTS " + max},
+      {"POINTS 99999999999999999999", "POINTS " + max},
+  };
+  int i = 0;
+  for (const auto& [points_line, expected] : cases) {
+    const std::string path = dir.file("count" + std::to_string(i++) + ".pcd");
+    writeBytes(path, head + points_line + "\nDATA ascii\n1 2 3\n");
+    const std::string msg = errorOf(path);
+    EXPECT_NE(msg.find(path), std::string::npos) << points_line << ": " << msg;
+    EXPECT_NE(msg.find(expected), std::string::npos) << points_line << ": " << msg;
+  }
+  // A count followed by a comment, as PCL reads it, is read.
+  const std::string ok = dir.file("ok.pcd");
+  writeBytes(ok, head + "POINTS 1 # one point\nDATA ascii\n1 2 3\n");
+  EXPECT_EQ(upd::io::readCloud(ok).size(), 1u);
 }
 
 TEST(PcdIo, AsciiPcdWithViewpointAndDoubleCoordinates) {

@@ -10,11 +10,15 @@
 #include <pcl/io/pcd_io.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
+#include <cstdlib>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <optional>
 #include <ostream>
 #include <vector>
 
@@ -199,6 +203,88 @@ bool headerNumbers(const std::string& line, std::size_t from, std::vector<std::u
   return true;
 }
 
+/// A header line's keyword as PCL's readHeader finds it: the line's first word, matched by its
+/// first letters ("POINTSX 9" is a POINTS line to PCL), the line's words after it (split at
+/// white space) from the position returned.
+struct HeaderWord {
+  std::string first;
+  std::size_t after = 0;  // where the words after the first begin
+  bool is(const char* keyword) const { return first.compare(0, std::strlen(keyword), keyword) == 0; }
+};
+
+HeaderWord headerWord(const std::string& line) {
+  const std::size_t b = line.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return {};
+  const std::size_t e = std::min(line.find_first_of(" \t\r", b), line.size());
+  return {line.substr(b, e - b), e};
+}
+
+/// The count after a header line's keyword as PCL reads it (an istream's >> into an unsigned
+/// integer: white space, a sign, digits, the rest ignored; "-1" wraps to the largest value, and
+/// so does a number past the range), or nothing where no digit follows.
+std::optional<std::uint64_t> streamCount(const std::string& line, std::size_t from) {
+  const char* p = line.c_str() + from;
+  while (*p == ' ' || *p == '\t' || *p == '\r') ++p;
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(p, &end, 10);
+  if (end == p) return std::nullopt;
+  return errno == ERANGE ? std::numeric_limits<std::uint64_t>::max() : static_cast<std::uint64_t>(v);
+}
+
+/// What a header asks PCL to allocate, line by line as PCL reads it: each POINTS line resizes the
+/// data to POINTS x the point's bytes at that line (FIELDS sets 4 bytes a field, SIZE and COUNT
+/// change them), so the largest count and the largest point size seen bound it.
+struct HeaderClaims {
+  std::vector<std::uint64_t> sizes, counts;
+  std::size_t fields = 0;
+  std::uint64_t points = 0, width = 0, height = 1, step = 0;
+  void updateStep() {
+    std::uint64_t now = 0;
+    for (std::size_t f = 0; f < std::max(fields, sizes.size()); ++f) {
+      now += (f < sizes.size() ? sizes[f] : 4) * (f < counts.size() ? counts[f] : 1);
+    }
+    step = std::max(step, now);
+  }
+};
+
+/// A SIZE or COUNT line checked (each field's SIZE is 1, 2, 4 or 8 bytes and its COUNT at least
+/// 1: PCL reads them as ints and sums SIZE x COUNT as unsigned, a "-4" becomes 4 GB a point).
+void checkSizeOrCount(const std::string& path, const std::string& line, const HeaderWord& w,
+                      HeaderClaims& claims) {
+  const bool size = w.is("SIZE");
+  std::vector<std::uint64_t>& list = size ? claims.sizes : claims.counts;
+  const bool ok = headerNumbers(line, w.after, list) &&
+                  std::all_of(list.begin(), list.end(), [&](std::uint64_t v) {
+                    return size ? (v == 1 || v == 2 || v == 4 || v == 8) : (v >= 1 && v <= 1u << 20);
+                  });
+  if (!ok) {
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    throw fileError(path, "corrupt PCD header: '" + line.substr(first, 80) + "' (" +
+                              (size ? "a SIZE is 1, 2, 4 or 8 bytes" : "a COUNT is at least 1") +
+                              ")");
+  }
+}
+
+/// The bytes PCL would allocate: the larger of POINTS and WIDTH x HEIGHT, times the point's
+/// bytes, in long double so that no product wraps. A file holds at most its size in binary, and
+/// about 90 times it compressed (LZF's longest back-reference: 264 bytes from 3).
+void checkClaims(const std::string& path, const HeaderClaims& c) {
+  const long double claimed =
+      std::max<long double>(c.points, static_cast<long double>(c.width) * c.height) *
+      std::max<std::uint64_t>(c.step, 1);
+  std::error_code ec;
+  const auto file_bytes = std::filesystem::file_size(path, ec);
+  const long double bound = 128.0L * (ec ? 0 : file_bytes) + 65536.0L;
+  if (claimed > bound) {
+    throw fileError(path, "corrupt PCD header: POINTS " + std::to_string(c.points) + " (WIDTH " +
+                              std::to_string(c.width) + " x HEIGHT " + std::to_string(c.height) +
+                              ") of " + std::to_string(c.step) +
+                              " bytes each, more than a file of " +
+                              std::to_string(ec ? 0 : file_bytes) + " bytes can hold");
+  }
+}
+
 /// The header up to its DATA line, checked where PCL would act on it: a header cut off before its
 /// DATA line (PCL takes such a file as a cloud of no points, or reads the header's own lines as
 /// ascii data), and a point count whose bytes this file cannot hold (PCL's readHeader allocates
@@ -208,60 +294,32 @@ void checkHeaderLines(const std::string& path) {
   std::string line;
   std::size_t n = 0;
   constexpr std::size_t kMaxHeaderLines = 1000;  // a PCD header has about a dozen
-  std::vector<std::uint64_t> sizes, counts, values;
-  std::uint64_t points = 0, width = 0, height = 1;
+  HeaderClaims claims;
   while (n < kMaxHeaderLines && std::getline(in, line)) {
     ++n;
-    const std::size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos) continue;
-    const auto keyword = [&](const char* k) {
-      const std::size_t len = std::strlen(k);
-      return line.compare(first, len, k) == 0 &&
-             (first + len == line.size() || line[first + len] == ' ' || line[first + len] == '\t');
-    };
-    const auto numbers = [&](const char* k) { return headerNumbers(line, first + std::strlen(k), values); };
-    // Each field's SIZE is 1, 2, 4 or 8 bytes and its COUNT at least 1 (PCL reads them as ints
-    // and sums SIZE x COUNT as unsigned: a "-4" becomes 4 GB a point).
-    if (keyword("SIZE") || keyword("COUNT")) {
-      const bool size = keyword("SIZE");
-      std::vector<std::uint64_t>& list = size ? sizes : counts;
-      const bool ok = headerNumbers(line, first + (size ? 4 : 5), list) &&
-                      std::all_of(list.begin(), list.end(), [&](std::uint64_t v) {
-                        return size ? (v == 1 || v == 2 || v == 4 || v == 8)
-                                    : (v >= 1 && v <= 1u << 20);
-                      });
-      if (!ok) {
-        throw fileError(path, "corrupt PCD header: '" + line.substr(first, 80) + "' (" +
-                                  (size ? "a SIZE is 1, 2, 4 or 8 bytes" : "a COUNT is at least 1") +
-                                  ")");
+    const HeaderWord w = headerWord(line);
+    if (w.first.empty() || w.first[0] == '#') continue;
+    if (w.is("FIELDS")) {
+      claims.fields = 0;
+      for (std::size_t p = w.after; (p = line.find_first_not_of(" \t\r", p)) != std::string::npos;
+           p = line.find_first_of(" \t\r", p)) {
+        ++claims.fields;
       }
-      continue;
+    } else if (w.is("SIZE") || w.is("COUNT")) {
+      checkSizeOrCount(path, line, w, claims);
+    } else if (w.is("POINTS") || w.is("WIDTH") || w.is("HEIGHT")) {
+      const std::optional<std::uint64_t> v = streamCount(line, w.after);
+      if (!v) continue;
+      if (w.is("POINTS")) claims.points = std::max(claims.points, *v);
+      // (WIDTH and HEIGHT are 32-bit in PCL: a larger number reads as the largest.)
+      const std::uint64_t v32 = std::min<std::uint64_t>(*v, 0xFFFFFFFFu);
+      if (w.is("WIDTH")) claims.width = v32;
+      if (w.is("HEIGHT")) claims.height = v32;
+    } else if (w.is("DATA")) {
+      checkClaims(path, claims);
+      return;
     }
-    if (keyword("POINTS") && numbers("POINTS") && values.size() == 1) points = values[0];
-    if (keyword("WIDTH") && numbers("WIDTH") && values.size() == 1) width = values[0];
-    if (keyword("HEIGHT") && numbers("HEIGHT") && values.size() == 1) height = values[0];
-    if (line.compare(first, 4, "DATA") != 0) continue;
-    // The bytes PCL would allocate: the larger of POINTS and WIDTH x HEIGHT, times the point's
-    // bytes (SIZE x COUNT per field), in long double so that no product wraps. A file holds at
-    // most its size in binary, and about 90 times it compressed (LZF's longest back-reference:
-    // 264 bytes from 3).
-    long double step = 0;
-    for (std::size_t f = 0; f < sizes.size(); ++f) {
-      step += static_cast<long double>(sizes[f]) * (f < counts.size() ? counts[f] : 1);
-    }
-    const long double claimed =
-        std::max<long double>(points, static_cast<long double>(width) * height) * step;
-    std::error_code ec;
-    const auto file_bytes = std::filesystem::file_size(path, ec);
-    const long double bound = 128.0L * (ec ? 0 : file_bytes) + 65536.0L;
-    if (claimed > bound) {
-      throw fileError(path, "corrupt PCD header: POINTS " + std::to_string(points) + " (WIDTH " +
-                                std::to_string(width) + " x HEIGHT " + std::to_string(height) +
-                                ") of " + std::to_string(static_cast<std::uint64_t>(step)) +
-                                " bytes each, more than a file of " +
-                                std::to_string(ec ? 0 : file_bytes) + " bytes can hold");
-    }
-    return;
+    claims.updateStep();
   }
   if (n == 0) throw fileError(path, "empty file, not a PCD file (no header)");
   throw fileError(path, "truncated or invalid PCD header: no DATA line in its first " +
