@@ -243,6 +243,37 @@ TEST(PcdIo, PointCountIsReadAsPclReadsIt) {
   EXPECT_EQ(upd::io::readCloud(ok).size(), 1u);
 }
 
+// PCL reads header lines on after the DATA line, up to the first line that is not one (and
+// skips blank lines and comments on the way): a count there, or a FIELDS line that widens the
+// point, is PCL's too (fuzz_pcd found the first). A line before DATA that is no header line
+// ends PCL's header there, so such a file is refused, its line shown as text.
+TEST(PcdIo, HeaderLinesAfterTheDataLineAreReadAsPclReadsThem) {
+  TempDir dir;
+  const std::string head = "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                           "WIDTH 1\nHEIGHT 1\nPOINTS 1\n";
+  std::string manyFields;  // 5,000 fields of 4 bytes: 20,000 bytes a point
+  for (int f = 0; f < 5000; ++f) manyFields += " a";
+  const std::pair<std::string, std::string> cases[] = {
+      {"DATA ascii\nPOINTS 6666666666\n1 2 3\n", "POINTS 6666666666 "},
+      {"DATA ascii\n\n# a comment\n\v POINTS 6666666666\n1 2 3\n", "POINTS 6666666666 "},
+      {"DATA ascii\nCOLUMNS" + manyFields + "\nPOINTS 2000\n1 2 3\n", "POINTS 2000 "},
+      {"UNKNOWN \x01\x02 line\nDATA ascii\n1 2 3\n", "line 9 ('UNKNOWN ?? line') is not a header line"},
+  };
+  int i = 0;
+  for (const auto& [tail, expected] : cases) {
+    const std::string path = dir.file("after" + std::to_string(i++) + ".pcd");
+    writeBytes(path, head + tail);
+    const std::string msg = errorOf(path);
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find(expected), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\x01'), std::string::npos) << msg;
+  }
+  // The body's first line ends the header: a file whose later body lines spell a keyword is read.
+  const std::string ok = dir.file("ok.pcd");
+  writeBytes(ok, head + "DATA ascii\n1 2 3\n");
+  EXPECT_EQ(upd::io::readCloud(ok).size(), 1u);
+}
+
 TEST(PcdIo, AsciiPcdWithViewpointAndDoubleCoordinates) {
   TempDir dir;
   const std::string f = dir.file("ascii.pcd");

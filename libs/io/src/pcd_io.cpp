@@ -10,6 +10,7 @@
 #include <pcl/io/pcd_io.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cstdlib>
@@ -203,19 +204,32 @@ bool headerNumbers(const std::string& line, std::size_t from, std::vector<std::u
   return true;
 }
 
-/// A header line's keyword as PCL's readHeader finds it: the line's first word, matched by its
-/// first letters ("POINTSX 9" is a POINTS line to PCL), the line's words after it (split at
-/// white space) from the position returned.
+/// A header line's keyword as PCL's readHeader finds it: the line's first word (after white
+/// space, as an istream's >> reads it), matched by its first letters ("POINTSX 9" is a POINTS
+/// line to PCL); the words after it begin at `after`.
 struct HeaderWord {
   std::string first;
-  std::size_t after = 0;  // where the words after the first begin
+  std::size_t after = 0;
   bool is(const char* keyword) const { return first.compare(0, std::strlen(keyword), keyword) == 0; }
 };
 
+bool isSpace(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
+
+/// At most n bytes of a header line from `from`, for a message: a byte that is not printable
+/// ASCII (a corrupt file's binary) shown as '?', so that the message stays one line of text.
+std::string quoted(const std::string& line, std::size_t from, std::size_t n) {
+  std::string q = line.substr(std::min(from, line.size()), n);
+  for (char& c : q) {
+    if (c < 0x20 || c > 0x7e) c = '?';
+  }
+  return "'" + q + "'";
+}
+
 HeaderWord headerWord(const std::string& line) {
-  const std::size_t b = line.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return {};
-  const std::size_t e = std::min(line.find_first_of(" \t\r", b), line.size());
+  std::size_t b = 0;
+  while (b < line.size() && isSpace(line[b])) ++b;
+  std::size_t e = b;
+  while (e < line.size() && !isSpace(line[e])) ++e;
   return {line.substr(b, e - b), e};
 }
 
@@ -259,8 +273,7 @@ void checkSizeOrCount(const std::string& path, const std::string& line, const He
                     return size ? (v == 1 || v == 2 || v == 4 || v == 8) : (v >= 1 && v <= 1u << 20);
                   });
   if (!ok) {
-    const std::size_t first = line.find_first_not_of(" \t\r");
-    throw fileError(path, "corrupt PCD header: '" + line.substr(first, 80) + "' (" +
+    throw fileError(path, "corrupt PCD header: " + quoted(line, w.after - w.first.size(), 80) + " (" +
                               (size ? "a SIZE is 1, 2, 4 or 8 bytes" : "a COUNT is at least 1") +
                               ")");
   }
@@ -285,45 +298,69 @@ void checkClaims(const std::string& path, const HeaderClaims& c) {
   }
 }
 
-/// The header up to its DATA line, checked where PCL would act on it: a header cut off before its
-/// DATA line (PCL takes such a file as a cloud of no points, or reads the header's own lines as
-/// ascii data), and a point count whose bytes this file cannot hold (PCL's readHeader allocates
-/// POINTS x the point's bytes before it reads the body: a corrupt count asks for terabytes).
+/// One header line into claims, as PCL's readHeader reads it; false when its first word is none
+/// of the header's keywords (PCL's header ends there).
+bool readHeaderLine(const std::string& path, const std::string& line, const HeaderWord& w,
+                    HeaderClaims& claims) {
+  if (w.is("FIELDS") || w.is("COLUMNS")) {
+    claims.fields = 0;  // (its words after the keyword, split at spaces, tabs and CRs, as PCL)
+    for (std::size_t p = w.after; (p = line.find_first_not_of(" \t\r", p)) != std::string::npos;
+         p = line.find_first_of(" \t\r", p)) {
+      ++claims.fields;
+    }
+  } else if (w.is("SIZE") || w.is("COUNT")) {
+    checkSizeOrCount(path, line, w, claims);
+  } else if (w.is("POINTS") || w.is("WIDTH") || w.is("HEIGHT")) {
+    const std::optional<std::uint64_t> v = streamCount(line, w.after);
+    if (!v) return true;
+    if (w.is("POINTS")) claims.points = std::max(claims.points, *v);
+    // (WIDTH and HEIGHT are 32-bit in PCL: a larger number reads as the largest.)
+    const std::uint64_t v32 = std::min<std::uint64_t>(*v, 0xFFFFFFFFu);
+    if (w.is("WIDTH")) claims.width = v32;
+    if (w.is("HEIGHT")) claims.height = v32;
+  } else if (!w.is("VERSION") && !w.is("TYPE") && !w.is("VIEWPOINT") && !w.is("DATA")) {
+    return false;
+  }
+  claims.updateStep();
+  return true;
+}
+
+/// The header, checked where PCL would act on it: a header cut off before its DATA line (PCL
+/// takes such a file as a cloud of no points, or reads the header's own lines as ascii data), a
+/// line before it that is no header line (where PCL's header ends), and a point count whose
+/// bytes this file cannot hold (PCL's readHeader allocates POINTS x the point's bytes before it
+/// reads the body: a corrupt count asks for terabytes). PCL reads header lines on after the DATA
+/// line too, up to the first line that is not one (the body's first line, as a rule), and so
+/// does this check.
 void checkHeaderLines(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   std::size_t n = 0;
   constexpr std::size_t kMaxHeaderLines = 1000;  // a PCD header has about a dozen
   HeaderClaims claims;
-  while (n < kMaxHeaderLines && std::getline(in, line)) {
-    ++n;
+  bool data = false;
+  while (std::getline(in, line)) {
+    if (++n > kMaxHeaderLines) {
+      throw fileError(path, data ? "corrupt PCD header: header lines go on after its DATA line "
+                                   "past line " + std::to_string(kMaxHeaderLines)
+                                 : "truncated or invalid PCD header: no DATA line in its first " +
+                                       std::to_string(kMaxHeaderLines) + " lines");
+    }
     const HeaderWord w = headerWord(line);
     if (w.first.empty() || w.first[0] == '#') continue;
-    if (w.is("FIELDS")) {
-      claims.fields = 0;
-      for (std::size_t p = w.after; (p = line.find_first_not_of(" \t\r", p)) != std::string::npos;
-           p = line.find_first_of(" \t\r", p)) {
-        ++claims.fields;
-      }
-    } else if (w.is("SIZE") || w.is("COUNT")) {
-      checkSizeOrCount(path, line, w, claims);
-    } else if (w.is("POINTS") || w.is("WIDTH") || w.is("HEIGHT")) {
-      const std::optional<std::uint64_t> v = streamCount(line, w.after);
-      if (!v) continue;
-      if (w.is("POINTS")) claims.points = std::max(claims.points, *v);
-      // (WIDTH and HEIGHT are 32-bit in PCL: a larger number reads as the largest.)
-      const std::uint64_t v32 = std::min<std::uint64_t>(*v, 0xFFFFFFFFu);
-      if (w.is("WIDTH")) claims.width = v32;
-      if (w.is("HEIGHT")) claims.height = v32;
-    } else if (w.is("DATA")) {
-      checkClaims(path, claims);
-      return;
+    if (!readHeaderLine(path, line, w, claims)) {
+      if (data) break;
+      throw fileError(path, "corrupt PCD header: line " + std::to_string(n) + " (" +
+                                quoted(line, 0, 40) + ") is not a header line, before the DATA line");
     }
-    claims.updateStep();
+    data = data || w.is("DATA");
   }
   if (n == 0) throw fileError(path, "empty file, not a PCD file (no header)");
-  throw fileError(path, "truncated or invalid PCD header: no DATA line in its first " +
-                            std::to_string(n) + " lines");
+  if (!data) {
+    throw fileError(path, "truncated or invalid PCD header: no DATA line in its first " +
+                              std::to_string(n) + " lines");
+  }
+  checkClaims(path, claims);
 }
 
 // Reads and checks the header, and checks the body against it before PCL parses the body (PCL
