@@ -86,6 +86,15 @@ int runAnalyze(const std::vector<std::string>& argv) {
       "%zu unknown; %.1f ms\n",
       input.c_str(), cloud.size(), result.cloud.size() - result.upd.invalid,
       params.upd.radius_m, c.traversable, c.non_traversable, c.unknown, result.timings.total_ms);
+  // A camera's cloud (optical frame: y down) read with the default up has its floor as a wall:
+  // nothing traversable. Said where the user chose no up, so that the fix is one option away.
+  if (c.traversable == 0 && c.non_traversable > 0 && !args.has("--up") && !args.has("--config") &&
+      !in.up) {
+    std::fprintf(stderr,
+                 "upd analyze: note: no point is traversable with up = 0,0,1 (the default); a "
+                 "cloud in a camera's optical frame (y down) needs --up 0,-1,0 or --mount "
+                 "MOUNT.ini\n");
+  }
   return 0;
 }
 

@@ -143,6 +143,28 @@ TEST_F(Cli, EveryCloudFileInSharedDataIsAnalysedOrRefusedClearly) {
   EXPECT_GE(analysed, 7u);
 }
 
+// A floor seen by a level camera, in its optical frame (y down): with the default up (+z) it is
+// a wall and nothing is traversable, which the command points out with the option that fixes
+// it; with that option the floor is traversable and the note is gone.
+TEST_F(Cli, CameraFrameCloudWithTheDefaultUpGetsANote) {
+  {
+    std::ofstream xyz(path("floor.xyz"));
+    for (int i = 0; i <= 40; ++i) {
+      for (int j = 0; j <= 40; ++j) xyz << -1 + 0.05 * i << " 0.7 " << 1 + 0.05 * j << "\n";
+    }
+  }
+  const std::string note = "no point is traversable with up = 0,0,1 (the default)";
+  const CmdResult plain = runUpd("analyze " + path("floor.xyz") + " --no-preprocess");
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_NE(plain.output.find(note), std::string::npos) << plain.output;
+  EXPECT_NE(plain.output.find("--up 0,-1,0"), std::string::npos) << plain.output;
+  const CmdResult up =
+      runUpd("analyze " + path("floor.xyz") + " --no-preprocess --up 0,-1,0");
+  ASSERT_EQ(up.exit_code, 0) << up.output;
+  EXPECT_EQ(up.output.find(note), std::string::npos) << up.output;
+  EXPECT_NE(up.output.find(" 0 non-traversable"), std::string::npos) << up.output;
+}
+
 TEST_F(Cli, MissingInputNamesTheFileAndWritesNothing) {
   const CmdResult r = runUpd("analyze " + path("nope.pcd") + " --output " + path("o.ply"));
   EXPECT_EQ(r.exit_code, 1);
