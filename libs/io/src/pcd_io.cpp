@@ -237,8 +237,7 @@ HeaderWord headerWord(const std::string& line) {
 /// integer: white space, a sign, digits, the rest ignored; "-1" wraps to the largest value, and
 /// so does a number past the range), or nothing where no digit follows.
 std::optional<std::uint64_t> streamCount(const std::string& line, std::size_t from) {
-  const char* p = line.c_str() + from;
-  while (*p == ' ' || *p == '\t' || *p == '\r') ++p;
+  const char* p = line.c_str() + from;  // (strtoull skips the white space itself)
   char* end = nullptr;
   errno = 0;
   const unsigned long long v = std::strtoull(p, &end, 10);
@@ -248,7 +247,8 @@ std::optional<std::uint64_t> streamCount(const std::string& line, std::size_t fr
 
 /// What a header asks PCL to allocate, line by line as PCL reads it: each POINTS line resizes the
 /// data to POINTS x the point's bytes at that line (FIELDS sets 4 bytes a field, SIZE and COUNT
-/// change them), so the largest count and the largest point size seen bound it.
+/// change them), so the largest count and the largest point size seen bound it. updateStep after
+/// every FIELDS, SIZE and COUNT line keeps that largest point size.
 struct HeaderClaims {
   std::vector<std::uint64_t> sizes, counts;
   std::size_t fields = 0;
@@ -308,8 +308,10 @@ bool readHeaderLine(const std::string& path, const std::string& line, const Head
          p = line.find_first_of(" \t\r", p)) {
       ++claims.fields;
     }
+    claims.updateStep();
   } else if (w.is("SIZE") || w.is("COUNT")) {
     checkSizeOrCount(path, line, w, claims);
+    claims.updateStep();
   } else if (w.is("POINTS") || w.is("WIDTH") || w.is("HEIGHT")) {
     const std::optional<std::uint64_t> v = streamCount(line, w.after);
     if (!v) return true;
@@ -321,7 +323,6 @@ bool readHeaderLine(const std::string& path, const std::string& line, const Head
   } else if (!w.is("VERSION") && !w.is("TYPE") && !w.is("VIEWPOINT") && !w.is("DATA")) {
     return false;
   }
-  claims.updateStep();
   return true;
 }
 
