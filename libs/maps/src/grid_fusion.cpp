@@ -137,10 +137,11 @@ inline void addRun(FrameCell& f, const float* const* __restrict layer,
   std::memcpy(&inf_bits, &inf, sizeof inf_bits);
   Double4 sum;
   Int4 count;
-  Float4 least = inf;
+  // (Built in registers: a copy of f.least over a stored vector of inf would be read back as one
+  // vector from two stores, which the store buffer cannot forward: a stall at every run.)
+  Float4 least = {f.least[0], f.least[1], kInf, kInf};
   std::memcpy(&sum, f.sum, sizeof sum);
   std::memcpy(&count, f.count, sizeof count);
-  std::memcpy(&least, f.least, sizeof f.least);
   std::uint32_t n_nontrav = f.n_nontrav;
   const float *const z = layer[kZ], *const zeta = layer[kZeta], *const slope = layer[kSlope],
                      *const cost = layer[kCost];
@@ -163,7 +164,7 @@ inline void addRun(FrameCell& f, const float* const* __restrict layer,
   }
   std::memcpy(f.sum, &sum, sizeof sum);
   std::memcpy(f.count, &count, sizeof count);
-  std::memcpy(f.least, &least, sizeof f.least);
+  f.least[0] = least[0], f.least[1] = least[1];
   f.n_nontrav = n_nontrav;
 }
 
