@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "../../libs/core/src/preprocess_internal.h"
@@ -74,7 +75,8 @@ TEST(PreprocessKernels, GatherWithinKeepsThePointsWithinTheBoundInOrder) {
   EXPECT_GT(checked, 300);
 }
 
-// selectMean and selectMeanPlain of the candidates cand against the mean of the square roots
+// selectMean (on AVX-512 the sorting networks where c <= 32), selectMean as a CPU without
+// AVX-512 runs it, and selectMeanPlain of the candidates cand against the mean of the square roots
 // of the want smallest in double, and the want-th; the incoming kth is the want-th times
 // guess. (To within 2^-23 of the mean: the vector version takes its roots in float, each within
 // 2^-24 of the double's.)
@@ -85,14 +87,18 @@ void expectSelectMean(const std::vector<float>& cand, std::size_t want, float gu
   double sum = 0;
   for (std::size_t j = 0; j < want; ++j) sum += std::sqrt(sorted[j]);
   const double mean = sum / static_cast<double>(want - 1);
-  for (const bool plain : {false, true}) {
+  using SelectMean = double (*)(float*, std::size_t, std::size_t, float&);
+  const std::pair<SelectMean, const char*> versions[] = {
+      {detail::selectMean, "the CPU's"},
+      {detail::selectMeanWithoutAvx512, "without AVX-512"},
+      {detail::selectMeanPlain, "plain"}};
+  for (const auto& [select, name] : versions) {
     std::vector<float> buf(c + 8);
     std::copy(cand.begin(), cand.end(), buf.begin());
     float kth = static_cast<float>(sorted[want - 1]) * guess;
-    const double got = plain ? detail::selectMeanPlain(buf.data(), c, want, kth)
-                             : detail::selectMean(buf.data(), c, want, kth);
-    EXPECT_NEAR(got, mean, 0x1p-23 * mean) << "trial " << trial << (plain ? " plain" : "");
-    EXPECT_EQ(kth, static_cast<float>(sorted[want - 1])) << "trial " << trial;
+    const double got = select(buf.data(), c, want, kth);
+    EXPECT_NEAR(got, mean, 0x1p-23 * mean) << "trial " << trial << ", " << name;
+    EXPECT_EQ(kth, static_cast<float>(sorted[want - 1])) << "trial " << trial << ", " << name;
   }
 }
 

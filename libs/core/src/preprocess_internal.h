@@ -109,16 +109,37 @@ std::size_t gatherWithin(const float* x, const float* y, const float* z, std::si
 /// The mean distance of a point to its k = want - 1 nearest others from the c >= want squared
 /// distances cand[0, c) to the points within a bound (the point itself among them, at 0; the
 /// caller knows that no other point is nearer than the want-th); the want-th (squared) into kth.
-/// cand has room for c rounded up to a multiple of 8 and is reordered. On AVX2, where c - want
+/// cand has room for c rounded up to a multiple of 8 and is reordered. On AVX-512, up to 32
+/// candidates are sorted (selectMeanSorted), more first narrowed as below. On AVX2, where c - want
 /// is small, the c - want largest are dropped one at a time; where it is not, the candidates
 /// are first narrowed to a bound near the incoming kth (a guess: the previous point's; only the
 /// speed depends on it), then, if still many, a partial selection.
 double selectMean(float* cand, std::size_t c, std::size_t want, float& kth);
 
-/// The plain versions of the two, whatever the CPU (the tests compare them).
+/// The plain versions of the two, whatever the CPU (the tests compare them), and selectMean
+/// as a CPU without AVX-512 runs it (AVX2 where the CPU has it, else the plain version).
 std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, std::size_t n,
                               float qx, float qy, float qz, float t, float* cand);
 double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth);
+double selectMeanWithoutAvx512(float* cand, std::size_t c, std::size_t want, float& kth);
+
+/// selectMean by sorting networks (preprocess_outlier_sort.cpp) for want <= c <= 32, on a CPU
+/// with AVX-512F (the caller checks): the candidates sorted in two vectors of 16, the want
+/// smallest then taken by lane. cand is read, not reordered.
+double selectMeanSorted(const float* cand, std::size_t c, std::size_t want, float& kth);
+/// selectMeanSorted of two points at once (their networks interleaved: each waits on its own
+/// chain of steps, the two chains overlap), each with want <= c <= 32.
+void selectMeansSorted(const float* cand0, std::size_t c0, const float* cand1, std::size_t c1,
+                       std::size_t want, float& kth0, float& kth1, double& mean0,
+                       double& mean1);
+/// Whether selectMean is selectMeanSorted where c <= 32 (the CPU has AVX-512F), so that the
+/// outlier filter's search may take its points two at a time.
+bool selectsSorted();
+/// Where selectsSorted: the candidates cand[0, c) within the smallest of a few bounds around
+/// guess (a guess of the want-th) that keeps at least want of them, packed to the front in
+/// order; returns their number (c where no bound keeps want). Elsewhere c, cand unchanged.
+/// cand has room for c rounded up to a multiple of 8.
+std::size_t narrowCandidates(float* cand, std::size_t c, std::size_t want, float guess);
 
 /// The outlier filter's grid cells: of each point i = finite[f], f < n, the cell
 /// (cx, cy, cz)[f] of edge 1 / inv_h anchored at (ox, oy, oz): floor(double(x[i] - ox) * inv_h),

@@ -285,16 +285,35 @@ __attribute__((target("avx2,popcnt,bmi"))) double selectMeanAvx2(float* cand, st
   }
 }
 
-SelectMeanFn pickSelectMean() {
+// By the sorting networks where the candidates fit in their 32 lanes (many first narrowed as
+// selectMeanAvx2 narrows them), else by selectMeanAvx2.
+__attribute__((target("avx512f,avx2,popcnt,bmi"))) double selectMeanAvx512(float* cand,
+                                                                          std::size_t c,
+                                                                          std::size_t want,
+                                                                          float& kth) {
+  if (c > 32 && c - want > 16) c = narrowAvx2(cand, c, want, kth);
+  if (c <= 32) return selectMeanSorted(cand, c, want, kth);
+  return selectMeanAvx2(cand, c, want, kth);
+}
+
+bool hasAvx2Selection() {
   __builtin_cpu_init();
   // (The instructions its target names: AVX2, POPCNT and BMI's TZCNT.)
   return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt") &&
-                 __builtin_cpu_supports("bmi")
-             ? selectMeanAvx2
-             : selectMeanScalar;
+         __builtin_cpu_supports("bmi");
+}
+
+SelectMeanFn pickSelectMean() {
+  if (!hasAvx2Selection()) return selectMeanScalar;
+  return __builtin_cpu_supports("avx512f") ? selectMeanAvx512 : selectMeanAvx2;
+}
+
+SelectMeanFn pickSelectMeanWithoutAvx512() {
+  return hasAvx2Selection() ? selectMeanAvx2 : selectMeanScalar;
 }
 #else
 SelectMeanFn pickSelectMean() { return selectMeanScalar; }
+SelectMeanFn pickSelectMeanWithoutAvx512() { return selectMeanScalar; }
 #endif
 
 const SelectMeanFn pickedSelectMean = pickSelectMean();
@@ -406,6 +425,28 @@ std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, st
 
 double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth) {
   return selectMeanScalar(cand, c, want, kth);
+}
+
+std::size_t narrowCandidates(float* cand, std::size_t c, std::size_t want, float guess) {
+#if defined(__GNUC__) && defined(__x86_64__)
+  if (selectsSorted()) return narrowAvx2(cand, c, want, guess);
+#endif
+  (void)cand, (void)want, (void)guess;
+  return c;
+}
+
+bool selectsSorted() {
+#if defined(__GNUC__) && defined(__x86_64__)
+  static const bool sorted = pickedSelectMean == selectMeanAvx512;
+  return sorted;
+#else
+  return false;
+#endif
+}
+
+double selectMeanWithoutAvx512(float* cand, std::size_t c, std::size_t want, float& kth) {
+  static const SelectMeanFn picked = pickSelectMeanWithoutAvx512();
+  return picked(cand, c, want, kth);
 }
 
 UPD_VECTOR_CLONES

@@ -137,24 +137,36 @@ class CellSearch {
     grow(1);
   }
 
+  // meanOf of grid points q0 and q1 (of the current cell): where the first ring settles both
+  // with at most 32 candidates each, their selections by the sorting networks at once (on
+  // AVX-512: selectsSorted); else each point its own selection, or meanOf where the first ring
+  // does not settle it.
+  void meanOfTwo(std::uint32_t q0, std::uint32_t q1, double& mean0, double& mean1) {
+    const std::uint32_t q[2] = {q0, q1};  // (startCell built the first ring's block)
+    float* const cand[2] = {cand_.data(), cand2_.data()};
+    std::size_t c[2];
+    for (int i = 0; i < 2; ++i) {
+      c[i] = gather(q[i], 1, cand[i]);
+      // (Beyond the networks' 32 lanes: first narrowed near the previous point's k-th.)
+      if (c[i] > 32) c[i] = detail::narrowCandidates(cand[i], c[i], want_, kth_);
+    }
+    if (c[0] >= want_ && c[1] >= want_ && c[0] <= 32 && c[1] <= 32) {
+      float kth0 = 0.f;
+      detail::selectMeansSorted(cand[0], c[0], cand[1], c[1], want_, kth0, kth_, mean0, mean1);
+      return;
+    }
+    // (meanOf may grow the buffers: the second point's candidates are found again by data().)
+    mean0 = c[0] >= want_ ? detail::selectMean(cand_.data(), c[0], want_, kth_) : meanOf(q0);
+    mean1 = c[1] >= want_ ? detail::selectMean(cand2_.data(), c[1], want_, kth_) : meanOf(q1);
+  }
+
   // The mean distance of grid point q (of the current cell) to its k nearest, or NaN when they
   // lie beyond 3 rings (a lone point, a tiny cloud).
   double meanOf(std::uint32_t q) {
     const float qx = g_->x[q], qy = g_->y[q], qz = g_->z[q];
     for (int ring = 1; ring <= 2; ++ring) {
       if (built_ < ring) grow(ring);
-      const BlockPoints& b = block_[ring];
-      const double m = margin(qx, qy, qz, ring);
-      const auto m2 = static_cast<float>(m * m * (1 - 1e-6));
-      // The previous point's k-th distance, a little widened, mostly bounds this one's: fewer
-      // candidates to select from. Where it does not, the block's margin.
-      const float t = std::min(m2, kth_ * kTighten);
-      std::size_t c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.cap, qx, qy,
-                                           qz, t, cand_.data());
-      if (c < want_ && t < m2) {
-        c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.cap, qx, qy, qz, m2,
-                                 cand_.data());
-      }
+      const std::size_t c = gather(q, ring, cand_.data());
       if (c >= want_) return detail::selectMean(cand_.data(), c, want_, kth_);
     }
     // The third ring, cell by cell: a cell whose box lies beyond the k-th distance so far holds
@@ -218,7 +230,26 @@ class CellSearch {
     }
     block_[ring].fill(*g_, cells_);
     cand_.resize(std::max(cand_.size(), block_[ring].cap));
+    cand2_.resize(std::max(cand2_.size(), block_[ring].cap));
     built_ = ring;
+  }
+
+  // The squared distances from grid point q to the points of the block of `ring` (built)
+  // within a bound, into cand; returns their number. The previous point's k-th distance, a
+  // little widened, mostly bounds this one's: fewer candidates to select from. Where it does
+  // not, the block's margin (no point outside the block is nearer).
+  std::size_t gather(std::uint32_t q, int ring, float* cand) const {
+    const float qx = g_->x[q], qy = g_->y[q], qz = g_->z[q];
+    const BlockPoints& b = block_[ring];
+    const double m = margin(qx, qy, qz, ring);
+    const auto m2 = static_cast<float>(m * m * (1 - 1e-6));
+    const float t = std::min(m2, kth_ * kTighten);
+    std::size_t c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.cap, qx, qy, qz,
+                                         t, cand);
+    if (c < want_ && t < m2) {
+      c = detail::gatherWithin(b.x.data(), b.y.data(), b.z.data(), b.cap, qx, qy, qz, m2, cand);
+    }
+    return c;
   }
 
   static constexpr float kTighten = 1.3f;  // (1.14 times the distance)
@@ -231,7 +262,7 @@ class CellSearch {
   double lo_[4][3] = {}, hi_[4][3] = {};  // the current cell's blocks' bounds by ring (1 .. 3)
   std::vector<std::uint32_t> cells_, around_, ring3_;
   BlockPoints block_[3];
-  std::vector<float> bd2_, cand_, d2_;
+  std::vector<float> bd2_, cand_, cand2_, d2_;  // (cand2_: meanOfTwo's second point)
 };
 
 // The cells [c0, c1) of grid g by search: each point's mean distance into mean_dist, the
@@ -242,16 +273,23 @@ UPD_NOIPA void searchCells(CellSearch& search, const PointGrid& g,
                            std::size_t c0, std::size_t c1,
                            std::vector<double>& mean_dist,
                            std::vector<std::uint32_t>& rest) {
+  const auto store = [&](std::uint32_t q, double mean) {
+    if (std::isnan(mean)) {
+      rest.push_back(q);
+    } else {
+      mean_dist[g.index[q]] = mean;
+    }
+  };
+  const bool two = detail::selectsSorted();
   for (std::size_t c = c0; c < c1; ++c) {
     search.startCell(c);
-    for (std::uint32_t q = g.start[c]; q < g.start[c + 1]; ++q) {
-      const double mean = search.meanOf(q);
-      if (std::isnan(mean)) {
-        rest.push_back(q);
-      } else {
-        mean_dist[g.index[q]] = mean;
-      }
+    std::uint32_t q = g.start[c];
+    for (; two && q + 1 < g.start[c + 1]; q += 2) {
+      double mean0, mean1;
+      search.meanOfTwo(q, q + 1, mean0, mean1);
+      store(q, mean0), store(q + 1, mean1);
     }
+    for (; q < g.start[c + 1]; ++q) store(q, search.meanOf(q));
   }
 }
 
