@@ -101,8 +101,8 @@ void copyAllButPoints(const PointCloud& in, PointCloud& out);
 
 /// The outlier filter's candidates: the squared distances from (qx, qy, qz) to the n points
 /// (x, y, z)[j] (n a multiple of 8) that lie within t, in point order, into cand (room for n).
-/// Returns their number. On AVX2 a vector of distances at a time, its lanes within t packed to
-/// the front (no branch per point).
+/// Returns their number. On AVX2 (AVX-512) a vector of 8 (16) distances at a time, its lanes
+/// within t packed to the front (no branch per point).
 std::size_t gatherWithin(const float* x, const float* y, const float* z, std::size_t n, float qx,
                          float qy, float qz, float t, float* cand);
 
@@ -116,17 +116,24 @@ std::size_t gatherWithin(const float* x, const float* y, const float* z, std::si
 /// speed depends on it), then, if still many, a partial selection.
 double selectMean(float* cand, std::size_t c, std::size_t want, float& kth);
 
-/// The plain versions of the two, whatever the CPU (the tests compare them), and selectMean
-/// as a CPU without AVX-512 runs it (AVX2 where the CPU has it, else the plain version).
+/// The plain versions of the two, whatever the CPU (the tests compare them), and the two as a
+/// CPU without AVX-512 runs them (AVX2 where the CPU has it, else the plain versions).
 std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, std::size_t n,
                               float qx, float qy, float qz, float t, float* cand);
 double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth);
+std::size_t gatherWithinWithoutAvx512(const float* x, const float* y, const float* z,
+                                      std::size_t n, float qx, float qy, float qz, float t,
+                                      float* cand);
 double selectMeanWithoutAvx512(float* cand, std::size_t c, std::size_t want, float& kth);
 
-/// selectMean by sorting networks (preprocess_outlier_sort.cpp) for want <= c <= 32, on a CPU
+/// selectMean by sorting networks (preprocess_outlier_avx512.cpp) for want <= c <= 32, on a CPU
 /// with AVX-512F (the caller checks): the candidates sorted in two vectors of 16, the want
 /// smallest then taken by lane. cand is read, not reordered.
 double selectMeanSorted(const float* cand, std::size_t c, std::size_t want, float& kth);
+/// gatherWithin 16 candidates at a time, on a CPU with AVX-512F, FMA and POPCNT (the caller
+/// checks; preprocess_outlier_avx512.cpp): AVX2's distances, packed by a compress.
+std::size_t gatherWithinAvx512(const float* x, const float* y, const float* z, std::size_t n,
+                               float qx, float qy, float qz, float t, float* cand);
 /// selectMeanSorted of two points at once (their networks interleaved: each waits on its own
 /// chain of steps, the two chains overlap), each with want <= c <= 32.
 void selectMeansSorted(const float* cand0, std::size_t c0, const float* cand1, std::size_t c1,

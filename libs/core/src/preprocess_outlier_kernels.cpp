@@ -76,7 +76,7 @@ GatherWithinFn pickGatherWithin() {
   __builtin_cpu_init();
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
       __builtin_cpu_supports("popcnt")) {
-    return gatherWithinAvx2;
+    return __builtin_cpu_supports("avx512f") ? gatherWithinAvx512 : gatherWithinAvx2;
   }
   return gatherWithinScalar;
 }
@@ -85,6 +85,15 @@ GatherWithinFn pickGatherWithin() { return gatherWithinScalar; }
 #endif
 
 const GatherWithinFn pickedGatherWithin = pickGatherWithin();
+
+#if defined(__GNUC__) && defined(__x86_64__)
+GatherWithinFn pickGatherWithinWithoutAvx512() {
+  const GatherWithinFn picked = pickGatherWithin();
+  return picked == gatherWithinAvx512 ? gatherWithinAvx2 : picked;
+}
+#else
+GatherWithinFn pickGatherWithinWithoutAvx512() { return gatherWithinScalar; }
+#endif
 
 using SelectMeanFn = double (*)(float*, std::size_t, std::size_t, float&);
 
@@ -442,6 +451,13 @@ bool selectsSorted() {
 #else
   return false;
 #endif
+}
+
+std::size_t gatherWithinWithoutAvx512(const float* x, const float* y, const float* z,
+                                      std::size_t n, float qx, float qy, float qz, float t,
+                                      float* cand) {
+  static const GatherWithinFn picked = pickGatherWithinWithoutAvx512();
+  return picked(x, y, z, n, qx, qy, qz, t, cand);
 }
 
 double selectMeanWithoutAvx512(float* cand, std::size_t c, std::size_t want, float& kth) {

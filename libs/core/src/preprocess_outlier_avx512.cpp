@@ -1,4 +1,6 @@
-// The outlier filter's selection of the k nearest on AVX-512, by sorting networks: up to 32
+// The outlier filter's inner steps on AVX-512 (the versions for other CPUs are in
+// preprocess_outlier_kernels.cpp): the gathering of the candidates within a bound, 16 at a time
+// packed by a compress, and the selection of the k nearest by sorting networks: up to 32
 // candidates sorted in two vectors of 16 (bitonic networks, a permutation, a minimum, a maximum
 // and a blend a step), no branch and no chain of dependent maxima. The mean of the square roots
 // of the want smallest and the want-th are selectMean's (the roots in float, summed in double).
@@ -120,6 +122,35 @@ __attribute__((target("avx512f"))) inline double meanOfSorted(__m512 a, __m512 b
 
 }  // namespace
 
+__attribute__((target("avx512f,fma,popcnt"))) std::size_t gatherWithinAvx512(
+    const float* __restrict x, const float* __restrict y, const float* __restrict z,
+    std::size_t n, float qx, float qy, float qz, float t, float* __restrict cand) {
+  const __m512 vx = _mm512_set1_ps(qx), vy = _mm512_set1_ps(qy), vz = _mm512_set1_ps(qz);
+  const __m512 vt = _mm512_set1_ps(t);
+  std::size_t c = 0, j = 0;
+  // (The lanes of gatherWithinAvx2, the same arithmetic: the same distances bit for bit.)
+  for (; j + 16 <= n; j += 16) {
+    const __m512 dx = _mm512_sub_ps(_mm512_loadu_ps(x + j), vx);
+    const __m512 dy = _mm512_sub_ps(_mm512_loadu_ps(y + j), vy);
+    const __m512 dz = _mm512_sub_ps(_mm512_loadu_ps(z + j), vz);
+    const __m512 d2 = _mm512_fmadd_ps(dz, dz, _mm512_fmadd_ps(dy, dy, _mm512_mul_ps(dx, dx)));
+    const __mmask16 within = _mm512_cmp_ps_mask(d2, vt, _CMP_LE_OQ);
+    _mm512_storeu_ps(cand + c, _mm512_maskz_compress_ps(within, d2));
+    c += static_cast<std::size_t>(__builtin_popcount(within));
+  }
+  if (j < n) {  // (n is a multiple of 8: the last 8)
+    const __mmask16 eight = 0xFF;
+    const __m512 dx = _mm512_sub_ps(_mm512_maskz_loadu_ps(eight, x + j), vx);
+    const __m512 dy = _mm512_sub_ps(_mm512_maskz_loadu_ps(eight, y + j), vy);
+    const __m512 dz = _mm512_sub_ps(_mm512_maskz_loadu_ps(eight, z + j), vz);
+    const __m512 d2 = _mm512_fmadd_ps(dz, dz, _mm512_fmadd_ps(dy, dy, _mm512_mul_ps(dx, dx)));
+    const __mmask16 within = _mm512_mask_cmp_ps_mask(eight, d2, vt, _CMP_LE_OQ);
+    _mm512_mask_storeu_ps(cand + c, eight, _mm512_maskz_compress_ps(within, d2));
+    c += static_cast<std::size_t>(__builtin_popcount(within));
+  }
+  return c;
+}
+
 __attribute__((target("avx512f"))) double selectMeanSorted(const float* cand, std::size_t c,
                                                            std::size_t want, float& kth) {
   __m512 v[2];
@@ -148,7 +179,12 @@ __attribute__((target("avx512f"))) void selectMeansSorted(const float* cand0, st
 
 namespace upd::core::detail {
 
-// (Without the networks: selectsSorted is false, and these are not called; defined for the link.)
+// (Without AVX-512: selectsSorted is false, and these are not called; defined for the link.)
+std::size_t gatherWithinAvx512(const float* x, const float* y, const float* z, std::size_t n,
+                               float qx, float qy, float qz, float t, float* cand) {
+  return gatherWithinPlain(x, y, z, n, qx, qy, qz, t, cand);
+}
+
 double selectMeanSorted(const float* cand, std::size_t c, std::size_t want, float& kth) {
   std::vector<float> copy(cand, cand + c);
   return selectMeanPlain(copy.data(), c, want, kth);
