@@ -160,10 +160,11 @@ TEST(PreprocessKernels, SelectMeanWithTiesAmongTheDropped) {
   EXPECT_GT(tied, 700);
 }
 
-// The voxel grid's key pass on AVX2 against the plain loop: the same key for every point (NaN,
-// infinite, on the range's and the box's bounds, beyond the keys' range), the same answer on
-// whether every passing point's voxel fits the key, the same count of finite points, at every
-// length (the vector part and the rest).
+// The voxel grid's key pass on AVX-512 or AVX2 (the CPU's, and as a CPU without AVX-512 runs
+// it) against the plain loop: the same key for every point (NaN, infinite, on the range's and
+// the box's bounds, beyond the keys' range), the same answer on whether every passing point's
+// voxel fits the key, the same count of finite points, at every length (the vector part and the
+// rest).
 TEST(PreprocessKernels, VoxelKeysAreThePlainLoopsKeys) {
   std::mt19937 rng(13);
   std::uniform_real_distribution<float> u(-6.f, 6.f);
@@ -198,16 +199,23 @@ TEST(PreprocessKernels, VoxelKeysAreThePlainLoopsKeys) {
     for (std::size_t j = 0; j < n; ++j) {
       finite_want += std::isfinite(x[j]) && std::isfinite(y[j]) && std::isfinite(z[j]) ? 1 : 0;
     }
+    std::vector<std::uint64_t> narrow(n, 4);  // (as a CPU without AVX-512 computes them)
+    std::size_t finite_narrow = 3;
     const bool ok = detail::voxelKeys(x.data(), y.data(), z.data(), n, k, got.data(), finite);
+    const bool ok_narrow = detail::voxelKeysWithoutAvx512(x.data(), y.data(), z.data(), n, k,
+                                                          narrow.data(), finite_narrow);
     const bool ok_plain =
         detail::voxelKeysPlain(x.data(), y.data(), z.data(), n, k, want.data(), finite_plain);
     ASSERT_EQ(ok, ok_plain) << "trial " << trial;
+    ASSERT_EQ(ok_narrow, ok_plain) << "trial " << trial;
     ASSERT_EQ(finite, finite_want) << "trial " << trial;
+    ASSERT_EQ(finite_narrow, finite_want) << "trial " << trial;
     ASSERT_EQ(finite_plain, finite_want) << "trial " << trial;
     refused += ok ? 0 : 1;
     if (!ok) continue;  // (the caller throws: the keys are not used)
     for (std::size_t j = 0; j < n; ++j) {
       ASSERT_EQ(got[j], want[j]) << "trial " << trial << ", point " << j;
+      ASSERT_EQ(narrow[j], want[j]) << "trial " << trial << ", point " << j << ", no AVX-512";
       passed += want[j] != detail::kNoKey ? 1 : 0;
     }
   }

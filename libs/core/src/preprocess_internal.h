@@ -74,10 +74,13 @@ struct KeyPassParams {
 /// The voxel key of each of the n points (x, y, z) that passes (finite, kept by the range and
 /// box tests, each in RangeBoxTest's arithmetic) into keys, kNoKey for the others; the number
 /// of finite points among them added to finite. Returns false when a passing point's voxel lies
-/// beyond the keys' range. On AVX2 by intrinsics, 8 points at a time; voxelKeysPlain is the
-/// compiler's vectorization of the plain loop, whatever the CPU.
+/// beyond the keys' range. By intrinsics, 8 points at a time on AVX2, 16 on AVX-512;
+/// voxelKeysPlain is the compiler's vectorization of the plain loop, whatever the CPU, and
+/// voxelKeysWithoutAvx512 the version a CPU without AVX-512 runs (the tests compare them).
 bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
                const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
+bool voxelKeysWithoutAvx512(const float* x, const float* y, const float* z, std::size_t n,
+                            const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
 bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t n,
                     const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
 

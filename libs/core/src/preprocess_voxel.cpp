@@ -1,6 +1,6 @@
 // The voxel grid's and the cut-off's vector kernels: the cut-off test and the voxel key of
-// every point of a row in a vector loop (on AVX2 by intrinsics, 8 points at a time), and the
-// cut-off's copy of an organized frame. Their keys and tests are cropRange's, bit for bit (this
+// every point of a row in a vector loop (by intrinsics: 8 points at a time on AVX2, 16 on
+// AVX-512), and the cut-off's copy of an organized frame. Their keys and tests are cropRange's, bit for bit (this
 // file is built without contracting a multiply and an add into one rounding, so that the vector
 // loop's range test is cropRange's). The sums are in preprocess_voxel_sums.cpp.
 #include <algorithm>
@@ -214,12 +214,108 @@ __attribute__((target("avx2,popcnt"))) bool voxelKeysAvx2(const float* __restric
   return rest && _mm256_testz_si256(bad, bad);
 }
 
+// (GCC 12.2 warns that the unmasked AVX-512 intrinsics read an uninitialized value: their
+// pass-through operand is _mm512_undefined_pd() by design; a false positive.)
+#pragma GCC diagnostic push
+#if !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+// cellCoords4 of 8 lanes on AVX-512: the same clamp (a NaN lane takes -2^30, max's second
+// operand), floor and truncation, in 8 doubles.
+__attribute__((target("avx512f"))) inline __m256i cellCoords8(__m256 h, double ref, double inv) {
+  const __m512d lim = _mm512_set1_pd(1073741824.0), nlim = _mm512_set1_pd(-1073741824.0);
+  const __m512d v = _mm512_mul_pd(_mm512_sub_pd(_mm512_cvtps_pd(h), _mm512_set1_pd(ref)),
+                                  _mm512_set1_pd(inv));
+  const __m512d c = _mm512_min_pd(_mm512_max_pd(v, nlim), lim);
+  return _mm512_cvttpd_epi32(_mm512_roundscale_pd(c, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+}
+
+// The range test of 8 lanes (offsets from the origin in float), rangeMask4's arithmetic.
+__attribute__((target("avx512f"))) inline __mmask8 rangeMask8(__m256 hx, __m256 hy, __m256 hz,
+                                                             const KeyPassParams& k) {
+  const __m512d sx = _mm512_cvtps_pd(hx), sy = _mm512_cvtps_pd(hy), sz = _mm512_cvtps_pd(hz);
+  const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(sx, sx), _mm512_mul_pd(sy, sy)),
+                                   _mm512_mul_pd(sz, sz));
+  return _mm512_cmp_pd_mask(d2, _mm512_set1_pd(k.rmin2), _CMP_GE_OQ) &
+         _mm512_cmp_pd_mask(d2, _mm512_set1_pd(k.rmax2), _CMP_LE_OQ);
+}
+
+// The 8 keys of half h of 16 points (f: their coordinates, pass: the 8 lanes' tests), kNoKey
+// where a lane fails; the lanes whose keys overflow added to bad.
+__attribute__((target("avx512f,avx512vl,avx512dq"))) inline __m512i keys8(const __m512 (&f)[3], int h,
+                                                       const KeyPassParams& k, __mmask8 pass,
+                                                       __mmask8& bad) {
+  const double ref[3] = {k.ref_x, k.ref_y, k.ref_z};
+  const __m256i lo = _mm256_set1_epi32(-static_cast<std::int32_t>(kKeyBias) - 1);
+  const __m256i hi = _mm256_set1_epi32(static_cast<std::int32_t>(kKeyBias));
+  __mmask8 fits = 0xFF;
+  __m512i key = _mm512_setzero_si512();
+  for (int a = 0; a < 3; ++a) {
+    const __m256 half = h ? _mm512_extractf32x8_ps(f[a], 1) : _mm512_castps512_ps256(f[a]);
+    const __m256i c = cellCoords8(half, ref[a], k.inv);
+    fits &= _mm256_cmpgt_epi32_mask(c, lo) & _mm256_cmpgt_epi32_mask(hi, c);
+    const __m512i u = _mm512_cvtepu32_epi64(_mm256_add_epi32(c, hi));
+    key = _mm512_or_si512(key, _mm512_slli_epi64(u, static_cast<unsigned>(21 * a)));
+  }
+  bad |= static_cast<__mmask8>(pass & ~fits);
+  return _mm512_mask_blend_epi64(pass, _mm512_set1_epi64(static_cast<long long>(kNoKey)), key);
+}
+
+// voxelKeys on AVX-512, 16 points at a time (the rest by the loop): voxelKeysAvx2's tests and
+// arithmetic in wider vectors, so the same keys.
+__attribute__((target("avx512f,avx512vl,avx512dq,popcnt"))) bool voxelKeysAvx512(
+    const float* __restrict x, const float* __restrict y, const float* __restrict z,
+    std::size_t n, const KeyPassParams& k, std::uint64_t* __restrict keys, std::size_t& finite) {
+  const __m512 maxf = _mm512_set1_ps(std::numeric_limits<float>::max());
+  const __m512 b0[3] = {_mm512_set1_ps(k.bx0), _mm512_set1_ps(k.by0), _mm512_set1_ps(k.bz0)};
+  const __m512 b1[3] = {_mm512_set1_ps(k.bx1), _mm512_set1_ps(k.by1), _mm512_set1_ps(k.bz1)};
+  const __m512 o[3] = {_mm512_set1_ps(k.ox), _mm512_set1_ps(k.oy), _mm512_set1_ps(k.oz)};
+  __mmask8 bad = 0;
+  std::size_t finite_count = 0;
+  const std::size_t n16 = n / 16 * 16;
+  for (std::size_t j = 0; j < n16; j += 16) {
+    const __m512 f[3] = {_mm512_loadu_ps(x + j), _mm512_loadu_ps(y + j), _mm512_loadu_ps(z + j)};
+    __mmask16 fin = 0xFFFF, ok = 0xFFFF;
+    __m512 d[3];
+    for (int a = 0; a < 3; ++a) {
+      fin &= _mm512_cmp_ps_mask(_mm512_abs_ps(f[a]), maxf, _CMP_LE_OQ);
+      ok &= _mm512_cmp_ps_mask(f[a], b0[a], _CMP_GE_OQ) & _mm512_cmp_ps_mask(f[a], b1[a], _CMP_LE_OQ);
+      d[a] = _mm512_sub_ps(f[a], o[a]);
+    }
+    finite_count += static_cast<std::size_t>(__builtin_popcount(fin));
+    const __mmask16 range =
+        static_cast<__mmask16>(rangeMask8(_mm512_castps512_ps256(d[0]), _mm512_castps512_ps256(d[1]),
+                                          _mm512_castps512_ps256(d[2]), k) |
+                               rangeMask8(_mm512_extractf32x8_ps(d[0], 1), _mm512_extractf32x8_ps(d[1], 1),
+                                          _mm512_extractf32x8_ps(d[2], 1), k) << 8);
+    ok &= fin & range;
+    if (ok == 0) {  // (none passes, as in the NaN holes and beyond the range)
+      const __m512i none = _mm512_set1_epi64(static_cast<long long>(kNoKey));
+      _mm512_storeu_si512(keys + j, none), _mm512_storeu_si512(keys + j + 8, none);
+      continue;
+    }
+    for (int h = 0; h < 2; ++h) {
+      _mm512_storeu_si512(keys + j + 8 * h,
+                          keys8(f, h, k, static_cast<__mmask8>(ok >> (8 * h)), bad));
+    }
+  }
+  finite += finite_count;
+  const bool rest = voxelKeysAvx2(x + n16, y + n16, z + n16, n - n16, k, keys + n16, finite);
+  return rest && bad == 0;
+}
+
+#pragma GCC diagnostic pop
+
 using VoxelKeysFn = bool (*)(const float*, const float*, const float*, std::size_t,
                              const KeyPassParams&, std::uint64_t*, std::size_t&);
 VoxelKeysFn pickVoxelKeys() {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt") ? voxelKeysAvx2
-                                                                            : voxelKeysLoop;
+  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("popcnt")) return voxelKeysLoop;
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                 __builtin_cpu_supports("avx512dq")
+             ? voxelKeysAvx512
+             : voxelKeysAvx2;
 }
 #else
 using VoxelKeysFn = bool (*)(const float*, const float*, const float*, std::size_t,
@@ -284,6 +380,14 @@ const CropCopyFn pickedCropCopy = pickCropCopy();
 
 bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
                const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite) {
+  return pickedVoxelKeys(x, y, z, n, k, keys, finite);
+}
+
+bool voxelKeysWithoutAvx512(const float* x, const float* y, const float* z, std::size_t n,
+                            const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite) {
+#if defined(__GNUC__) && defined(__x86_64__)
+  if (pickedVoxelKeys == voxelKeysAvx512) return voxelKeysAvx2(x, y, z, n, k, keys, finite);
+#endif
   return pickedVoxelKeys(x, y, z, n, k, keys, finite);
 }
 
