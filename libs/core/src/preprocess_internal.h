@@ -90,11 +90,14 @@ KeyPassParams rangeBoxBounds(const PreprocessParams* p, const Eigen::Vector3f& s
 
 /// The range and box cut of n points (x, y, z) into (ox, oy, oz): a point that passes (finite,
 /// kept by the range and box tests of k, each in RangeBoxTest's arithmetic) is copied, any
-/// other becomes NaN; cropRange's points of an organized cloud. One pass, on AVX2 by
-/// intrinsics 8 points at a time; cropCopyPlain is the plain loop, whatever the CPU. The output
-/// arrays must not overlap the input ones.
+/// other becomes NaN; cropRange's points of an organized cloud. One pass, by intrinsics 8
+/// points at a time on AVX2, 16 on AVX-512; cropCopyPlain is the plain loop, whatever the CPU,
+/// and cropCopyWithoutAvx512 the version a CPU without AVX-512 runs. The output arrays must not
+/// overlap the input ones.
 CropCounts cropCopy(const float* x, const float* y, const float* z, std::size_t n,
                     const KeyPassParams& k, float* ox, float* oy, float* oz);
+CropCounts cropCopyWithoutAvx512(const float* x, const float* y, const float* z, std::size_t n,
+                                 const KeyPassParams& k, float* ox, float* oy, float* oz);
 CropCounts cropCopyPlain(const float* x, const float* y, const float* z, std::size_t n,
                          const KeyPassParams& k, float* ox, float* oy, float* oz);
 
