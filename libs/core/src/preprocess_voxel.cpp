@@ -241,6 +241,31 @@ __attribute__((target("avx512f"))) inline __mmask8 rangeMask8(__m256 hx, __m256 
          _mm512_cmp_pd_mask(d2, _mm512_set1_pd(k.rmax2), _CMP_LE_OQ);
 }
 
+// The tests of 16 points on AVX-512: fin, all three coordinates finite; pass, finite and kept
+// by the box and range tests (voxelKeysAvx2's tests, lane for lane).
+struct Tests16 {
+  __mmask16 fin, pass;
+};
+__attribute__((target("avx512f,avx512vl,avx512dq"))) inline Tests16 tests16(const __m512 (&f)[3],
+                                                                           const KeyPassParams& k) {
+  const __m512 maxf = _mm512_set1_ps(std::numeric_limits<float>::max());
+  const float b0[3] = {k.bx0, k.by0, k.bz0}, b1[3] = {k.bx1, k.by1, k.bz1}, o[3] = {k.ox, k.oy, k.oz};
+  __mmask16 fin = 0xFFFF, pass = 0xFFFF;
+  __m512 d[3];
+  for (int a = 0; a < 3; ++a) {
+    fin &= _mm512_cmp_ps_mask(_mm512_abs_ps(f[a]), maxf, _CMP_LE_OQ);
+    pass &= _mm512_cmp_ps_mask(f[a], _mm512_set1_ps(b0[a]), _CMP_GE_OQ) &
+            _mm512_cmp_ps_mask(f[a], _mm512_set1_ps(b1[a]), _CMP_LE_OQ);
+    d[a] = _mm512_sub_ps(f[a], _mm512_set1_ps(o[a]));
+  }
+  const auto range = static_cast<__mmask16>(
+      rangeMask8(_mm512_castps512_ps256(d[0]), _mm512_castps512_ps256(d[1]),
+                 _mm512_castps512_ps256(d[2]), k) |
+      rangeMask8(_mm512_extractf32x8_ps(d[0], 1), _mm512_extractf32x8_ps(d[1], 1),
+                 _mm512_extractf32x8_ps(d[2], 1), k) << 8);
+  return {fin, static_cast<__mmask16>(pass & fin & range)};
+}
+
 // The 8 keys of half h of 16 points (f: their coordinates, pass: the 8 lanes' tests), kNoKey
 // where a lane fails; the lanes whose keys overflow added to bad.
 __attribute__((target("avx512f,avx512vl,avx512dq"))) inline __m512i keys8(const __m512 (&f)[3], int h,
@@ -267,29 +292,14 @@ __attribute__((target("avx512f,avx512vl,avx512dq"))) inline __m512i keys8(const 
 __attribute__((target("avx512f,avx512vl,avx512dq,popcnt"))) bool voxelKeysAvx512(
     const float* __restrict x, const float* __restrict y, const float* __restrict z,
     std::size_t n, const KeyPassParams& k, std::uint64_t* __restrict keys, std::size_t& finite) {
-  const __m512 maxf = _mm512_set1_ps(std::numeric_limits<float>::max());
-  const __m512 b0[3] = {_mm512_set1_ps(k.bx0), _mm512_set1_ps(k.by0), _mm512_set1_ps(k.bz0)};
-  const __m512 b1[3] = {_mm512_set1_ps(k.bx1), _mm512_set1_ps(k.by1), _mm512_set1_ps(k.bz1)};
-  const __m512 o[3] = {_mm512_set1_ps(k.ox), _mm512_set1_ps(k.oy), _mm512_set1_ps(k.oz)};
   __mmask8 bad = 0;
   std::size_t finite_count = 0;
   const std::size_t n16 = n / 16 * 16;
   for (std::size_t j = 0; j < n16; j += 16) {
     const __m512 f[3] = {_mm512_loadu_ps(x + j), _mm512_loadu_ps(y + j), _mm512_loadu_ps(z + j)};
-    __mmask16 fin = 0xFFFF, ok = 0xFFFF;
-    __m512 d[3];
-    for (int a = 0; a < 3; ++a) {
-      fin &= _mm512_cmp_ps_mask(_mm512_abs_ps(f[a]), maxf, _CMP_LE_OQ);
-      ok &= _mm512_cmp_ps_mask(f[a], b0[a], _CMP_GE_OQ) & _mm512_cmp_ps_mask(f[a], b1[a], _CMP_LE_OQ);
-      d[a] = _mm512_sub_ps(f[a], o[a]);
-    }
-    finite_count += static_cast<std::size_t>(__builtin_popcount(fin));
-    const __mmask16 range =
-        static_cast<__mmask16>(rangeMask8(_mm512_castps512_ps256(d[0]), _mm512_castps512_ps256(d[1]),
-                                          _mm512_castps512_ps256(d[2]), k) |
-                               rangeMask8(_mm512_extractf32x8_ps(d[0], 1), _mm512_extractf32x8_ps(d[1], 1),
-                                          _mm512_extractf32x8_ps(d[2], 1), k) << 8);
-    ok &= fin & range;
+    const Tests16 t = tests16(f, k);
+    finite_count += static_cast<std::size_t>(__builtin_popcount(t.fin));
+    const __mmask16 ok = t.pass;
     if (ok == 0) {  // (none passes, as in the NaN holes and beyond the range)
       const __m512i none = _mm512_set1_epi64(static_cast<long long>(kNoKey));
       _mm512_storeu_si512(keys + j, none), _mm512_storeu_si512(keys + j + 8, none);
@@ -372,31 +382,15 @@ __attribute__((target("avx512f,avx512vl,avx512dq,popcnt"))) CropCounts cropCopyA
     const float* __restrict x, const float* __restrict y, const float* __restrict z,
     std::size_t n, const KeyPassParams& k, float* __restrict ox, float* __restrict oy,
     float* __restrict oz) {
-  const __m512 maxf = _mm512_set1_ps(std::numeric_limits<float>::max());
   const __m512 nan = _mm512_set1_ps(std::numeric_limits<float>::quiet_NaN());
-  const __m512 b0[3] = {_mm512_set1_ps(k.bx0), _mm512_set1_ps(k.by0), _mm512_set1_ps(k.bz0)};
-  const __m512 b1[3] = {_mm512_set1_ps(k.bx1), _mm512_set1_ps(k.by1), _mm512_set1_ps(k.bz1)};
-  const __m512 o[3] = {_mm512_set1_ps(k.ox), _mm512_set1_ps(k.oy), _mm512_set1_ps(k.oz)};
   float* const out[3] = {ox, oy, oz};
   std::size_t finite_count = 0, kept = 0;
   const std::size_t n16 = n / 16 * 16;
   for (std::size_t j = 0; j < n16; j += 16) {
     const __m512 f[3] = {_mm512_loadu_ps(x + j), _mm512_loadu_ps(y + j), _mm512_loadu_ps(z + j)};
-    __mmask16 fin = 0xFFFF, pass = 0xFFFF;
-    __m512 d[3];
-    for (int a = 0; a < 3; ++a) {
-      fin &= _mm512_cmp_ps_mask(_mm512_abs_ps(f[a]), maxf, _CMP_LE_OQ);
-      pass &= _mm512_cmp_ps_mask(f[a], b0[a], _CMP_GE_OQ) &
-              _mm512_cmp_ps_mask(f[a], b1[a], _CMP_LE_OQ);
-      d[a] = _mm512_sub_ps(f[a], o[a]);
-    }
-    const auto range = static_cast<__mmask16>(
-        rangeMask8(_mm512_castps512_ps256(d[0]), _mm512_castps512_ps256(d[1]),
-                   _mm512_castps512_ps256(d[2]), k) |
-        rangeMask8(_mm512_extractf32x8_ps(d[0], 1), _mm512_extractf32x8_ps(d[1], 1),
-                   _mm512_extractf32x8_ps(d[2], 1), k) << 8);
-    pass &= fin & range;
-    finite_count += static_cast<std::size_t>(__builtin_popcount(fin));
+    const Tests16 t = tests16(f, k);
+    const __mmask16 pass = t.pass;
+    finite_count += static_cast<std::size_t>(__builtin_popcount(t.fin));
     kept += static_cast<std::size_t>(__builtin_popcount(pass));
     for (int a = 0; a < 3; ++a) _mm512_storeu_ps(out[a] + j, _mm512_mask_blend_ps(pass, nan, f[a]));
   }
