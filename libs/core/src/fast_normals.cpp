@@ -351,21 +351,21 @@ Moments gaussianMoments(const std::vector<float>& cx, const std::vector<float>& 
   return m;
 }
 
-// The unit covariances of a thread's points, solved a batch at a time
-// (detail::normalsFromUnitCovariances) and written, oriented, to their cloud indices.
+// The moments of a thread's points' neighbourhoods, solved a batch at a time
+// (detail::normalsFromMoments) and written, oriented, to their cloud indices.
 class NormalBatch {
  public:
-  // Adds the neighbourhood of point i; false when its covariance has no spread.
-  bool add(const Moments& m, std::size_t i) {
-    if (!detail::unitCovariance(m, cov_[size_])) return false;
+  // Adds the neighbourhood of point i (one without spread fails at the flush).
+  void add(const Moments& m, std::size_t i) {
+    const double f[10] = {m.n, m.x, m.y, m.z, m.xx, m.xy, m.xz, m.yy, m.yz, m.zz};
+    for (std::size_t k = 0; k < 10; ++k) moments_[k][size_] = f[k];
     index_[size_++] = i;
-    return true;
   }
   bool full() const { return size_ == kSize; }
   // Solves and writes the batch; returns the number of points without a normal.
   template <class Orient>
   std::size_t flush(const PointCloud& cloud, const Orient& orient, Normals& out) {
-    detail::normalsFromUnitCovariances(cov_, size_, n_, curvature_, ok_);
+    detail::normalsFromMoments(&moments_[0][0], kSize, size_, n_, curvature_, ok_);
     std::size_t failed = 0;
     for (std::size_t b = 0; b < size_; ++b) {
       const std::size_t i = index_[b];
@@ -382,7 +382,7 @@ class NormalBatch {
  private:
   static constexpr std::size_t kSize = 64;
   std::size_t size_ = 0;
-  double cov_[kSize][6];
+  double moments_[10][kSize];  // (by field, in Moments' order)
   std::size_t index_[kSize];
   Eigen::Vector3f n_[kSize];
   float curvature_[kSize];
@@ -432,10 +432,11 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
                      : detail::gatedMoments(cx.data(), cy.data(), cz.data(), n_rows, 0, 0, 0,
                                             n_candidates - 1, 1, p.x(), p.y(), p.z(), radius2);
         if (!gaussian) count = static_cast<std::size_t>(m.n);
-        if (count < 3 || !batch.add(m, g.points.order[s])) {
+        if (count < 3) {
           ++invalid;
           continue;
         }
+        batch.add(m, g.points.order[s]);
         if (batch.full()) invalid += batch.flush(cloud, orient, out);
       }
     }

@@ -62,22 +62,21 @@ UPD_AVX2 __m256d settle(__m256d B00, __m256d B01, __m256d B02, __m256d B11, __m2
   return fail;
 }
 
-// Four covariances from cov[i0 ...]: ok[i] = 1 and n, curvature where the common path settles
-// them, else ok[i] = 2 (the caller asks the scalar function).
-UPD_AVX2 void fourNormals(const double (*cov)[6], std::size_t i0, Eigen::Vector3f* n_out,
-                          float* curvature_out, std::uint8_t* ok) {
-  alignas(32) double e6[6][4];
-  for (int l = 0; l < 4; ++l) {
-    for (int k = 0; k < 6; ++k) e6[k][l] = cov[i0 + static_cast<std::size_t>(l)][k];
-  }
-  const __m256d a = _mm256_load_pd(e6[0]), b = _mm256_load_pd(e6[1]), c = _mm256_load_pd(e6[2]),
-                d = _mm256_load_pd(e6[3]), e = _mm256_load_pd(e6[4]), f = _mm256_load_pd(e6[5]);
+// The common path of normalFromUnitCovariance for four covariances (a .. f: the upper
+// triangles' entries by lane): the unit normal (vx, vy, vz) and curvature l0 of the lanes of
+// good (on entry the lanes to solve; on return those the common path settles).
+struct FourNormals {
+  __m256d vx, vy, vz, l0, good;
+};
+
+UPD_AVX2 FourNormals fourNormalsOf(__m256d a, __m256d b, __m256d c, __m256d d, __m256d e,
+                                   __m256d f, __m256d good) {
   const __m256d one = _mm256_set1_pd(1.0), two = _mm256_set1_pd(2.0);
   const __m256d A00 = d * f - e * e, A01 = c * e - b * f, A02 = b * e - c * d;
   const __m256d A11 = a * f - c * c, A12 = b * c - a * e, A22 = a * d - b * b;
   const __m256d adj_norm2 =
       A00 * A00 + A11 * A11 + A22 * A22 + two * (A01 * A01 + A02 * A02 + A12 * A12);
-  __m256d good = gt(adj_norm2, _mm256_set1_pd(1e-20));
+  good = _mm256_and_pd(good, gt(adj_norm2, _mm256_set1_pd(1e-20)));
   const __m256d B00 = A00 * A00 + A01 * A01 + A02 * A02;
   const __m256d B01 = A00 * A01 + A01 * A11 + A02 * A12;
   const __m256d B02 = A00 * A02 + A01 * A12 + A02 * A22;
@@ -116,14 +115,21 @@ UPD_AVX2 void fourNormals(const double (*cov)[6], std::size_t i0, Eigen::Vector3
   good = _mm256_andnot_pd(settle(B00, B01, B02, B11, B12, B22, good, vx, vy, vz), good);
   const __m256d l0 = maxZero(vx * (a * vx + b * vy + c * vz) + vy * (b * vx + d * vy + e * vz) +
                              vz * (c * vx + e * vy + f * vz));
+  return {vx, vy, vz, l0, good};
+}
+
+// The lanes of r into n_out, curvature_out and ok from i0 on: ok 1 where settled (the lanes of
+// r.good), else `otherwise`.
+UPD_AVX2 void storeFour(const FourNormals& r, std::size_t i0, Eigen::Vector3f* n_out,
+                        float* curvature_out, std::uint8_t* ok, const std::uint8_t* otherwise) {
   alignas(32) double ox[4], oy[4], oz[4], ol0[4];
-  _mm256_store_pd(ox, vx), _mm256_store_pd(oy, vy), _mm256_store_pd(oz, vz);
-  _mm256_store_pd(ol0, l0);
-  const int mask = _mm256_movemask_pd(good);
+  _mm256_store_pd(ox, r.vx), _mm256_store_pd(oy, r.vy), _mm256_store_pd(oz, r.vz);
+  _mm256_store_pd(ol0, r.l0);
+  const int mask = _mm256_movemask_pd(r.good);
   for (int l = 0; l < 4; ++l) {
     const std::size_t i = i0 + static_cast<std::size_t>(l);
     if (!(mask & (1 << l))) {
-      ok[i] = 2;
+      ok[i] = otherwise[l];
       continue;
     }
     n_out[i] = Eigen::Vector3f(static_cast<float>(ox[l]), static_cast<float>(oy[l]),
@@ -131,6 +137,46 @@ UPD_AVX2 void fourNormals(const double (*cov)[6], std::size_t i0, Eigen::Vector3
     curvature_out[i] = static_cast<float>(ol0[l]);
     ok[i] = 1;
   }
+}
+
+// Four covariances from cov[i0 ...]: ok[i] = 1 and n, curvature where the common path settles
+// them, else ok[i] = 2 (the caller asks the scalar function).
+UPD_AVX2 void fourNormals(const double (*cov)[6], std::size_t i0, Eigen::Vector3f* n_out,
+                          float* curvature_out, std::uint8_t* ok) {
+  alignas(32) double e6[6][4];
+  for (int l = 0; l < 4; ++l) {
+    for (int k = 0; k < 6; ++k) e6[k][l] = cov[i0 + static_cast<std::size_t>(l)][k];
+  }
+  const FourNormals r = fourNormalsOf(
+      _mm256_load_pd(e6[0]), _mm256_load_pd(e6[1]), _mm256_load_pd(e6[2]), _mm256_load_pd(e6[3]),
+      _mm256_load_pd(e6[4]), _mm256_load_pd(e6[5]), _mm256_castsi256_pd(_mm256_set1_epi64x(-1)));
+  const std::uint8_t scalar[4] = {2, 2, 2, 2};
+  storeFour(r, i0, n_out, curvature_out, ok, scalar);
+}
+
+// Four neighbourhoods' moments from rows m (field k of neighbourhood i at m[k * stride + i]):
+// unitCovariance's arithmetic lane by lane, then fourNormalsOf; ok[i] = 0 where the moments
+// have no spread, 2 where the common path does not settle them.
+UPD_AVX2 void fourNormalsFromMoments(const double* m, std::size_t stride, std::size_t i0,
+                                     Eigen::Vector3f* n_out, float* curvature_out,
+                                     std::uint8_t* ok) {
+  __m256d v[10];
+  for (int k = 0; k < 10; ++k) v[k] = _mm256_loadu_pd(m + static_cast<std::size_t>(k) * stride + i0);
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+  const __m256d inv = one / v[0];
+  const __m256d mx = v[1] * inv, my = v[2] * inv, mz = v[3] * inv;
+  const __m256d a = v[4] * inv - mx * mx, b = v[5] * inv - mx * my, c = v[6] * inv - mx * mz;
+  const __m256d d = v[7] * inv - my * my, e = v[8] * inv - my * mz, f = v[9] * inv - mz * mz;
+  const __m256d trace = a + d + f;
+  const __m256d spread = _mm256_and_pd(gt(v[0], zero), gt(trace, zero));
+  const __m256d s = one / trace;
+  const FourNormals r = fourNormalsOf(a * s, b * s, c * s, d * s, e * s, f * s, spread);
+  const int has = _mm256_movemask_pd(spread);
+  const std::uint8_t otherwise[4] = {static_cast<std::uint8_t>(has & 1 ? 2 : 0),
+                                     static_cast<std::uint8_t>(has & 2 ? 2 : 0),
+                                     static_cast<std::uint8_t>(has & 4 ? 2 : 0),
+                                     static_cast<std::uint8_t>(has & 8 ? 2 : 0)};
+  storeFour(r, i0, n_out, curvature_out, ok, otherwise);
 }
 
 bool haveAvx2() {
@@ -141,6 +187,27 @@ const bool kHaveAvx2 = haveAvx2();
 #endif
 
 }  // namespace
+
+void normalsFromMoments(const double* m, std::size_t stride, std::size_t count,
+                        Eigen::Vector3f* n, float* curvature, std::uint8_t* ok) {
+  const auto scalar = [&](std::size_t i) {
+    Moments mi;
+    double* const f[10] = {&mi.n, &mi.x, &mi.y, &mi.z, &mi.xx, &mi.xy, &mi.xz, &mi.yy, &mi.yz, &mi.zz};
+    for (std::size_t k = 0; k < 10; ++k) *f[k] = m[k * stride + i];
+    double cov[6];
+    return unitCovariance(mi, cov) && normalFromUnitCovariance(cov, n[i], curvature[i]);
+  };
+  std::size_t i = 0;
+#if defined(__GNUC__) && defined(__x86_64__)
+  if (kHaveAvx2) {
+    for (; i + 4 <= count; i += 4) fourNormalsFromMoments(m, stride, i, n, curvature, ok);
+    for (std::size_t j = 0; j < i; ++j) {
+      if (ok[j] == 2) ok[j] = scalar(j) ? 1 : 0;
+    }
+  }
+#endif
+  for (; i < count; ++i) ok[i] = scalar(i) ? 1 : 0;
+}
 
 void normalsFromUnitCovariances(const double (*cov)[6], std::size_t count, Eigen::Vector3f* n,
                                 float* curvature, std::uint8_t* ok) {

@@ -43,6 +43,13 @@ bool normalFromUnitCovariance(const double (&cov)[6], Eigen::Vector3f& n, float&
 void normalsFromUnitCovariances(const double (*cov)[6], std::size_t count, Eigen::Vector3f* n,
                                 float* curvature, std::uint8_t* ok);
 
+// unitCovariance and normalFromUnitCovariance of count neighbourhoods' moments given as rows
+// (field k of neighbourhood i at m[k * stride + i], in Moments' order n, x, y, z, xx, xy, xz,
+// yy, yz, zz): ok[i] is 1 where both succeed, with n[i] and curvature[i], else 0. The same values
+// bit for bit, four at a time on AVX2.
+void normalsFromMoments(const double* m, std::size_t stride, std::size_t count,
+                        Eigen::Vector3f* n, float* curvature, std::uint8_t* ok);
+
 // The angular pitch of the sensor per column (along_u: the angle between the rays of columns
 // u and u + 1) and per row [rad], from the ranges of an organized cloud
 // (fast_normals_pitch.cpp); empty when too few neighbouring pixels have a range.
