@@ -1,5 +1,6 @@
-// The batched PCA normals (normalsFromUnitCovariances and normalsFromMoments, four at a time on
-// AVX2) give the scalar normalFromUnitCovariance's answers bit for bit: the same validity, normal and curvature, on
+// The batched PCA normals (normalsFromUnitCovariances and normalsFromMoments, eight at a time on
+// AVX-512, four on AVX2, and each as a CPU without AVX-512 runs it) give the scalar
+// normalFromUnitCovariance's answers bit for bit: the same validity, normal and curvature, on
 // planes with noise, rounded edges, lines, isotropic blobs and degenerate covariances, in
 // batches of every length (the vector lanes and the scalar tail). Fixed seeds.
 #include <gtest/gtest.h>
@@ -87,19 +88,23 @@ TEST(FastNormalsBatch, BatchedNormalsAreTheScalarOnesBitForBit) {
   }
   const auto* cov = reinterpret_cast<const double(*)[6]>(flat.data());
   int valid = 0, invalid = 0;
-  // Batches of every length from 0 to 13, then the whole set at once.
+  // Batches of every length from 0 to 13 (the 8 lanes, the 4 and the scalar tail), then the
+  // whole set at once.
   std::size_t begin = 0;
   for (std::size_t len = 0; begin < covs.size(); len = len == 13 ? covs.size() : len + 1) {
     const std::size_t count = std::min(len, covs.size() - begin);
-    std::vector<Eigen::Vector3f> n(count);
-    std::vector<float> curvature(count);
-    std::vector<std::uint8_t> ok(count, 7);
-    detail::normalsFromUnitCovariances(cov + begin, count, n.data(), curvature.data(), ok.data());
-    for (std::size_t j = 0; j < count; ++j) {
-      Eigen::Vector3f n1;
-      float c1 = 0.f;
-      const bool ok1 = detail::normalFromUnitCovariance(cov[begin + j], n1, c1);
-      expectScalarsAnswer(ok[j], n[j], curvature[j], ok1, n1, c1, begin + j, valid, invalid);
+    for (const auto solve : {detail::normalsFromUnitCovariances,
+                             detail::normalsFromUnitCovariancesWithoutAvx512}) {
+      std::vector<Eigen::Vector3f> n(count);
+      std::vector<float> curvature(count);
+      std::vector<std::uint8_t> ok(count, 7);
+      solve(cov + begin, count, n.data(), curvature.data(), ok.data());
+      for (std::size_t j = 0; j < count; ++j) {
+        Eigen::Vector3f n1;
+        float c1 = 0.f;
+        const bool ok1 = detail::normalFromUnitCovariance(cov[begin + j], n1, c1);
+        expectScalarsAnswer(ok[j], n[j], curvature[j], ok1, n1, c1, begin + j, valid, invalid);
+      }
     }
     begin += count;
   }
@@ -125,17 +130,19 @@ TEST(FastNormalsBatch, NormalsFromMomentsAreTheScalarOnesBitForBit) {
       const double f[10] = {m.n, m.x, m.y, m.z, m.xx, m.xy, m.xz, m.yy, m.yz, m.zz};
       for (std::size_t k = 0; k < 10; ++k) rows[k * stride + j] = f[k];
     }
-    std::vector<Eigen::Vector3f> n(count);
-    std::vector<float> curvature(count);
-    std::vector<std::uint8_t> ok(count, 7);
-    detail::normalsFromMoments(rows.data(), stride, count, n.data(), curvature.data(), ok.data());
-    for (std::size_t j = 0; j < count; ++j) {
-      double cov[6];
-      Eigen::Vector3f n1;
-      float c1 = 0.f;
-      const bool ok1 = detail::unitCovariance(moments[begin + j], cov) &&
-                       detail::normalFromUnitCovariance(cov, n1, c1);
-      expectScalarsAnswer(ok[j], n[j], curvature[j], ok1, n1, c1, begin + j, valid, invalid);
+    for (const auto solve : {detail::normalsFromMoments, detail::normalsFromMomentsWithoutAvx512}) {
+      std::vector<Eigen::Vector3f> n(count);
+      std::vector<float> curvature(count);
+      std::vector<std::uint8_t> ok(count, 7);
+      solve(rows.data(), stride, count, n.data(), curvature.data(), ok.data());
+      for (std::size_t j = 0; j < count; ++j) {
+        double cov[6];
+        Eigen::Vector3f n1;
+        float c1 = 0.f;
+        const bool ok1 = detail::unitCovariance(moments[begin + j], cov) &&
+                         detail::normalFromUnitCovariance(cov, n1, c1);
+        expectScalarsAnswer(ok[j], n[j], curvature[j], ok1, n1, c1, begin + j, valid, invalid);
+      }
     }
     begin += count;
   }

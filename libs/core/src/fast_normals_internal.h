@@ -46,9 +46,16 @@ void normalsFromUnitCovariances(const double (*cov)[6], std::size_t count, Eigen
 // unitCovariance and normalFromUnitCovariance of count neighbourhoods' moments given as rows
 // (field k of neighbourhood i at m[k * stride + i], in Moments' order n, x, y, z, xx, xy, xz,
 // yy, yz, zz): ok[i] is 1 where both succeed, with n[i] and curvature[i], else 0. The same values
-// bit for bit, four at a time on AVX2.
+// bit for bit, four at a time on AVX2, eight on AVX-512.
 void normalsFromMoments(const double* m, std::size_t stride, std::size_t count,
                         Eigen::Vector3f* n, float* curvature, std::uint8_t* ok);
+
+// The two as a CPU without AVX-512 computes them (the tests compare them).
+void normalsFromUnitCovariancesWithoutAvx512(const double (*cov)[6], std::size_t count,
+                                             Eigen::Vector3f* n, float* curvature,
+                                             std::uint8_t* ok);
+void normalsFromMomentsWithoutAvx512(const double* m, std::size_t stride, std::size_t count,
+                                     Eigen::Vector3f* n, float* curvature, std::uint8_t* ok);
 
 // The angular pitch of the sensor per column (along_u: the angle between the rays of columns
 // u and u + 1) and per row [rad], from the ranges of an organized cloud
