@@ -95,6 +95,7 @@ TEST(FastNormalsBatch, BatchedNormalsAreTheScalarOnesBitForBit) {
     const std::size_t count = std::min(len, covs.size() - begin);
     for (const auto solve : {detail::normalsFromUnitCovariances,
                              detail::normalsFromUnitCovariancesWithoutAvx512}) {
+      SCOPED_TRACE(solve == detail::normalsFromUnitCovariances ? "the CPU's" : "without AVX-512");
       std::vector<Eigen::Vector3f> n(count);
       std::vector<float> curvature(count);
       std::vector<std::uint8_t> ok(count, 7);
@@ -131,6 +132,7 @@ TEST(FastNormalsBatch, NormalsFromMomentsAreTheScalarOnesBitForBit) {
       for (std::size_t k = 0; k < 10; ++k) rows[k * stride + j] = f[k];
     }
     for (const auto solve : {detail::normalsFromMoments, detail::normalsFromMomentsWithoutAvx512}) {
+      SCOPED_TRACE(solve == detail::normalsFromMoments ? "the CPU's" : "without AVX-512");
       std::vector<Eigen::Vector3f> n(count);
       std::vector<float> curvature(count);
       std::vector<std::uint8_t> ok(count, 7);
