@@ -97,12 +97,8 @@ bool haveAvx2() {
   __builtin_cpu_init();
   return __builtin_cpu_supports("avx2");
 }
-bool haveAvx512() {
-  __builtin_cpu_init();
-  return haveAvx2() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
-}
 const bool kHaveAvx2 = haveAvx2();
-const bool kHaveAvx512 = haveAvx512();
+const bool kHaveAvx512 = kHaveAvx2 && cpuHasAvx512();
 #else
 constexpr bool kHaveAvx2 = false, kHaveAvx512 = false;
 #endif

@@ -11,6 +11,16 @@
 
 namespace upd::core::detail {
 
+#if defined(__GNUC__) && defined(__x86_64__)
+/// Whether the CPU runs the AVX-512 kernels (foundation, vector-length and doubleword
+/// extensions: every AVX-512 CPU has the three).
+inline bool cpuHasAvx512() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+         __builtin_cpu_supports("avx512dq");
+}
+#endif
+
 /// Lanes of the fixed-width inner loops (a multiple of every vector width used).
 constexpr int kLanes = 16;
 

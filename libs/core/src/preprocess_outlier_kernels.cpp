@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "fast_cell_map.h"
+#include "fast_simd.h"
 #include "preprocess_internal.h"
 #include "upd/core/openmp.h"
 #include "upd/core/vector_clones.h"
@@ -76,7 +77,7 @@ GatherWithinFn pickGatherWithin() {
   __builtin_cpu_init();
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
       __builtin_cpu_supports("popcnt")) {
-    return __builtin_cpu_supports("avx512f") ? gatherWithinAvx512 : gatherWithinAvx2;
+    return cpuHasAvx512() ? gatherWithinAvx512 : gatherWithinAvx2;
   }
   return gatherWithinScalar;
 }
@@ -314,7 +315,7 @@ bool hasAvx2Selection() {
 
 SelectMeanFn pickSelectMean() {
   if (!hasAvx2Selection()) return selectMeanScalar;
-  return __builtin_cpu_supports("avx512f") ? selectMeanAvx512 : selectMeanAvx2;
+  return cpuHasAvx512() ? selectMeanAvx512 : selectMeanAvx2;
 }
 
 SelectMeanFn pickSelectMeanWithoutAvx512() {

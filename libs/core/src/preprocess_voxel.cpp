@@ -1,8 +1,9 @@
 // The voxel grid's and the cut-off's vector kernels: the cut-off test and the voxel key of
 // every point of a row in a vector loop (by intrinsics: 8 points at a time on AVX2, 16 on
-// AVX-512), and the cut-off's copy of an organized frame. Their keys and tests are cropRange's, bit for bit (this
-// file is built without contracting a multiply and an add into one rounding, so that the vector
-// loop's range test is cropRange's). The sums are in preprocess_voxel_sums.cpp.
+// AVX-512), and the cut-off's copy of an organized frame. Their keys and tests are cropRange's,
+// bit for bit (this file is built without contracting a multiply and an add into one rounding,
+// so that the vector loop's range test is cropRange's). The sums are in
+// preprocess_voxel_sums.cpp.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -322,10 +323,7 @@ using VoxelKeysFn = bool (*)(const float*, const float*, const float*, std::size
 VoxelKeysFn pickVoxelKeys() {
   __builtin_cpu_init();
   if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("popcnt")) return voxelKeysLoop;
-  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                 __builtin_cpu_supports("avx512dq")
-             ? voxelKeysAvx512
-             : voxelKeysAvx2;
+  return cpuHasAvx512() ? voxelKeysAvx512 : voxelKeysAvx2;
 }
 #else
 using VoxelKeysFn = bool (*)(const float*, const float*, const float*, std::size_t,
@@ -405,10 +403,7 @@ using CropCopyFn = CropCounts (*)(const float*, const float*, const float*, std:
 CropCopyFn pickCropCopy() {
   __builtin_cpu_init();
   if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("popcnt")) return cropCopyLoop;
-  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                 __builtin_cpu_supports("avx512dq")
-             ? cropCopyAvx512
-             : cropCopyAvx2;
+  return cpuHasAvx512() ? cropCopyAvx512 : cropCopyAvx2;
 }
 #else
 using CropCopyFn = CropCounts (*)(const float*, const float*, const float*, std::size_t,
