@@ -309,8 +309,11 @@ int cellsAround(const RadiusGrid& g, std::size_t c, std::array<std::uint32_t, 27
 // rows for gatedMoments, padded with kFar; returns their number. The rows are resized to room
 // for the fullest cell's points in each cell around (no count before the copy), never shrunk
 // (no allocation once they have the room).
-std::ptrdiff_t gatherAround(const RadiusGrid& g, std::size_t c, std::vector<float>& cx,
-                            std::vector<float>& cy, std::vector<float>& cz) {
+__attribute__((always_inline)) inline std::ptrdiff_t gatherAround(const RadiusGrid& g,
+                                                                  std::size_t c,
+                                                                  std::vector<float>& cx,
+                                                                  std::vector<float>& cy,
+                                                                  std::vector<float>& cz) {
   // (Not value-initialized: only the first n_around are read, each written first.)
   std::array<std::uint32_t, 27> around;
   const int n_around = cellsAround(g, c, around);
@@ -389,6 +392,47 @@ class NormalBatch {
   std::uint8_t ok_[kSize];
 };
 
+// The normals of the points of cell c: their candidates gathered, the moments of each point's
+// ball added to the batch (weighted by a Gaussian of the distance where kGaussian), the batch
+// flushed into out whenever it fills. Returns the number of points without a normal.
+template <bool kGaussian>
+__attribute__((always_inline)) inline std::size_t cellNormalsWith(
+    const RadiusGrid& g, std::size_t c, float radius2, float inv_2s2, std::vector<float>& cx,
+    std::vector<float>& cy, std::vector<float>& cz, NormalBatch& batch, const PointCloud& cloud,
+    const NormalOrienter& orient, Normals& out) {
+  const std::ptrdiff_t n_candidates = gatherAround(g, c, cx, cy, cz);
+  // (The rows' length for gatedMoments: the candidates and one vector of padding.)
+  const auto n_rows = static_cast<std::size_t>(n_candidates) + kScanLanes;
+  std::size_t invalid = 0;
+  for (std::uint32_t s = g.points.start[c]; s < g.points.start[c + 1]; ++s) {
+    // Moments of the neighbours relative to p (eq. 4).
+    const Eigen::Vector3f p(g.x[s], g.y[s], g.z[s]);
+    std::size_t count = 0;
+    const Moments m =
+        kGaussian ? gaussianMoments(cx, cy, cz, n_candidates, p, radius2, inv_2s2, count)
+                  : detail::gatedMomentsBody(cx.data(), cy.data(), cz.data(), n_rows, 0, 0, 0,
+                                             n_candidates - 1, 1, p.x(), p.y(), p.z(), radius2);
+    if (!kGaussian) count = static_cast<std::size_t>(m.n);
+    if (count < 3) {
+      ++invalid;
+      continue;
+    }
+    batch.add(m, g.points.order[s]);
+    if (batch.full()) invalid += batch.flush(cloud, orient, out);
+  }
+  return invalid;
+}
+
+// The unweighted ones, cloned: the copies, the scans and the batch's stores at the machine's
+// vector width, the scan inlined rather than called through its dispatcher.
+UPD_VECTOR_CLONES
+std::size_t cellNormals(const RadiusGrid& g, std::size_t c, float radius2,
+                        std::vector<float>& cx, std::vector<float>& cy, std::vector<float>& cz,
+                        NormalBatch& batch, const PointCloud& cloud,
+                        const NormalOrienter& orient, Normals& out) {
+  return cellNormalsWith<false>(g, c, radius2, 0.f, cx, cy, cz, batch, cloud, orient, out);
+}
+
 }  // namespace
 
 Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
@@ -420,25 +464,9 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
 #pragma omp for schedule(dynamic, 16)
     for (std::ptrdiff_t cc = 0; cc < n_cells; ++cc) {
       const auto c = static_cast<std::size_t>(cc);
-      const std::ptrdiff_t n_candidates = gatherAround(g, c, cx, cy, cz);
-      // (The rows' length for gatedMoments: the candidates and one vector of padding.)
-      const auto n_rows = static_cast<std::size_t>(n_candidates) + kScanLanes;
-      for (std::uint32_t s = g.points.start[c]; s < g.points.start[c + 1]; ++s) {
-        const Eigen::Vector3f p(g.x[s], g.y[s], g.z[s]);
-        // Moments of the neighbours relative to p (eq. 4), weighted when Gaussian.
-        std::size_t count = 0;
-        const Moments m =
-            gaussian ? gaussianMoments(cx, cy, cz, n_candidates, p, radius2, inv_2s2, count)
-                     : detail::gatedMoments(cx.data(), cy.data(), cz.data(), n_rows, 0, 0, 0,
-                                            n_candidates - 1, 1, p.x(), p.y(), p.z(), radius2);
-        if (!gaussian) count = static_cast<std::size_t>(m.n);
-        if (count < 3) {
-          ++invalid;
-          continue;
-        }
-        batch.add(m, g.points.order[s]);
-        if (batch.full()) invalid += batch.flush(cloud, orient, out);
-      }
+      invalid += gaussian ? cellNormalsWith<true>(g, c, radius2, inv_2s2, cx, cy, cz, batch,
+                                                  cloud, orient, out)
+                          : cellNormals(g, c, radius2, cx, cy, cz, batch, cloud, orient, out);
     }
     invalid += batch.flush(cloud, orient, out);
   }

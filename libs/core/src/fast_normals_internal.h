@@ -69,6 +69,8 @@ bool normalFromMoments(const Moments& m, Eigen::Vector3f& n, float& curvature);
 
 // gatedMoments is defined here, static, so that each source calling it gets its own vector
 // clones: the dispatcher GCC emits for a target_clones function must live beside its clones.
+// Its body, gatedMomentsBody, is inlined into the callers that are cloned themselves (a clone's
+// call to a cloned function goes through the dispatcher).
 typedef float LaneF __attribute__((vector_size(kScanLanes * sizeof(float))));
 
 typedef float LaneQ __attribute__((vector_size(4 * sizeof(float))));
@@ -81,11 +83,10 @@ inline void loadLanes(LaneF& v, const float* p) { std::memcpy(&v, p, sizeof v); 
 // hold kFar, so they fail the distance test like any far point; the columns read past a1 (a
 // vector at a time) are real points of the cloud or kFar padding, and the ones within the
 // radius are neighbours of p like any other (the window only bounds the ball).
-UPD_VECTOR_CLONES
-[[maybe_unused]] static Moments gatedMoments(const float* X, const float* Y, const float* Z, std::size_t W,
-                            std::ptrdiff_t v0, std::ptrdiff_t v1, std::ptrdiff_t a0,
-                            std::ptrdiff_t a1, std::ptrdiff_t row_step, float px, float py,
-                            float pz, float radius2) {
+__attribute__((always_inline)) inline Moments gatedMomentsBody(
+    const float* X, const float* Y, const float* Z, std::size_t W, std::ptrdiff_t v0,
+    std::ptrdiff_t v1, std::ptrdiff_t a0, std::ptrdiff_t a1, std::ptrdiff_t row_step, float px,
+    float py, float pz, float radius2) {
   const LaneF zero = {};
   LaneI count = {};
   LaneF sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero,
@@ -140,6 +141,15 @@ UPD_VECTOR_CLONES
   m.xz = static_cast<double>(t1[2]), m.yy = static_cast<double>(t1[3]);
   m.yz = static_cast<double>(t2[0]), m.zz = static_cast<double>(t2[1]);
   return m;
+}
+
+UPD_VECTOR_CLONES
+[[maybe_unused]] static Moments gatedMoments(const float* X, const float* Y, const float* Z,
+                                             std::size_t W, std::ptrdiff_t v0, std::ptrdiff_t v1,
+                                             std::ptrdiff_t a0, std::ptrdiff_t a1,
+                                             std::ptrdiff_t row_step, float px, float py,
+                                             float pz, float radius2) {
+  return gatedMomentsBody(X, Y, Z, W, v0, v1, a0, a1, row_step, px, py, pz, radius2);
 }
 
 inline void setUnset(Normals& out, std::size_t i) {
