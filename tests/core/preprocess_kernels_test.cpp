@@ -1,11 +1,10 @@
-// The outlier filter's two inner steps, in the version the running CPU gets (AVX-512 or AVX2
-// where it has them) and as a CPU without AVX-512 runs them, against their plain versions and
-// a reference in double: gatherWithin keeps exactly the points within the bound, in point
-// order; selectMean gives the mean of the square roots of the want smallest (to float
-// precision) and the want-th exactly, with ties, few candidates and many, whatever the guess
-// of the want-th it is given; the voxel grid's key pass gives the plain loop's keys; the
-// sensor-rate range cut keeps what RangeBoxTest keeps; the outlier filter's grid cells are the
-// floors of the plain arithmetic. Fixed seeds.
+// The outlier filter's two inner steps, in every version the running CPU can run (AVX-512,
+// AVX2, plain), against a reference in double: gatherWithin keeps exactly the points within the
+// bound, in point order; selectMean gives the mean of the square roots of the want smallest (to
+// float precision) and the want-th exactly, with ties, few candidates and many, whatever the
+// guess of the want-th it is given; every version of the voxel grid's key pass gives the plain
+// loop's keys; every version of the sensor-rate range cut keeps what RangeBoxTest keeps; the
+// outlier filter's grid cells are the floors of the plain arithmetic. Fixed seeds.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,6 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -27,6 +27,16 @@ double exactD2(float x, float y, float z, float qx, float qy, float qz) {
   const double dx = static_cast<double>(x) - qx, dy = static_cast<double>(y) - qy,
                dz = static_cast<double>(z) - qz;
   return dx * dx + dy * dy + dz * dz;
+}
+
+// Every version of a kernel the running CPU can run (AVX-512, AVX2, plain), and first the one
+// the library calls, through its entry point.
+template <class Fn>
+std::vector<std::pair<Fn, std::string>> withTheCpus(
+    const std::vector<detail::KernelVersion<Fn>>& versions, Fn entry) {
+  std::vector<std::pair<Fn, std::string>> out{{entry, "the CPU's"}};
+  for (const auto& v : versions) out.emplace_back(v.fn, v.name);
+  return out;
 }
 
 TEST(PreprocessKernels, GatherWithinKeepsThePointsWithinTheBoundInOrder) {
@@ -58,13 +68,8 @@ TEST(PreprocessKernels, GatherWithinKeepsThePointsWithinTheBoundInOrder) {
     for (std::size_t j = 0; j < n; ++j) {
       if (d2[j] <= t) want.push_back(d2[j]);
     }
-    using Gather = std::size_t (*)(const float*, const float*, const float*, std::size_t, float,
-                                   float, float, float, float*);
-    const std::pair<Gather, const char*> versions[] = {
-        {detail::gatherWithin, "the CPU's"},
-        {detail::gatherWithinWithoutAvx512, "without AVX-512"},
-        {detail::gatherWithinPlain, "plain"}};
-    for (const auto& [gather, name] : versions) {
+    for (const auto& [gather, name] :
+         withTheCpus(detail::gatherWithinVersions(), detail::gatherWithin)) {
       std::vector<float> cand(n, -1.f);  // (exactly n: a write past it is a sanitizer's error)
       const std::size_t c = gather(x.data(), y.data(), z.data(), n, qx, qy, qz,
                                    static_cast<float>(t), cand.data());
@@ -78,9 +83,9 @@ TEST(PreprocessKernels, GatherWithinKeepsThePointsWithinTheBoundInOrder) {
   EXPECT_GT(checked, 300);
 }
 
-// selectMean (on AVX-512 the sorting networks where c <= 32), selectMean as a CPU without
-// AVX-512 runs it, and selectMeanPlain of the candidates cand against the mean of the square roots
-// of the want smallest in double, and the want-th; the incoming kth is the want-th times
+// selectMean in every version the CPU can run (on AVX-512 the sorting networks where c <= 32;
+// AVX2; plain) of the candidates cand against the mean of the square roots of the want smallest
+// in double, and the want-th; the incoming kth is the want-th times
 // guess. (To within 2^-23 of the mean: the vector version takes its roots in float, each within
 // 2^-24 of the double's.)
 void expectSelectMean(const std::vector<float>& cand, std::size_t want, float guess, int trial) {
@@ -90,12 +95,7 @@ void expectSelectMean(const std::vector<float>& cand, std::size_t want, float gu
   double sum = 0;
   for (std::size_t j = 0; j < want; ++j) sum += std::sqrt(sorted[j]);
   const double mean = sum / static_cast<double>(want - 1);
-  using SelectMean = double (*)(float*, std::size_t, std::size_t, float&);
-  const std::pair<SelectMean, const char*> versions[] = {
-      {detail::selectMean, "the CPU's"},
-      {detail::selectMeanWithoutAvx512, "without AVX-512"},
-      {detail::selectMeanPlain, "plain"}};
-  for (const auto& [select, name] : versions) {
+  for (const auto& [select, name] : withTheCpus(detail::selectMeanVersions(), detail::selectMean)) {
     std::vector<float> buf(c + 8);
     std::copy(cand.begin(), cand.end(), buf.begin());
     float kth = static_cast<float>(sorted[want - 1]) * guess;
@@ -160,8 +160,8 @@ TEST(PreprocessKernels, SelectMeanWithTiesAmongTheDropped) {
   EXPECT_GT(tied, 700);
 }
 
-// The voxel grid's key pass on AVX-512 or AVX2 (the CPU's, and as a CPU without AVX-512 runs
-// it) against the plain loop: the same key for every point (NaN, infinite, on the range's and
+// The voxel grid's key pass in every version the CPU can run (AVX-512, AVX2) against the plain
+// loop: the same key for every point (NaN, infinite, on the range's and
 // the box's bounds, beyond the keys' range), the same answer on whether every passing point's
 // voxel fits the key, the same count of finite points, at every length (the vector part and the
 // rest).
@@ -194,39 +194,39 @@ TEST(PreprocessKernels, VoxelKeysAreThePlainLoopsKeys) {
         default: break;
       }
     }
-    std::vector<std::uint64_t> got(n, 1), want(n, 2);
-    std::size_t finite = 3, finite_plain = 3, finite_want = 3;  // (the counts add to these)
+    std::size_t finite_want = 3;  // (the counts add to what they are given)
     for (std::size_t j = 0; j < n; ++j) {
       finite_want += std::isfinite(x[j]) && std::isfinite(y[j]) && std::isfinite(z[j]) ? 1 : 0;
     }
-    std::vector<std::uint64_t> narrow(n, 4);  // (as a CPU without AVX-512 computes them)
-    std::size_t finite_narrow = 3;
-    const bool ok = detail::voxelKeys(x.data(), y.data(), z.data(), n, k, got.data(), finite);
-    const bool ok_narrow = detail::voxelKeysWithoutAvx512(x.data(), y.data(), z.data(), n, k,
-                                                          narrow.data(), finite_narrow);
+    const auto versions = withTheCpus(detail::voxelKeysVersions(), detail::voxelKeys);
+    std::vector<std::uint64_t> want(n, 2);
+    std::size_t finite_plain = 3;
     const bool ok_plain =
-        detail::voxelKeysPlain(x.data(), y.data(), z.data(), n, k, want.data(), finite_plain);
-    ASSERT_EQ(ok, ok_plain) << "trial " << trial;
-    ASSERT_EQ(ok_narrow, ok_plain) << "trial " << trial;
-    ASSERT_EQ(finite, finite_want) << "trial " << trial;
-    ASSERT_EQ(finite_narrow, finite_want) << "trial " << trial;
+        versions.back().first(x.data(), y.data(), z.data(), n, k, want.data(), finite_plain);
+    ASSERT_EQ(versions.back().second, "plain");
     ASSERT_EQ(finite_plain, finite_want) << "trial " << trial;
-    refused += ok ? 0 : 1;
-    if (!ok) continue;  // (the caller throws: the keys are not used)
-    for (std::size_t j = 0; j < n; ++j) {
-      ASSERT_EQ(got[j], want[j]) << "trial " << trial << ", point " << j;
-      ASSERT_EQ(narrow[j], want[j]) << "trial " << trial << ", point " << j << ", no AVX-512";
-      passed += want[j] != detail::kNoKey ? 1 : 0;
+    refused += ok_plain ? 0 : 1;
+    for (const auto& [keys_of, name] : versions) {
+      std::vector<std::uint64_t> got(n, 1);
+      std::size_t finite = 3;
+      const bool ok = keys_of(x.data(), y.data(), z.data(), n, k, got.data(), finite);
+      ASSERT_EQ(ok, ok_plain) << "trial " << trial << ", " << name;
+      ASSERT_EQ(finite, finite_want) << "trial " << trial << ", " << name;
+      if (!ok) continue;  // (the caller throws: the keys are not used)
+      for (std::size_t j = 0; j < n; ++j) {
+        ASSERT_EQ(got[j], want[j]) << "trial " << trial << ", point " << j << ", " << name;
+      }
     }
+    if (!ok_plain) continue;
+    for (std::size_t j = 0; j < n; ++j) passed += want[j] != detail::kNoKey ? 1 : 0;
   }
   EXPECT_GT(refused, 10);
   EXPECT_GT(passed, 1000);
 }
 
-// The sensor-rate range cut: the version the CPU gets, the one a CPU without AVX-512 runs and
-// the plain loop all keep exactly the points RangeBoxTest keeps (points on the range's and the
-// box's bounds, NaN and infinite coordinates, every length up to a few vectors), the others
-// NaN, and count them alike.
+// The sensor-rate range cut: every version the CPU can run (AVX-512, AVX2, plain) keeps exactly
+// the points RangeBoxTest keeps (points on the range's and the box's bounds, NaN and infinite
+// coordinates, every length up to a few vectors), the others NaN, and counts them alike.
 TEST(PreprocessKernels, CropCopyKeepsWhatRangeBoxTestKeeps) {
   std::mt19937 rng(17);
   std::uniform_real_distribution<float> u(-6.f, 6.f);
@@ -258,13 +258,7 @@ TEST(PreprocessKernels, CropCopyKeepsWhatRangeBoxTestKeeps) {
         default: break;
       }
     }
-    using Crop = detail::CropCounts (*)(const float*, const float*, const float*, std::size_t,
-                                        const detail::KeyPassParams&, float*, float*, float*);
-    const std::pair<Crop, const char*> versions[] = {
-        {detail::cropCopy, "the CPU's"},
-        {detail::cropCopyWithoutAvx512, "without AVX-512"},
-        {detail::cropCopyPlain, "plain"}};
-    for (const auto& [crop, name] : versions) {
+    for (const auto& [crop, name] : withTheCpus(detail::cropCopyVersions(), detail::cropCopy)) {
       std::vector<float> ox(n, 7.f), oy(n, 7.f), oz(n, 7.f);
       const detail::CropCounts c =
           crop(x.data(), y.data(), z.data(), n, k, ox.data(), oy.data(), oz.data());

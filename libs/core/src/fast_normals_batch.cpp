@@ -1,8 +1,9 @@
-// normalFromUnitCovariance for many covariances at once, four to an AVX2 vector of doubles or
-// eight to an AVX-512 one (the same code for both: fast_normals_lanes.inc), with the scalar
-// function's results bit for bit: the same operations in the same order, each correctly rounded
-// (this file is built with -ffp-contract=off, so that no multiply and add are fused), the lanes
-// of a vector stepping together and each stopping where the scalar loop stops.
+// unitCovariance and normalFromUnitCovariance for many neighbourhoods' moments at once, four to
+// an AVX2 vector of doubles or eight to an AVX-512 one (the same code for both:
+// fast_normals_lanes.inc), with the scalar functions' results bit for bit: the same operations
+// in the same order, each correctly rounded (this file is built with -ffp-contract=off, so that
+// no multiply and add are fused), the lanes of a vector stepping together and each stopping
+// where the scalar loop stops.
 // A lane the common path does not settle (no clear plane: the general eigen solver; a
 // degenerate covariance; a step of zero length) is handed to the scalar function.
 #include <cmath>
@@ -19,13 +20,6 @@ namespace upd::core::detail {
 
 namespace {
 
-void scalarNormals(const double (*cov)[6], std::size_t begin, std::size_t end,
-                   Eigen::Vector3f* n, float* curvature, std::uint8_t* ok) {
-  for (std::size_t i = begin; i < end; ++i) {
-    ok[i] = normalFromUnitCovariance(cov[i], n[i], curvature[i]) ? 1 : 0;
-  }
-}
-
 #if defined(__GNUC__) && defined(__x86_64__)
 constexpr double kMaxDouble = std::numeric_limits<double>::max();
 
@@ -36,7 +30,6 @@ using V = __m256d;
 constexpr int kN = 4;
 UPD_LANES V set1(double x) { return _mm256_set1_pd(x); }
 UPD_LANES V zero() { return _mm256_setzero_pd(); }
-UPD_LANES V allLanes() { return _mm256_castsi256_pd(_mm256_set1_epi64x(-1)); }
 UPD_LANES V ge(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_GE_OQ); }
 UPD_LANES V gt(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
 UPD_LANES V le(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
@@ -49,7 +42,6 @@ UPD_LANES V and_(V a, V b) { return _mm256_and_pd(a, b); }
 UPD_LANES V andnot(V a, V b) { return _mm256_andnot_pd(a, b); }  // ~a & b
 UPD_LANES V or_(V a, V b) { return _mm256_or_pd(a, b); }
 UPD_LANES int mask(V v) { return _mm256_movemask_pd(v); }
-UPD_LANES V load(const double* p) { return _mm256_load_pd(p); }
 UPD_LANES V loadu(const double* p) { return _mm256_loadu_pd(p); }
 UPD_LANES void store(double* p, V v) { _mm256_store_pd(p, v); }
 #include "fast_normals_lanes.inc"
@@ -71,7 +63,6 @@ using V = __m512d;
 constexpr int kN = 8;
 UPD_LANES V set1(double x) { return _mm512_set1_pd(x); }
 UPD_LANES V zero() { return _mm512_setzero_pd(); }
-UPD_LANES V allLanes() { return _mm512_castsi512_pd(_mm512_set1_epi64(-1)); }
 UPD_LANES V lanes(__mmask8 m) { return _mm512_castsi512_pd(_mm512_movm_epi64(m)); }
 UPD_LANES V ge(V a, V b) { return lanes(_mm512_cmp_pd_mask(a, b, _CMP_GE_OQ)); }
 UPD_LANES V gt(V a, V b) { return lanes(_mm512_cmp_pd_mask(a, b, _CMP_GT_OQ)); }
@@ -85,7 +76,6 @@ UPD_LANES V vsqrt(V v) { return _mm512_sqrt_pd(v); }
 UPD_LANES V and_(V a, V b) { return _mm512_and_pd(a, b); }
 UPD_LANES V andnot(V a, V b) { return _mm512_andnot_pd(a, b); }  // ~a & b
 UPD_LANES V or_(V a, V b) { return _mm512_or_pd(a, b); }
-UPD_LANES V load(const double* p) { return _mm512_load_pd(p); }
 UPD_LANES V loadu(const double* p) { return _mm512_loadu_pd(p); }
 UPD_LANES void store(double* p, V v) { _mm512_store_pd(p, v); }
 #include "fast_normals_lanes.inc"
@@ -130,23 +120,6 @@ void fromMoments(const double* m, std::size_t stride, std::size_t count, Eigen::
   for (; i < count; ++i) scalarFromMoments(m, stride, i, n, curvature, ok);
 }
 
-void fromCovariances(const double (*cov)[6], std::size_t count, Eigen::Vector3f* n,
-                     float* curvature, std::uint8_t* ok, bool wide) {
-  std::size_t i = 0;
-#if defined(__GNUC__) && defined(__x86_64__)
-  if (kHaveAvx512 && wide) {
-    for (; i + 8 <= count; i += 8) avx512::normalsOfCovariances(cov, i, n, curvature, ok);
-  }
-  if (kHaveAvx2) {
-    for (; i + 4 <= count; i += 4) avx2::normalsOfCovariances(cov, i, n, curvature, ok);
-  }
-  for (std::size_t j = 0; j < i; ++j) {
-    if (ok[j] == 2) ok[j] = normalFromUnitCovariance(cov[j], n[j], curvature[j]) ? 1 : 0;
-  }
-#endif
-  scalarNormals(cov, i, count, n, curvature, ok);
-}
-
 }  // namespace
 
 void normalsFromMoments(const double* m, std::size_t stride, std::size_t count,
@@ -157,17 +130,6 @@ void normalsFromMoments(const double* m, std::size_t stride, std::size_t count,
 void normalsFromMomentsWithoutAvx512(const double* m, std::size_t stride, std::size_t count,
                                      Eigen::Vector3f* n, float* curvature, std::uint8_t* ok) {
   fromMoments(m, stride, count, n, curvature, ok, false);
-}
-
-void normalsFromUnitCovariances(const double (*cov)[6], std::size_t count, Eigen::Vector3f* n,
-                                float* curvature, std::uint8_t* ok) {
-  fromCovariances(cov, count, n, curvature, ok, true);
-}
-
-void normalsFromUnitCovariancesWithoutAvx512(const double (*cov)[6], std::size_t count,
-                                             Eigen::Vector3f* n, float* curvature,
-                                             std::uint8_t* ok) {
-  fromCovariances(cov, count, n, curvature, ok, false);
 }
 
 }  // namespace upd::core::detail

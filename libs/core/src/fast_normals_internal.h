@@ -38,11 +38,6 @@ bool unitCovariance(const Moments& m, double (&cov)[6]);
 // or false for a neighbourhood without a plane (lambda_1 ~ 0, as pcaNormal).
 bool normalFromUnitCovariance(const double (&cov)[6], Eigen::Vector3f& n, float& curvature);
 
-// normalFromUnitCovariance for cov[0, count): ok[i] is 1 where it gives n[i] and curvature[i],
-// 0 where it returns false; the same values bit for bit, four at a time on AVX2.
-void normalsFromUnitCovariances(const double (*cov)[6], std::size_t count, Eigen::Vector3f* n,
-                                float* curvature, std::uint8_t* ok);
-
 // unitCovariance and normalFromUnitCovariance of count neighbourhoods' moments given as rows
 // (field k of neighbourhood i at m[k * stride + i], in Moments' order n, x, y, z, xx, xy, xz,
 // yy, yz, zz): ok[i] is 1 where both succeed, with n[i] and curvature[i], else 0. The same values
@@ -50,10 +45,7 @@ void normalsFromUnitCovariances(const double (*cov)[6], std::size_t count, Eigen
 void normalsFromMoments(const double* m, std::size_t stride, std::size_t count,
                         Eigen::Vector3f* n, float* curvature, std::uint8_t* ok);
 
-// The two as a CPU without AVX-512 computes them (the tests compare them).
-void normalsFromUnitCovariancesWithoutAvx512(const double (*cov)[6], std::size_t count,
-                                             Eigen::Vector3f* n, float* curvature,
-                                             std::uint8_t* ok);
+// The same as a CPU without AVX-512 computes them (the tests compare them).
 void normalsFromMomentsWithoutAvx512(const double* m, std::size_t stride, std::size_t count,
                                      Eigen::Vector3f* n, float* curvature, std::uint8_t* ok);
 

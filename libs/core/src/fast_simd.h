@@ -6,10 +6,20 @@
 
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 #include "upd/core/vector_clones.h"
 
 namespace upd::core::detail {
+
+/// A version of a kernel written once per instruction set, and its name ("AVX-512", "AVX2",
+/// "plain"). Each such kernel lists the versions the running CPU can run: the one the library
+/// calls first, the plain loop last (the tests compare every one).
+template <class Fn>
+struct KernelVersion {
+  Fn fn;
+  const char* name;
+};
 
 #if defined(__GNUC__) && defined(__x86_64__)
 /// Whether the CPU runs the AVX-512 kernels (foundation, vector-length and doubleword
@@ -18,6 +28,17 @@ inline bool cpuHasAvx512() {
   __builtin_cpu_init();
   return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
          __builtin_cpu_supports("avx512dq");
+}
+
+/// The versions of a kernel the running CPU can run: avx512 where it has AVX-512 and has_avx2,
+/// avx2 where has_avx2 (the CPU has the instructions the AVX2 version's target names), plain.
+template <class Fn>
+std::vector<KernelVersion<Fn>> kernelVersions(bool has_avx2, Fn avx512, Fn avx2, Fn plain) {
+  std::vector<KernelVersion<Fn>> v;
+  if (has_avx2 && cpuHasAvx512()) v.push_back({avx512, "AVX-512"});
+  if (has_avx2) v.push_back({avx2, "AVX2"});
+  v.push_back({plain, "plain"});
+  return v;
 }
 #endif
 

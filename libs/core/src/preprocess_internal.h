@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fast_cell_ranks.h"
+#include "fast_simd.h"
 #include "upd/core/point_cloud.h"
 #include "upd/core/preprocess.h"
 
@@ -74,15 +75,14 @@ struct KeyPassParams {
 /// The voxel key of each of the n points (x, y, z) that passes (finite, kept by the range and
 /// box tests, each in RangeBoxTest's arithmetic) into keys, kNoKey for the others; the number
 /// of finite points among them added to finite. Returns false when a passing point's voxel lies
-/// beyond the keys' range. By intrinsics, 8 points at a time on AVX2, 16 on AVX-512;
-/// voxelKeysPlain is the compiler's vectorization of the plain loop, whatever the CPU, and
-/// voxelKeysWithoutAvx512 the version a CPU without AVX-512 runs (the tests compare them).
+/// beyond the keys' range. By intrinsics, 8 points at a time on AVX2, 16 on AVX-512; the plain
+/// version is the compiler's vectorization of the plain loop. (voxelKeysVersions and the other
+/// lists of versions below: KernelVersion, fast_simd.h.)
 bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
                const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
-bool voxelKeysWithoutAvx512(const float* x, const float* y, const float* z, std::size_t n,
-                            const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
-bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t n,
-                    const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite);
+using VoxelKeysFn = bool (*)(const float*, const float*, const float*, std::size_t,
+                             const KeyPassParams&, std::uint64_t*, std::size_t&);
+std::vector<KernelVersion<VoxelKeysFn>> voxelKeysVersions();
 
 /// KeyPassParams' sensor origin and range and box bounds from p (null: every test off; the
 /// key fields zero).
@@ -91,15 +91,12 @@ KeyPassParams rangeBoxBounds(const PreprocessParams* p, const Eigen::Vector3f& s
 /// The range and box cut of n points (x, y, z) into (ox, oy, oz): a point that passes (finite,
 /// kept by the range and box tests of k, each in RangeBoxTest's arithmetic) is copied, any
 /// other becomes NaN; cropRange's points of an organized cloud. One pass, by intrinsics 8
-/// points at a time on AVX2, 16 on AVX-512; cropCopyPlain is the plain loop, whatever the CPU,
-/// and cropCopyWithoutAvx512 the version a CPU without AVX-512 runs. The output arrays must not
-/// overlap the input ones.
+/// points at a time on AVX2, 16 on AVX-512. The output arrays must not overlap the input ones.
 CropCounts cropCopy(const float* x, const float* y, const float* z, std::size_t n,
                     const KeyPassParams& k, float* ox, float* oy, float* oz);
-CropCounts cropCopyWithoutAvx512(const float* x, const float* y, const float* z, std::size_t n,
-                                 const KeyPassParams& k, float* ox, float* oy, float* oz);
-CropCounts cropCopyPlain(const float* x, const float* y, const float* z, std::size_t n,
-                         const KeyPassParams& k, float* ox, float* oy, float* oz);
+using CropCopyFn = CropCounts (*)(const float*, const float*, const float*, std::size_t,
+                                  const KeyPassParams&, float*, float*, float*);
+std::vector<KernelVersion<CropCopyFn>> cropCopyVersions();
 
 /// out takes in's layout, colour and sensor origin, its point arrays resized to in's but not
 /// written (the colour copied by the OpenMP team in static shares).
@@ -122,15 +119,12 @@ std::size_t gatherWithin(const float* x, const float* y, const float* z, std::si
 /// speed depends on it), then, if still many, a partial selection.
 double selectMean(float* cand, std::size_t c, std::size_t want, float& kth);
 
-/// The plain versions of the two, whatever the CPU (the tests compare them), and the two as a
-/// CPU without AVX-512 runs them (AVX2 where the CPU has it, else the plain versions).
-std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, std::size_t n,
-                              float qx, float qy, float qz, float t, float* cand);
-double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth);
-std::size_t gatherWithinWithoutAvx512(const float* x, const float* y, const float* z,
-                                      std::size_t n, float qx, float qy, float qz, float t,
-                                      float* cand);
-double selectMeanWithoutAvx512(float* cand, std::size_t c, std::size_t want, float& kth);
+/// The versions of the two the running CPU can run.
+using GatherWithinFn = std::size_t (*)(const float*, const float*, const float*, std::size_t,
+                                       float, float, float, float, float*);
+using SelectMeanFn = double (*)(float*, std::size_t, std::size_t, float&);
+std::vector<KernelVersion<GatherWithinFn>> gatherWithinVersions();
+std::vector<KernelVersion<SelectMeanFn>> selectMeanVersions();
 
 /// selectMean by sorting networks (preprocess_outlier_avx512.cpp) for want <= c <= 32, on a CPU
 /// with AVX-512F (the caller checks): the candidates sorted in two vectors of 16, the want

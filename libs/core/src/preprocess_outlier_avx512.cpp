@@ -179,15 +179,16 @@ __attribute__((target("avx512f"))) void selectMeansSorted(const float* cand0, st
 
 namespace upd::core::detail {
 
-// (Without AVX-512: selectsSorted is false, and these are not called; defined for the link.)
+// (Without AVX-512: selectsSorted is false, and these are not called; defined for the link,
+// by the versions this build has.)
 std::size_t gatherWithinAvx512(const float* x, const float* y, const float* z, std::size_t n,
                                float qx, float qy, float qz, float t, float* cand) {
-  return gatherWithinPlain(x, y, z, n, qx, qy, qz, t, cand);
+  return gatherWithin(x, y, z, n, qx, qy, qz, t, cand);
 }
 
 double selectMeanSorted(const float* cand, std::size_t c, std::size_t want, float& kth) {
   std::vector<float> copy(cand, cand + c);
-  return selectMeanPlain(copy.data(), c, want, kth);
+  return selectMean(copy.data(), c, want, kth);
 }
 
 void selectMeansSorted(const float* cand0, std::size_t c0, const float* cand1, std::size_t c1,

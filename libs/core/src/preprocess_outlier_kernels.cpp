@@ -21,9 +21,6 @@ namespace upd::core::detail {
 
 namespace {
 
-using GatherWithinFn = std::size_t (*)(const float*, const float*, const float*, std::size_t,
-                                       float, float, float, float, float*);
-
 std::size_t gatherWithinScalar(const float* __restrict x, const float* __restrict y,
                                const float* __restrict z, std::size_t n, float qx, float qy,
                                float qz, float t, float* __restrict cand) {
@@ -73,30 +70,15 @@ __attribute__((target("avx2,fma,popcnt"))) std::size_t gatherWithinAvx2(
   return c;
 }
 
-GatherWithinFn pickGatherWithin() {
+// (The instructions gatherWithinAvx2's target names.)
+bool hasAvx2Gather() {
   __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-      __builtin_cpu_supports("popcnt")) {
-    return cpuHasAvx512() ? gatherWithinAvx512 : gatherWithinAvx2;
-  }
-  return gatherWithinScalar;
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+         __builtin_cpu_supports("popcnt");
 }
-#else
-GatherWithinFn pickGatherWithin() { return gatherWithinScalar; }
 #endif
 
-const GatherWithinFn pickedGatherWithin = pickGatherWithin();
-
-#if defined(__GNUC__) && defined(__x86_64__)
-GatherWithinFn pickGatherWithinWithoutAvx512() {
-  const GatherWithinFn picked = pickGatherWithin();
-  return picked == gatherWithinAvx512 ? gatherWithinAvx2 : picked;
-}
-#else
-GatherWithinFn pickGatherWithinWithoutAvx512() { return gatherWithinScalar; }
-#endif
-
-using SelectMeanFn = double (*)(float*, std::size_t, std::size_t, float&);
+const GatherWithinFn pickedGatherWithin = gatherWithinVersions().front().fn;
 
 // By a partial selection of the want smallest.
 double selectMeanScalar(float* cand, std::size_t c, std::size_t want, float& kth) {
@@ -313,20 +295,9 @@ bool hasAvx2Selection() {
          __builtin_cpu_supports("bmi");
 }
 
-SelectMeanFn pickSelectMean() {
-  if (!hasAvx2Selection()) return selectMeanScalar;
-  return cpuHasAvx512() ? selectMeanAvx512 : selectMeanAvx2;
-}
-
-SelectMeanFn pickSelectMeanWithoutAvx512() {
-  return hasAvx2Selection() ? selectMeanAvx2 : selectMeanScalar;
-}
-#else
-SelectMeanFn pickSelectMean() { return selectMeanScalar; }
-SelectMeanFn pickSelectMeanWithoutAvx512() { return selectMeanScalar; }
 #endif
 
-const SelectMeanFn pickedSelectMean = pickSelectMean();
+const SelectMeanFn pickedSelectMean = selectMeanVersions().front().fn;
 
 // floor(v) as a 32-bit integer, v clamped to +-2^30 first: detail::floorToInt's value wherever
 // a key fits (keyFits refuses the clamped ones), in arithmetic that vectorizes.
@@ -428,14 +399,24 @@ double selectMean(float* cand, std::size_t c, std::size_t want, float& kth) {
   return pickedSelectMean(cand, c, want, kth);
 }
 
-std::size_t gatherWithinPlain(const float* x, const float* y, const float* z, std::size_t n,
-                              float qx, float qy, float qz, float t, float* cand) {
-  return gatherWithinScalar(x, y, z, n, qx, qy, qz, t, cand);
+#if defined(__GNUC__) && defined(__x86_64__)
+std::vector<KernelVersion<GatherWithinFn>> gatherWithinVersions() {
+  return kernelVersions<GatherWithinFn>(hasAvx2Gather(), gatherWithinAvx512, gatherWithinAvx2,
+                                        gatherWithinScalar);
 }
 
-double selectMeanPlain(float* cand, std::size_t c, std::size_t want, float& kth) {
-  return selectMeanScalar(cand, c, want, kth);
+std::vector<KernelVersion<SelectMeanFn>> selectMeanVersions() {
+  return kernelVersions<SelectMeanFn>(hasAvx2Selection(), selectMeanAvx512, selectMeanAvx2,
+                                      selectMeanScalar);
 }
+#else
+std::vector<KernelVersion<GatherWithinFn>> gatherWithinVersions() {
+  return {{gatherWithinScalar, "plain"}};
+}
+std::vector<KernelVersion<SelectMeanFn>> selectMeanVersions() {
+  return {{selectMeanScalar, "plain"}};
+}
+#endif
 
 std::size_t narrowCandidates(float* cand, std::size_t c, std::size_t want, float guess) {
 #if defined(__GNUC__) && defined(__x86_64__)
@@ -452,18 +433,6 @@ bool selectsSorted() {
 #else
   return false;
 #endif
-}
-
-std::size_t gatherWithinWithoutAvx512(const float* x, const float* y, const float* z,
-                                      std::size_t n, float qx, float qy, float qz, float t,
-                                      float* cand) {
-  static const GatherWithinFn picked = pickGatherWithinWithoutAvx512();
-  return picked(x, y, z, n, qx, qy, qz, t, cand);
-}
-
-double selectMeanWithoutAvx512(float* cand, std::size_t c, std::size_t want, float& kth) {
-  static const SelectMeanFn picked = pickSelectMeanWithoutAvx512();
-  return picked(cand, c, want, kth);
 }
 
 UPD_VECTOR_CLONES

@@ -318,20 +318,9 @@ __attribute__((target("avx512f,avx512vl,avx512dq,popcnt"))) bool voxelKeysAvx512
 
 #pragma GCC diagnostic pop
 
-using VoxelKeysFn = bool (*)(const float*, const float*, const float*, std::size_t,
-                             const KeyPassParams&, std::uint64_t*, std::size_t&);
-VoxelKeysFn pickVoxelKeys() {
-  __builtin_cpu_init();
-  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("popcnt")) return voxelKeysLoop;
-  return cpuHasAvx512() ? voxelKeysAvx512 : voxelKeysAvx2;
-}
-#else
-using VoxelKeysFn = bool (*)(const float*, const float*, const float*, std::size_t,
-                             const KeyPassParams&, std::uint64_t*, std::size_t&);
-VoxelKeysFn pickVoxelKeys() { return voxelKeysLoop; }
 #endif
 
-const VoxelKeysFn pickedVoxelKeys = pickVoxelKeys();
+const VoxelKeysFn pickedVoxelKeys = voxelKeysVersions().front().fn;
 
 #if defined(__GNUC__) && defined(__x86_64__)
 // cropCopy by AVX2 intrinsics, 8 points at a time (the rest by the loop): voxelKeysAvx2's tests,
@@ -398,57 +387,42 @@ __attribute__((target("avx512f,avx512vl,avx512dq,popcnt"))) CropCounts cropCopyA
 }
 #pragma GCC diagnostic pop
 
-using CropCopyFn = CropCounts (*)(const float*, const float*, const float*, std::size_t,
-                                  const KeyPassParams&, float*, float*, float*);
-CropCopyFn pickCropCopy() {
-  __builtin_cpu_init();
-  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("popcnt")) return cropCopyLoop;
-  return cpuHasAvx512() ? cropCopyAvx512 : cropCopyAvx2;
-}
-#else
-using CropCopyFn = CropCounts (*)(const float*, const float*, const float*, std::size_t,
-                                  const KeyPassParams&, float*, float*, float*);
-CropCopyFn pickCropCopy() { return cropCopyLoop; }
 #endif
 
-const CropCopyFn pickedCropCopy = pickCropCopy();
+const CropCopyFn pickedCropCopy = cropCopyVersions().front().fn;
 
 }  // namespace
+
+#if defined(__GNUC__) && defined(__x86_64__)
+namespace {
+// (The instructions the AVX2 versions' targets name.)
+bool hasAvx2Popcnt() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
+}
+}  // namespace
+
+std::vector<KernelVersion<VoxelKeysFn>> voxelKeysVersions() {
+  return kernelVersions<VoxelKeysFn>(hasAvx2Popcnt(), voxelKeysAvx512, voxelKeysAvx2,
+                                     voxelKeysLoop);
+}
+
+std::vector<KernelVersion<CropCopyFn>> cropCopyVersions() {
+  return kernelVersions<CropCopyFn>(hasAvx2Popcnt(), cropCopyAvx512, cropCopyAvx2, cropCopyLoop);
+}
+#else
+std::vector<KernelVersion<VoxelKeysFn>> voxelKeysVersions() { return {{voxelKeysLoop, "plain"}}; }
+std::vector<KernelVersion<CropCopyFn>> cropCopyVersions() { return {{cropCopyLoop, "plain"}}; }
+#endif
 
 bool voxelKeys(const float* x, const float* y, const float* z, std::size_t n,
                const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite) {
   return pickedVoxelKeys(x, y, z, n, k, keys, finite);
 }
 
-bool voxelKeysWithoutAvx512(const float* x, const float* y, const float* z, std::size_t n,
-                            const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite) {
-#if defined(__GNUC__) && defined(__x86_64__)
-  if (pickedVoxelKeys == voxelKeysAvx512) return voxelKeysAvx2(x, y, z, n, k, keys, finite);
-#endif
-  return pickedVoxelKeys(x, y, z, n, k, keys, finite);
-}
-
-bool voxelKeysPlain(const float* x, const float* y, const float* z, std::size_t n,
-                    const KeyPassParams& k, std::uint64_t* keys, std::size_t& finite) {
-  return voxelKeysLoop(x, y, z, n, k, keys, finite);
-}
-
 CropCounts cropCopy(const float* x, const float* y, const float* z, std::size_t n,
                     const KeyPassParams& k, float* ox, float* oy, float* oz) {
   return pickedCropCopy(x, y, z, n, k, ox, oy, oz);
-}
-
-CropCounts cropCopyWithoutAvx512(const float* x, const float* y, const float* z, std::size_t n,
-                                 const KeyPassParams& k, float* ox, float* oy, float* oz) {
-#if defined(__GNUC__) && defined(__x86_64__)
-  if (pickedCropCopy == cropCopyAvx512) return cropCopyAvx2(x, y, z, n, k, ox, oy, oz);
-#endif
-  return pickedCropCopy(x, y, z, n, k, ox, oy, oz);
-}
-
-CropCounts cropCopyPlain(const float* x, const float* y, const float* z, std::size_t n,
-                         const KeyPassParams& k, float* ox, float* oy, float* oz) {
-  return cropCopyLoop(x, y, z, n, k, ox, oy, oz);
 }
 
 KeyPassParams rangeBoxBounds(const PreprocessParams* p, const Eigen::Vector3f& sensor_origin) {
