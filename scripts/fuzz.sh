@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of tests/fuzz with clang 14 under ASan and UBSan into
 # build-fuzz/, and runs each for SECONDS (default 30): the four cloud readers (pcd, ply, xyz,
-# kitti_bin), the robot config (ini), a rawlog object stream (rawlog), a ROS 1 bag (bag: built
-# when the ROS 1 packages are there) and the core pipeline on arbitrary float clouds (pipeline).
+# kitti_bin), the robot config (ini), a rawlog object stream (rawlog), a depth PNG (depth_png)
+# and a depth camera's calibration YAML (calibration), a ROS 1 bag (bag: built when the ROS 1
+# packages are there) and the core pipeline on arbitrary float clouds (pipeline).
 # docs/RELIABILITY.md, "Fuzzing".
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     e.g. scripts/fuzz.sh 600 pcd ply
 # UPD_FUZZ_RUNS=N stops each target after N inputs as well (what comes first), and
@@ -21,7 +22,7 @@ UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${UPD_FUZZ_BUILD:-$UPD_ROOT/build-fuzz}"
 SECS="${1:-30}"
 [ $# -gt 0 ] && shift
-ALL=(pcd ply xyz kitti_bin ini rawlog bag pipeline)
+ALL=(pcd ply xyz kitti_bin ini rawlog depth_png calibration bag pipeline)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=("${ALL[@]}")
 SHARED="${UPD_SHARED_DATA_DIR:-$UPD_ROOT/../shared/data}"

@@ -3,9 +3,10 @@
 # Tests that need ../shared/data skip with a visible message when it is absent.
 # In CI (CI=true), or with UPD_RELIABILITY=1, bounded reliability steps follow
 # (docs/RELIABILITY.md): the fuzzers of the cloud readers, the robot config and the core
-# pipeline, a rawlog object stream and a ROS 1 bag for at most UPD_FUZZ_SECONDS each (default
-# 90; a fixed seed and 2,000 inputs: close to repeatable), and under ASan + UBSan every test program
-# (the navigation scenarios shortened, four long playbacks left out).
+# pipeline, a rawlog object stream, a depth PNG and a ROS 1 bag for at most
+# UPD_FUZZ_SECONDS each (default 90; a fixed seed and 2,000 inputs: close to repeatable), and
+# under ASan + UBSan every test program (the navigation scenarios shortened, four long
+# playbacks left out).
 # Longer and wider: scripts/fuzz.sh SECONDS [TARGET...] and scripts/sanitize.sh (every test).
 set -euo pipefail
 step_start=$SECONDS
@@ -18,7 +19,7 @@ step_done "the suite"
 if [ "${CI:-}" = true ] || [ "${UPD_RELIABILITY:-0}" = 1 ]; then
   # Repeatable: a fixed seed and 2,000 inputs per target (well within the time).
   UPD_FUZZ_SEED="${UPD_FUZZ_SEED:-1}" UPD_FUZZ_RUNS="${UPD_FUZZ_RUNS:-2000}" \
-    "$UPD_ROOT/scripts/fuzz.sh" "${UPD_FUZZ_SECONDS:-90}" pcd ply xyz kitti_bin pipeline ini rawlog bag
+    "$UPD_ROOT/scripts/fuzz.sh" "${UPD_FUZZ_SECONDS:-90}" pcd ply xyz kitti_bin pipeline ini rawlog depth_png bag
   step_done "fuzzing"
   # Every test program under ASan + UBSan + LeakSanitizer (apps/upd built instrumented), the
   # navigation scenarios shortened (NavScenarioStart.*) and nine long runs left out (a minute

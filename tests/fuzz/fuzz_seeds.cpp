@@ -4,12 +4,15 @@
 // actions (scan matching with each pose distribution, a 3D movement) and one of the other
 // sensors a robot records beside its depth camera (IMU, odometry, GNSS, point clouds, range
 // finders, JPEG camera images, a 360-degree RGB-D rig); with ROS 1, small bags (uncompressed,
-// BZ2 and LZ4 chunks) of depth frames and point clouds with their transforms. scripts/fuzz.sh
-// adds the seeds taken from ../shared/data.
-//   fuzz_seeds OUTDIR   ->  OUTDIR/{pcd,ply,xyz,kitti_bin,pipeline,rawlog,bag}/...
+// BZ2 and LZ4 chunks) of depth frames and point clouds with their transforms; for the depth
+// files a small 16-bit depth PNG and calibrations as ROS and RTAB-Map write them.
+// scripts/fuzz.sh adds the seeds taken from ../shared/data.
+//   fuzz_seeds OUTDIR   ->  OUTDIR/{pcd,ply,xyz,kitti_bin,pipeline,rawlog,bag,depth_png,
+//                                   calibration}/...
 #include "io/cloud_samples.h"
 
 #include "upd/io/cloud_io.h"
+#include "upd/mrpt_bridge/depth_files.h"
 #include "upd/sim/scenes.h"
 
 #include <mrpt/io/CFileOutputStream.h>
@@ -58,6 +61,30 @@ void put(const fs::path& dir, const std::string& name, const std::string& bytes)
   fs::create_directories(dir);
   std::ofstream(dir / name, std::ios::binary)
       .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// A 16 x 12 depth PNG (a ramp with invalid pixels), and calibrations: a ROS camera_info YAML,
+// and an OpenCV (RTAB-Map) one with distortion and a local_transform.
+void putDepthFiles(const fs::path& dir, const fs::path& yaml_dir) {
+  fs::create_directories(dir);
+  upd::core::DepthImage d;
+  d.width = 16, d.height = 12;
+  d.depth_m.resize(16 * 12);
+  for (std::size_t i = 0; i < d.depth_m.size(); ++i) {
+    d.depth_m[i] = i % 7 == 0 ? 0.f : 0.5f + 0.01f * static_cast<float>(i);
+  }
+  upd::mrpt_bridge::writeDepthPng((dir / "ramp.png").string(), d);
+  put(yaml_dir, "ros.yaml",
+      "image_width: 16\nimage_height: 12\ncamera_name: depth\ncamera_matrix:\n  rows: 3\n"
+      "  cols: 3\n  data: [13.1, 0, 7.5, 0, 13.1, 5.5, 0, 0, 1]\ndistortion_model: plumb_bob\n"
+      "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n");
+  put(yaml_dir, "rtabmap.yaml",
+      "%YAML:1.0\n---\ncamera_name: depth\nimage_width: 16\nimage_height: 12\n"
+      "camera_matrix:\n   rows: 3\n   cols: 3\n"
+      "   data: [ 13.1, 0., 7.5, 0., 13.1, 5.5, 0., 0., 1. ]\n"
+      "distortion_coefficients:\n   rows: 1\n   cols: 5\n   data: [ 0.1, -0.2, 0., 0., 0. ]\n"
+      "local_transform:\n   rows: 3\n   cols: 4\n"
+      "   data: [ 0., 0., 1., 0.1, -1., 0., 0., 0., 0., -1., 0., 0.4 ]\n");
 }
 
 // A scored PLY of the points (writeScoredPly's file), for readScoredPly.
@@ -287,6 +314,7 @@ int main(int argc, char** argv) {
     }
     put(out / "pipeline", "scene_" + name, floats(p, 0));
   }
+  putDepthFiles(out / "depth_png", out / "calibration");
   putActionsRawlog(out / "rawlog");
   putSensorsRawlog(out / "rawlog");
 #ifdef UPD_FUZZ_HAVE_ROS1

@@ -1,15 +1,18 @@
 #include "upd/mrpt_bridge/depth_files.h"
 
 #include "upd/io/atomic_file.h"
+#include "yaml_text.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <iterator>
 #include <ostream>
 #include <stdexcept>
 #include <vector>
@@ -26,14 +29,18 @@ namespace {
 std::vector<double> matrixValues(const cv::FileNode& node, const std::string& file,
                                  const std::string& key, std::size_t expected) {
   std::vector<double> v;
-  if (node.isMap() && node["data"].isSeq()) {
-    node["data"] >> v;
-  } else if (node.isSeq()) {
-    node >> v;
-  } else {
-    cv::Mat m;
-    node >> m;
-    m.reshape(1, 1).convertTo(v, CV_64F);
+  try {  // (OpenCV throws where an element is not a number)
+    if (node.isMap() && node["data"].isSeq()) {
+      node["data"] >> v;
+    } else if (node.isSeq()) {
+      node >> v;
+    } else {
+      cv::Mat m;
+      node >> m;
+      m.reshape(1, 1).convertTo(v, CV_64F);
+    }
+  } catch (const cv::Exception& e) {
+    fail(file, "'" + key + "' is not a list of numbers (" + e.err + ")");
   }
   if (v.size() != expected) {
     fail(file, "'" + key + "' has " + std::to_string(v.size()) + " values, expected " +
@@ -52,13 +59,8 @@ int intField(const cv::FileStorage& fs, const std::string& file, const char* key
 }
 
 cv::FileStorage openCalibration(const std::string& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) fail(file, "not found");
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  if (!(text << in.rdbuf())) fail(file, "unreadable");
   // OpenCV's parser wants its directive, which ROS's camera_info files do not carry.
-  std::string yaml = text.str();
+  std::string yaml = checkedYamlText(file, "calibration");
   if (yaml.rfind("%YAML", 0) != 0) yaml = "%YAML:1.0\n---\n" + yaml;
   try {
     cv::FileStorage fs(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY |
@@ -67,6 +69,8 @@ cv::FileStorage openCalibration(const std::string& file) {
     return fs;
   } catch (const cv::Exception& e) {
     fail(file, "not valid YAML (" + e.err + ")");
+  } catch (const std::length_error&) {  // (OpenCV's parser on a key with no name)
+    fail(file, "not valid YAML");
   }
 }
 
@@ -88,7 +92,8 @@ Eigen::Isometry3d localTransform(const cv::FileNode& node, const std::string& fi
 
 }  // namespace
 
-DepthCalibration loadDepthCalibration(const std::string& yaml_path) {
+namespace {
+DepthCalibration readCalibration(const std::string& yaml_path) {
   const cv::FileStorage fs = openCalibration(yaml_path);
   DepthCalibration c;
   c.K.width = intField(fs, yaml_path, "image_width");
@@ -109,12 +114,31 @@ DepthCalibration loadDepthCalibration(const std::string& yaml_path) {
   const cv::FileNode dist = fs["distortion_coefficients"];
   if (!dist.empty()) {
     std::vector<double> d;
-    if (dist.isMap() && dist["data"].isSeq()) dist["data"] >> d;
+    try {
+      if (dist.isMap() && dist["data"].isSeq()) dist["data"] >> d;
+    } catch (const cv::Exception& e) {
+      fail(yaml_path, "'distortion_coefficients' is not a list of numbers (" + e.err + ")");
+    }
     for (double x : d) c.has_distortion = c.has_distortion || x != 0.0;
   }
   const cv::FileNode lt = fs["local_transform"];
   if (!lt.empty()) c.camera_on_robot = localTransform(lt, yaml_path);
   return c;
+}
+}  // namespace
+
+DepthCalibration loadDepthCalibration(const std::string& yaml_path) {
+  // (What the fields' own checks did not foresee: OpenCV's errors, and the standard library's
+  // that its parser lets through, as one line naming the file.)
+  try {
+    return readCalibration(yaml_path);
+  } catch (const std::runtime_error&) {
+    throw;  // (ours, naming the file and field)
+  } catch (const cv::Exception& e) {
+    fail(yaml_path, "not a calibration OpenCV can read (" + e.err + ")");
+  } catch (const std::exception&) {
+    fail(yaml_path, "not a calibration OpenCV can read");
+  }
 }
 
 core::DepthImage readDepthPng(const std::string& png_path, double metres_per_unit) {
@@ -122,16 +146,43 @@ core::DepthImage readDepthPng(const std::string& png_path, double metres_per_uni
     throw std::invalid_argument("depth scale = " + std::to_string(metres_per_unit) +
                                 " m per unit: must be > 0");
   }
+  const auto bad = [&](const std::string& why) {
+    return std::runtime_error("depth image " + png_path + ": " + why);
+  };
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(png_path, ec)) {
-    throw std::runtime_error("depth image " + png_path + ": not found");
+  if (!std::filesystem::is_regular_file(png_path, ec)) throw bad("not found");
+  std::ifstream in(png_path, std::ios::binary);
+  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
+                                         std::istreambuf_iterator<char>());
+  if (!in.eof() && in.fail()) throw bad("unreadable");
+  // The PNG signature, then the IHDR chunk's size: OpenCV would decode any format it knows
+  // and allocate whatever a damaged header claims (up to 2^30 pixels) before reading a row.
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes.size() < 24 || !std::equal(kSignature, kSignature + 8, bytes.begin()) ||
+      !std::equal(bytes.begin() + 12, bytes.begin() + 16, "IHDR")) {
+    throw bad("not a PNG image");
   }
-  const cv::Mat img = cv::imread(png_path, cv::IMREAD_UNCHANGED);
-  if (img.empty()) throw std::runtime_error("depth image " + png_path + ": not a readable image");
+  const auto be32 = [&](std::size_t at) {
+    return std::uint32_t{bytes[at]} << 24 | std::uint32_t{bytes[at + 1]} << 16 |
+           std::uint32_t{bytes[at + 2]} << 8 | std::uint32_t{bytes[at + 3]};
+  };
+  const std::uint32_t width = be32(16), height = be32(20);
+  if (width == 0 || height == 0 || width > kMaxDepthSide || height > kMaxDepthSide ||
+      std::uint64_t{width} * height > kMaxDepthPixels) {
+    throw bad(std::to_string(width) + " x " + std::to_string(height) +
+              " pixels by its header: a depth image has 1 to " + std::to_string(kMaxDepthSide) +
+              " a side and at most " + std::to_string(kMaxDepthPixels) + " in all");
+  }
+  cv::Mat img;
+  try {
+    img = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw bad("not a readable image (" + e.err + ")");
+  }
+  if (img.empty()) throw bad("not a readable image");
   if (img.type() != CV_16UC1) {
-    throw std::runtime_error("depth image " + png_path + ": " + std::to_string(img.elemSize1() * 8) +
-                             "-bit, " + std::to_string(img.channels()) +
-                             " channel(s); a depth image is 16-bit single channel");
+    throw bad(std::to_string(img.elemSize1() * 8) + "-bit, " + std::to_string(img.channels()) +
+              " channel(s); a depth image is 16-bit single channel");
   }
   core::DepthImage d;
   d.width = img.cols;

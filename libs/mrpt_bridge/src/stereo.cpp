@@ -1,13 +1,13 @@
 #include "upd/mrpt_bridge/stereo.h"
 
 #include "upd/core/params.h"
+#include "yaml_text.h"
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
-#include <filesystem>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -207,17 +207,17 @@ cv::Mat readMatrix(const cv::FileStorage& fs, const std::string& file, const std
 }
 
 cv::FileStorage openYaml(const std::string& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) {
-    throw std::runtime_error("stereo calibration " + file + ": not found");
-  }
+  const std::string yaml = checkedYamlText(file, "stereo calibration");
   try {
-    cv::FileStorage fs(file, cv::FileStorage::READ);
+    cv::FileStorage fs(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY |
+                                 cv::FileStorage::FORMAT_YAML);
     if (!fs.isOpened()) throw std::runtime_error("stereo calibration " + file + ": unreadable");
     return fs;
   } catch (const cv::Exception& e) {
-    throw std::runtime_error("stereo calibration " + file + ": not valid OpenCV YAML (" + e.msg +
+    throw std::runtime_error("stereo calibration " + file + ": not valid OpenCV YAML (" + e.err +
                              ")");
+  } catch (const std::length_error&) {  // (OpenCV's parser on a key with no name)
+    throw std::runtime_error("stereo calibration " + file + ": not valid OpenCV YAML");
   }
 }
 

@@ -13,6 +13,7 @@
 
 #include <Eigen/Geometry>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -30,9 +31,16 @@ struct DepthCalibration {
 /// the file and the field.
 DepthCalibration loadDepthCalibration(const std::string& yaml_path);
 
+/// The largest depth image readDepthPng reads: its side and its pixels (depth cameras give a
+/// few thousand a side, a few million in all).
+constexpr std::uint32_t kMaxDepthSide = 16384;
+constexpr std::uint64_t kMaxDepthPixels = std::uint64_t{1} << 25;
+
 /// Reads a 16-bit depth PNG: depth_m = value * metres_per_unit (0 stays 0: invalid). Throws
-/// std::runtime_error naming the file when it is missing, unreadable, or not 16-bit single
-/// channel; std::invalid_argument for metres_per_unit <= 0.
+/// std::runtime_error naming the file when it is missing, unreadable, not a PNG (by its
+/// signature), larger than kMaxDepthSide a side or kMaxDepthPixels by its header (before any
+/// allocation), damaged, or not 16-bit single channel; std::invalid_argument for
+/// metres_per_unit <= 0.
 core::DepthImage readDepthPng(const std::string& png_path, double metres_per_unit = 0.001);
 
 /// Writes depth_m as a 16-bit PNG in units of metres_per_unit (rounded; 0 and NaN -> 0, values

@@ -1,0 +1,211 @@
+// Depth PNGs as `upd analyze --intrinsics` and TUM folders read them: a written image reads
+// back to the millimetre; a file that is not a PNG, one whose header claims an image larger than
+// kMaxDepthSide a side or kMaxDepthPixels in all (refused before anything is allocated), a
+// truncated one and an 8-bit one are refused with a message naming the file and what is wrong;
+// so is a calibration YAML with a field that holds something other than numbers.
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/core/persistence.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "temp_dir.h"
+#include "upd/mrpt_bridge/depth_files.h"
+
+namespace upd {
+namespace {
+
+std::vector<char> fileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void writeBytes(const std::string& path, const std::vector<char>& bytes) {
+  std::ofstream(path, std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// readDepthPng's error on path, or "" when it reads.
+std::string readError(const std::string& path) {
+  try {
+    mrpt_bridge::readDepthPng(path);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+core::DepthImage ramp(int width, int height) {
+  core::DepthImage d;
+  d.width = width, d.height = height;
+  d.depth_m.resize(static_cast<std::size_t>(width) * height);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      d.depth_m[static_cast<std::size_t>(v) * width + u] =
+          u == 0 ? 0.f : 0.5f + 0.01f * u + 0.02f * v;  // (column 0: invalid)
+    }
+  }
+  return d;
+}
+
+TEST(DepthFiles, WrittenDepthReadsBackToTheMillimetre) {
+  const test::TempDir tmp("depth-png");
+  const std::string path = (tmp.path() / "d.png").string();
+  const core::DepthImage d = ramp(64, 48);
+  mrpt_bridge::writeDepthPng(path, d);
+  const core::DepthImage r = mrpt_bridge::readDepthPng(path);
+  ASSERT_EQ(r.width, 64);
+  ASSERT_EQ(r.height, 48);
+  for (std::size_t i = 0; i < d.depth_m.size(); ++i) {
+    EXPECT_NEAR(r.depth_m[i], d.depth_m[i], 0.0005f + 1e-6f) << "pixel " << i;
+  }
+}
+
+TEST(DepthFiles, DamagedOrForeignFilesAreRefusedNamingTheFile) {
+  const test::TempDir tmp("depth-png-bad");
+  const std::string good = (tmp.path() / "good.png").string();
+  mrpt_bridge::writeDepthPng(good, ramp(32, 24));
+  const std::vector<char> bytes = fileBytes(good);
+  ASSERT_GT(bytes.size(), 40u);
+
+  // Not a PNG: text, and a 16-bit TIFF (OpenCV would decode it by its content).
+  const std::string text = (tmp.path() / "text.png").string();
+  writeBytes(text, {'d', 'e', 'p', 't', 'h'});
+  EXPECT_NE(readError(text).find("text.png: not a PNG image"), std::string::npos)
+      << readError(text);
+  const std::string tiff = (tmp.path() / "tiff.png").string();
+  std::vector<unsigned char> tiff_bytes;
+  ASSERT_TRUE(cv::imencode(".tiff", cv::Mat(24, 32, CV_16UC1, cv::Scalar(1000)), tiff_bytes));
+  writeBytes(tiff, std::vector<char>(tiff_bytes.begin(), tiff_bytes.end()));
+  EXPECT_NE(readError(tiff).find("tiff.png: not a PNG image"), std::string::npos)
+      << readError(tiff);
+
+  // A header claiming 100,000 x 100,000 pixels (40 GB as 16-bit): refused by its size.
+  std::vector<char> huge = bytes;
+  for (std::size_t at : {16u, 20u}) {
+    const std::uint32_t side = 100000;
+    for (int b = 0; b < 4; ++b) huge[at + b] = static_cast<char>(side >> (24 - 8 * b));
+  }
+  const std::string big = (tmp.path() / "big.png").string();
+  writeBytes(big, huge);
+  EXPECT_NE(readError(big).find("big.png: 100000 x 100000 pixels by its header"),
+            std::string::npos)
+      << readError(big);
+  // 16,000 x 16,000 (within a side, within OpenCV's own limit of 2^30 pixels: 512 MB that
+  // OpenCV would allocate): refused by its pixels.
+  for (std::size_t at : {16u, 20u}) {
+    const std::uint32_t side = 16000;
+    for (int b = 0; b < 4; ++b) huge[at + b] = static_cast<char>(side >> (24 - 8 * b));
+  }
+  writeBytes(big, huge);
+  EXPECT_NE(readError(big).find("big.png: 16000 x 16000 pixels by its header"),
+            std::string::npos)
+      << readError(big);
+
+  // Cut in the middle of its data, and empty.
+  const std::string cut = (tmp.path() / "cut.png").string();
+  writeBytes(cut, std::vector<char>(bytes.begin(), bytes.begin() + bytes.size() / 2));
+  EXPECT_NE(readError(cut).find("cut.png: "), std::string::npos);
+  const std::string empty = (tmp.path() / "empty.png").string();
+  writeBytes(empty, {});
+  EXPECT_NE(readError(empty).find("empty.png: not a PNG image"), std::string::npos);
+
+  // An 8-bit image.
+  const std::string eight = (tmp.path() / "eight.png").string();
+  ASSERT_TRUE(cv::imwrite(eight, cv::Mat(24, 32, CV_8UC1, cv::Scalar(7))));
+  EXPECT_NE(readError(eight).find("eight.png: 8-bit, 1 channel(s)"), std::string::npos)
+      << readError(eight);
+}
+
+// The calibrations users have load: ROS's camera_info (comments, a quoted name), RTAB-Map's
+// (its lists over several lines, a local_transform) and what OpenCV's own writer gives
+// (!!opencv-matrix with its dt).
+TEST(DepthFiles, RosRtabmapAndOpenCvCalibrationsLoad) {
+  const test::TempDir tmp("depth-yaml-good");
+  const std::string ros = (tmp.path() / "ros.yaml").string();
+  std::ofstream(ros) << "# from camera_calibration\nimage_width: 640\nimage_height: 480\n"
+                        "camera_name: 'head camera'\ncamera_matrix:\n  rows: 3\n  cols: 3\n"
+                        "  data: [525, 0, 319.5, 0, 525, 239.5, 0, 0, 1]  # pixels\n"
+                        "distortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n"
+                        "  cols: 5\n  data: [0, 0, 0, 0, 0]\n";
+  const std::string rtabmap = (tmp.path() / "rtabmap.yaml").string();
+  std::ofstream(rtabmap) << "%YAML:1.0\n---\ncamera_name: \"17\"\nimage_width: 640\n"
+                            "image_height: 480\ncamera_matrix:\n   rows: 3\n   cols: 3\n"
+                            "   data: [ 525., 0., 3.1950000000000000e+02, 0., 525.,\n"
+                            "       2.3950000000000000e+02, 0., 0., 1. ]\nlocal_transform:\n"
+                            "   rows: 3\n   cols: 4\n   data: [ 0., 0., 1., 0.1, -1., 0., 0., 0.,\n"
+                            "       0., -1., 0., 0.4 ]\n";
+  const std::string opencv = (tmp.path() / "opencv.yaml").string();
+  {
+    cv::FileStorage fs(opencv, cv::FileStorage::WRITE);
+    fs << "image_width" << 640 << "image_height" << 480;
+    fs << "camera_matrix" << (cv::Mat_<double>(3, 3) << 525, 0, 319.5, 0, 525, 239.5, 0, 0, 1);
+    fs << "distortion_coefficients" << (cv::Mat_<double>(1, 5) << 0.1, 0, 0, 0, 0);
+  }
+  for (const std::string& path : {ros, rtabmap, opencv}) {
+    const mrpt_bridge::DepthCalibration c = mrpt_bridge::loadDepthCalibration(path);
+    EXPECT_EQ(c.K.width, 640) << path;
+    EXPECT_EQ(c.K.height, 480) << path;
+    EXPECT_DOUBLE_EQ(c.K.fx, 525.0) << path;
+    EXPECT_DOUBLE_EQ(c.K.cy, 239.5) << path;
+    EXPECT_EQ(c.camera_on_robot.has_value(), path == rtabmap) << path;
+    EXPECT_EQ(c.has_distortion, path == opencv) << path;
+  }
+}
+
+// Calibrations the fuzzer found to end or hang the process (OpenCV threw through the reader, or
+// its parser looped forever) are refused in one line naming the file and the field or line: a
+// matrix element that is a word, bytes in a list, a key with no name, a document marker with
+// text after it, text after the document's end, a control byte.
+TEST(DepthFiles, CalibrationsThatEndedOrHungTheProcessAreRefused) {
+  const test::TempDir tmp("depth-yaml");
+  const std::string ros = (tmp.path() / "ros.yaml").string();
+  std::ofstream(ros) << "image_width: 16\nimage_height: 12\ncamera_matrix:\n  rows: 3\n"
+                        "  cols: 3\n  data: [13.1, 0, 7.5, 0, focal, 5.5, 0, 0, 1]\n";
+  const std::string rtabmap = (tmp.path() / "rtabmap.yaml").string();
+  std::ofstream(rtabmap) << "%YAML:1.0\n---\nimage_width: 16\nimage_height: 12\n"
+                            "camera_matrix:\n   rows: 3\n   cols: 3\n"
+                            "   data: [ 13.1, 0., 7.5, 0., 13.1, 5.5, 0., 0., 1. ]\n"
+                            "distortion_coefficients:\n   rows: 1\n   cols: 5\n"
+                            "   data: [ 0.1, \"\\xff\\xff\", 0., 0., 0. ]\n";
+  // A key with no name (OpenCV's parser threw std::length_error through the reader).
+  const std::string nameless = (tmp.path() / "nameless.yaml").string();
+  std::ofstream(nameless) << "%YAML:1.0\n---\nimage_width: 16\nlocal_transform:\n   rows: 3\n"
+                             "   :d aat[ 0., 0., 1. ]\n";
+  // A document marker with text after it, and text after the document's end, on which
+  // OpenCV's parser loops forever; a control byte.
+  const std::string marker = (tmp.path() / "marker.yaml").string();
+  std::ofstream(marker) << "%YAML:1.0\n---e:h\nima-\nc";
+  const std::string ended = (tmp.path() / "ended.yaml").string();
+  std::ofstream(ended) << "...\n-";
+  const std::string control = (tmp.path() / "control.yaml").string();
+  std::ofstream(control) << "image_width: 16\nimage_height: 1\x01\n";
+  const char* not_a_line = "is not a line of a calibration";
+  for (const auto& [path, field] :
+       {std::pair<std::string, std::string>{ros, "'camera_matrix' is not a list of numbers"},
+        {rtabmap, "line 12: '   data: [ 0.1, \""},
+        {nameless, "line 6: '   :d aat[ 0., 0., 1. ]' " + std::string(not_a_line)},
+        {marker, "line 2: '---e:h' " + std::string(not_a_line)},
+        {ended, "line 2: text after '...', the end of the document"},
+        {control, "line 2: byte 1: not a text file"}}) {
+    try {
+      mrpt_bridge::loadDepthCalibration(path);
+      ADD_FAILURE() << path << " was read";
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("calibration " + path + ": " + field), std::string::npos) << what;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace upd
