@@ -165,7 +165,7 @@ TEST(DepthFiles, RosRtabmapAndOpenCvCalibrationsLoad) {
 // Calibrations the fuzzer found to end or hang the process (OpenCV threw through the reader, or
 // its parser looped forever) are refused in one line naming the file and the field or line: a
 // matrix element that is a word, bytes in a list, a key with no name, a document marker with
-// text after it, text after the document's end, a control byte.
+// text after it, text after the document's end, a control byte, a byte beyond ASCII.
 TEST(DepthFiles, CalibrationsThatEndedOrHungTheProcessAreRefused) {
   const test::TempDir tmp("depth-yaml");
   const std::string ros = (tmp.path() / "ros.yaml").string();
@@ -189,6 +189,8 @@ TEST(DepthFiles, CalibrationsThatEndedOrHungTheProcessAreRefused) {
   std::ofstream(ended) << "...\n-";
   const std::string control = (tmp.path() / "control.yaml").string();
   std::ofstream(control) << "image_width: 16\nimage_height: 1\x01\n";
+  const std::string latin = (tmp.path() / "latin.yaml").string();
+  std::ofstream(latin) << "camera_name: \"cam\xe9ra\"\nimage_width: 16\n";
   const char* not_a_line = "is not a line of a calibration";
   for (const auto& [path, field] :
        {std::pair<std::string, std::string>{ros, "'camera_matrix' is not a list of numbers"},
@@ -196,7 +198,8 @@ TEST(DepthFiles, CalibrationsThatEndedOrHungTheProcessAreRefused) {
         {nameless, "line 6: '   :d aat[ 0., 0., 1. ]' " + std::string(not_a_line)},
         {marker, "line 2: '---e:h' " + std::string(not_a_line)},
         {ended, "line 2: text after '...', the end of the document"},
-        {control, "line 2: byte 1: not a text file"}}) {
+        {control, "line 2: byte 1: a control character, not text"},
+        {latin, "line 1: byte 233: not ASCII (a calibration is ASCII)"}}) {
     try {
       mrpt_bridge::loadDepthCalibration(path);
       ADD_FAILURE() << path << " was read";

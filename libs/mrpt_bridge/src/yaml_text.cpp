@@ -150,9 +150,12 @@ void checkText(const std::string& yaml, const std::string& file, const std::stri
   std::size_t number = 1;
   for (const char ch : yaml) {
     const auto b = static_cast<unsigned char>(ch);
-    if ((b < 0x20 && b != '\t' && b != '\n' && b != '\r') || b >= 0x80) {
-      throw std::runtime_error(what + " " + file + ": line " + std::to_string(number) +
-                               ": byte " + std::to_string(b) + ": not a text file");
+    const bool control = b < 0x20 && b != '\t' && b != '\n' && b != '\r';
+    if (control || b >= 0x80) {
+      throw std::runtime_error(
+          what + " " + file + ": line " + std::to_string(number) + ": byte " +
+          std::to_string(b) +
+          (control ? ": a control character, not text" : ": not ASCII (a calibration is ASCII)"));
     }
     number += b == '\n' ? 1 : 0;
   }
