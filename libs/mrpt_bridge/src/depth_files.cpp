@@ -58,22 +58,6 @@ int intField(const cv::FileStorage& fs, const std::string& file, const char* key
   return static_cast<int>(n);
 }
 
-cv::FileStorage openCalibration(const std::string& file) {
-  // OpenCV's parser wants its directive, which ROS's camera_info files do not carry.
-  std::string yaml = checkedYamlText(file, "calibration");
-  if (yaml.rfind("%YAML", 0) != 0) yaml = "%YAML:1.0\n---\n" + yaml;
-  try {
-    cv::FileStorage fs(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY |
-                                 cv::FileStorage::FORMAT_YAML);
-    if (!fs.isOpened()) fail(file, "unreadable");
-    return fs;
-  } catch (const cv::Exception& e) {
-    fail(file, "not valid YAML (" + e.err + ")");
-  } catch (const std::length_error&) {  // (OpenCV's parser on a key with no name)
-    fail(file, "not valid YAML");
-  }
-}
-
 Eigen::Isometry3d localTransform(const cv::FileNode& node, const std::string& file) {
   const std::vector<double> v = matrixValues(node, file, "local_transform", 12);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -94,7 +78,7 @@ Eigen::Isometry3d localTransform(const cv::FileNode& node, const std::string& fi
 
 namespace {
 DepthCalibration readCalibration(const std::string& yaml_path) {
-  const cv::FileStorage fs = openCalibration(yaml_path);
+  const cv::FileStorage fs = openCheckedYaml(yaml_path, "calibration");
   DepthCalibration c;
   c.K.width = intField(fs, yaml_path, "image_width");
   c.K.height = intField(fs, yaml_path, "image_height");

@@ -206,21 +206,6 @@ cv::Mat readMatrix(const cv::FileStorage& fs, const std::string& file, const std
   return m;
 }
 
-cv::FileStorage openYaml(const std::string& file) {
-  const std::string yaml = checkedYamlText(file, "stereo calibration");
-  try {
-    cv::FileStorage fs(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY |
-                                 cv::FileStorage::FORMAT_YAML);
-    if (!fs.isOpened()) throw std::runtime_error("stereo calibration " + file + ": unreadable");
-    return fs;
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error("stereo calibration " + file + ": not valid OpenCV YAML (" + e.err +
-                             ")");
-  } catch (const std::length_error&) {  // (OpenCV's parser on a key with no name)
-    throw std::runtime_error("stereo calibration " + file + ": not valid OpenCV YAML");
-  }
-}
-
 int readInt(const cv::FileStorage& fs, const std::string& file, const std::string& key) {
   const cv::FileNode node = fs[key];
   if (node.empty() || !node.isInt()) {
@@ -235,8 +220,8 @@ StereoCalibration loadStereoCalibrationYaml(const std::string& left_yaml,
                                             const std::string& right_yaml) {
   StereoCalibration c;
   try {
-    cv::FileStorage left = openYaml(left_yaml);
-    cv::FileStorage right = openYaml(right_yaml);
+    cv::FileStorage left = openCheckedYaml(left_yaml, "stereo calibration");
+    cv::FileStorage right = openCheckedYaml(right_yaml, "stereo calibration");
     c.width = readInt(left, left_yaml, "image_width");
     c.height = readInt(left, left_yaml, "image_height");
     const int rw = readInt(right, right_yaml, "image_width");

@@ -1,5 +1,7 @@
-// The YAML files handed to OpenCV's parser, checked line by line first (yaml_text.h).
+// Calibration YAMLs checked line by line, then opened by OpenCV's parser (yaml_text.h).
 #include "yaml_text.h"
+
+#include <opencv2/core.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -171,16 +173,27 @@ void checkText(const std::string& yaml, const std::string& file, const std::stri
 
 }  // namespace
 
-std::string checkedYamlText(const std::string& file, const std::string& what) {
+cv::FileStorage openCheckedYaml(const std::string& file, const std::string& what) {
+  const auto fail = [&](const std::string& why) {
+    return std::runtime_error(what + " " + file + ": " + why);
+  };
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) {
-    throw std::runtime_error(what + " " + file + ": not found");
-  }
+  if (!std::filesystem::is_regular_file(file, ec)) throw fail("not found");
   std::ifstream in(file, std::ios::binary);
   std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw std::runtime_error(what + " " + file + ": unreadable");
+  if (in.bad()) throw fail("unreadable");
   checkText(yaml, file, what);
-  return yaml;
+  if (yaml.rfind("%YAML", 0) != 0) yaml = "%YAML:1.0\n---\n" + yaml;
+  try {
+    cv::FileStorage fs(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY |
+                                 cv::FileStorage::FORMAT_YAML);
+    if (!fs.isOpened()) throw fail("unreadable");
+    return fs;
+  } catch (const cv::Exception& e) {
+    throw fail("not valid YAML (" + e.err + ")");
+  } catch (const std::length_error&) {  // (OpenCV's parser on a key with no name)
+    throw fail("not valid YAML");
+  }
 }
 
 }  // namespace upd::mrpt_bridge
