@@ -68,6 +68,21 @@ class RankedCells {
     if ((w.bits & bit) == 0) return kNoIndex;
     return w.before + countBits(w.bits & (bit - 1));
   }
+  /// The ids of the occupied cells at index at + offsets[j], in the offsets' order, into out;
+  /// returns their number. (out has room for every offset: each one's rank is stored and the
+  /// count moves on where the cell is occupied, with no branch on the cells' pattern.)
+  std::size_t occupiedIds(std::size_t at, const std::int64_t* offsets, std::size_t n_offsets,
+                          std::uint32_t* out) const {
+    std::size_t n = 0;
+    for (std::size_t j = 0; j < n_offsets; ++j) {
+      const std::size_t index = at + static_cast<std::size_t>(offsets[j]);
+      const Word& w = words_[index / 64];
+      const std::uint64_t bit = std::uint64_t{1} << (index % 64);
+      out[n] = w.before + countBits(w.bits & (bit - 1));
+      n += (w.bits & bit) != 0 ? 1 : 0;
+    }
+    return n;
+  }
   /// The ids of the cells at index b, b + 1 and b + 2 (kNoIndex where empty): one population
   /// count where the three share a word.
   void threeIds(std::size_t b, std::uint32_t (&out)[3]) const {

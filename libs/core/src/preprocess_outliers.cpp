@@ -107,10 +107,9 @@ struct BlockPoints {
 UPD_VECTOR_CLONES
 void rankedShell(const detail::RankedCells& ranks, std::size_t at,
                  const std::vector<std::int64_t>& offsets, std::vector<std::uint32_t>& out) {
-  for (const std::int64_t o : offsets) {
-    const std::uint32_t c = ranks.id(at + static_cast<std::size_t>(o));
-    if (c != detail::kNoIndex) out.push_back(c);
-  }
+  const std::size_t before = out.size();
+  out.resize(before + offsets.size());
+  out.resize(before + ranks.occupiedIds(at, offsets.data(), offsets.size(), out.data() + before));
 }
 
 // The searches of one thread, cell by cell: the points of a cell share their blocks (the cells
@@ -316,20 +315,51 @@ void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>
   }
 }
 
-// d2[0, n) offered to best. (Once it is full, a run of 16 with none below its worst, the common
-// case, is passed over by one test: the worst only falls, so their offers would be refused.)
-void offerAll(const float* d2, std::size_t n, NearestK& best) {
-  std::size_t j = 0;
-  for (; j < n && !best.full(); ++j) best.offer(d2[j]);
-  constexpr std::size_t kRun = 16;
-  for (; j + kRun <= n; j += kRun) {
-    const float w = best.worst();
-    int below = 0;
-    for (std::size_t t = 0; t < kRun; ++t) below |= d2[j + t] < w ? 1 : 0;
-    if (below == 0) continue;
-    for (std::size_t t = 0; t < kRun; ++t) best.offer(d2[j + t]);
+// The least of each block of kLeastBlock values of d2[0, n) into mins (the n % kLeastBlock last
+// values left out). (Sixteen running minima in lanes, then theirs: cloned for the vector units.)
+constexpr std::size_t kLeastBlock = 64;
+UPD_VECTOR_CLONES
+void blockLeasts(const float* __restrict d2, std::size_t n, float* __restrict mins) {
+  constexpr std::size_t kLanes = 16;
+  for (std::size_t b = 0; b < n / kLeastBlock; ++b) {
+    const float* v = d2 + b * kLeastBlock;
+    float m[kLanes];
+    for (std::size_t t = 0; t < kLanes; ++t) m[t] = v[t];
+    for (std::size_t j = kLanes; j < kLeastBlock; j += kLanes) {
+      for (std::size_t t = 0; t < kLanes; ++t) m[t] = v[j + t] < m[t] ? v[j + t] : m[t];
+    }
+    float least = m[0];
+    for (std::size_t t = 1; t < kLanes; ++t) least = m[t] < least ? m[t] : least;
+    mins[b] = least;
   }
-  for (; j < n; ++j) best.offer(d2[j]);
+}
+
+// The k = best's capacity smallest of d2[0, n) offered to best, and few of the others: each
+// block of kLeastBlock holds its least, so the k-th least of the blocks' leasts bounds the k-th
+// of all (k blocks hold a value at or below it); only the blocks that hold a value at or below it
+// are offered. (Offering every value, in the grid's order, the far points first fill best and
+// most later ones displace one: an insertion each.) mins, order: scratch.
+void offerLeast(const float* d2, std::size_t n, std::size_t k, std::vector<float>& mins,
+                std::vector<float>& order, NearestK& best) {
+  // (Fewer blocks than k: no bound, every value offered.)
+  const std::size_t blocks = n / kLeastBlock >= k ? n / kLeastBlock : 0;
+  float bound = std::numeric_limits<float>::infinity();
+  if (blocks > 0) {
+    mins.resize(blocks);
+    blockLeasts(d2, n, mins.data());
+    order.assign(mins.begin(), mins.end());
+    std::nth_element(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k - 1),
+                     order.end());
+    bound = order[k - 1];
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    // (A block whose least lies beyond the bound passed over at once.)
+    if (j % kLeastBlock == 0 && j / kLeastBlock < blocks && mins[j / kLeastBlock] > bound) {
+      j += kLeastBlock - 1;
+      continue;
+    }
+    if (d2[j] <= bound) best.offer(d2[j]);
+  }
 }
 
 // The mean distances of the few grid points at positions todo, each compared with every point
@@ -340,13 +370,13 @@ void allPairsMeanDistances(const PointGrid& g, std::size_t want,
 #pragma omp parallel if (todo.size() > 1)
   {
     NearestK best(want);
-    std::vector<float> d2(n);
+    std::vector<float> d2(n), mins, order;
 #pragma omp for schedule(dynamic, 1)
     for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(todo.size()); ++r) {
       const std::uint32_t q = todo[static_cast<std::size_t>(r)];
       distances2(g.x.data(), g.y.data(), g.z.data(), n, g.x[q], g.y[q], g.z[q], d2.data());
       best.clear();
-      offerAll(d2.data(), n, best);
+      offerLeast(d2.data(), n, want, mins, order, best);
       if (best.size() >= 2) mean_dist[g.index[q]] = best.meanWithoutFirst();
     }
   }
