@@ -11,6 +11,7 @@ PACKAGES=(build-essential cmake pkg-config
           libeigen3-dev libmrpt-dev liboctomap-dev libopenni2-dev libopencv-dev
           libpcl-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libgdal-dev zlib1g-dev
           libjpeg-dev  # the rawlog pre-check decodes a JPEG before MRPT does
+          libpng-dev  # depth PNGs, decoded with error handlers of ours
           libfreenect-dev libfreenect-bin  # the Kinect v1; fakenect replays it in the tests
           libegl1 libgl1-mesa-dri  # upd render: CFBORender through EGL, Mesa's software renderer
           libx11-dev xvfb  # upd view: screenshots read from the X server; its test's X server

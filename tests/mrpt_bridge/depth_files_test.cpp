@@ -2,8 +2,11 @@
 // back to the millimetre; a file that is not a PNG, one whose header claims an image larger than
 // kMaxDepthSide a side or kMaxDepthPixels in all (refused before anything is allocated), a
 // truncated one and an 8-bit one are refused with a message naming the file and what is wrong;
-// so is a calibration YAML with a field that holds something other than numbers.
+// a damaged one in one line with libpng's reason and nothing on stderr; an interlaced one reads
+// as the plain one; so is a calibration YAML with a field that holds something other than
+// numbers.
 #include <gtest/gtest.h>
+#include <png.h>
 
 #include <opencv2/core.hpp>
 #include <opencv2/core/persistence.hpp>
@@ -126,6 +129,81 @@ TEST(DepthFiles, DamagedOrForeignFilesAreRefusedNamingTheFile) {
       << readError(eight);
 }
 
+// A 16-bit grey PNG of d's values in millimetres, Adam7-interlaced (OpenCV writes none), by
+// libpng.
+void writeInterlaced(const std::string& path, const core::DepthImage& d) {
+  FILE* f = std::fopen(path.c_str(), "wb");
+  ASSERT_NE(f, nullptr) << path;
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png_create_info_struct(png);
+  png_init_io(png, f);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(d.width), static_cast<png_uint_32>(d.height),
+               16, PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_ADAM7, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  png_set_swap(png);  // (the rows below in the host's order, little-endian here)
+  std::vector<std::uint16_t> mm(d.depth_m.size());
+  for (std::size_t i = 0; i < mm.size(); ++i) {
+    mm[i] = static_cast<std::uint16_t>(std::lround(d.depth_m[i] * 1000));
+  }
+  std::vector<png_bytep> rows(static_cast<std::size_t>(d.height));
+  for (int v = 0; v < d.height; ++v) {
+    rows[static_cast<std::size_t>(v)] =
+        reinterpret_cast<png_bytep>(mm.data() + static_cast<std::size_t>(v) * d.width);
+  }
+  png_write_image(png, rows.data());
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  std::fclose(f);
+}
+
+TEST(DepthFiles, InterlacedPngReadsAsThePlainOne) {
+  const test::TempDir tmp("depth-png-interlaced");
+  const core::DepthImage d = ramp(37, 29);  // (not a multiple of Adam7's 8 x 8 passes)
+  const std::string plain = (tmp.path() / "plain.png").string();
+  const std::string interlaced = (tmp.path() / "interlaced.png").string();
+  mrpt_bridge::writeDepthPng(plain, d);
+  writeInterlaced(interlaced, d);
+  ASSERT_EQ(fileBytes(interlaced).at(28), 1) << "IHDR's interlace method: Adam7";
+  const core::DepthImage a = mrpt_bridge::readDepthPng(plain);
+  const core::DepthImage b = mrpt_bridge::readDepthPng(interlaced);
+  ASSERT_EQ(b.width, 37);
+  ASSERT_EQ(b.height, 29);
+  ASSERT_EQ(a.depth_m.size(), b.depth_m.size());
+  for (std::size_t i = 0; i < a.depth_m.size(); ++i) {
+    ASSERT_EQ(a.depth_m[i], b.depth_m[i]) << "pixel " << i;
+  }
+}
+
+// A damaged PNG: one line naming the file and libpng's reason, and nothing on stderr (libpng's
+// own handler prints its errors there, and OpenCV's decoder keeps that handler).
+TEST(DepthFiles, DamagedPngIsOneLineAndNothingOnStderr) {
+  const test::TempDir tmp("depth-png-damaged");
+  const std::string good = (tmp.path() / "good.png").string();
+  mrpt_bridge::writeDepthPng(good, ramp(64, 48));
+  const std::vector<char> bytes = fileBytes(good);
+  ASSERT_GT(bytes.size(), 100u);
+  std::vector<char> bad_header = bytes, bad_data = bytes;
+  bad_header[28] ^= 0x01;  // IHDR's interlace byte: its CRC no longer matches
+  for (std::size_t i = 50; i < 60; ++i) bad_data[i] ^= 0x5a;  // inside IDAT's compressed data
+  const std::pair<std::vector<char>, std::string> cases[] = {
+      {bad_header, "damaged PNG (IHDR: CRC error)"},
+      {bad_data, "damaged PNG ("},
+      {std::vector<char>(bytes.begin(), bytes.end() - 20), "damaged PNG ("},  // IEND cut off
+  };
+  int n = 0;
+  for (const auto& [damaged, expected] : cases) {
+    const std::string path = (tmp.path() / ("damaged" + std::to_string(n++) + ".png")).string();
+    writeBytes(path, damaged);
+    testing::internal::CaptureStderr();
+    const std::string what = readError(path);
+    const std::string printed = testing::internal::GetCapturedStderr();
+    EXPECT_NE(what.find("depth image " + path + ": " + expected), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    EXPECT_EQ(printed, "") << path;
+  }
+}
+
 // The calibrations users have load: ROS's camera_info (comments, a quoted name), RTAB-Map's
 // (its lists over several lines, a local_transform) and what OpenCV's own writer gives
 // (!!opencv-matrix with its dt).
@@ -166,7 +244,7 @@ TEST(DepthFiles, RosRtabmapAndOpenCvCalibrationsLoad) {
 // its parser looped forever) are refused in one line naming the file and the field or line: a
 // matrix element that is a word, bytes in a list, a key with no name, a document marker with
 // text after it, text after the document's end, a control byte, a byte beyond ASCII.
-TEST(DepthFiles, CalibrationsThatEndedOrHungTheProcessAreRefused) {
+TEST(DepthFiles, CalibrationsThatEndedOrHungTheProcessOrAreEmptyAreRefused) {
   const test::TempDir tmp("depth-yaml");
   const std::string ros = (tmp.path() / "ros.yaml").string();
   std::ofstream(ros) << "image_width: 16\nimage_height: 12\ncamera_matrix:\n  rows: 3\n"
@@ -191,6 +269,11 @@ TEST(DepthFiles, CalibrationsThatEndedOrHungTheProcessAreRefused) {
   std::ofstream(control) << "image_width: 16\nimage_height: 1\x01\n";
   const std::string latin = (tmp.path() / "latin.yaml").string();
   std::ofstream(latin) << "camera_name: \"cam\xe9ra\"\nimage_width: 16\n";
+  // Empty, and only a comment and the directive: said so, not as the first field missing.
+  const std::string empty = (tmp.path() / "empty.yaml").string();
+  std::ofstream(empty) << "";
+  const std::string comment = (tmp.path() / "comment.yaml").string();
+  std::ofstream(comment) << "%YAML:1.0\n---\n# camera: to be calibrated\n";
   const char* not_a_line = "is not a line of a calibration";
   for (const auto& [path, field] :
        {std::pair<std::string, std::string>{ros, "'camera_matrix' is not a list of numbers"},
@@ -199,7 +282,9 @@ TEST(DepthFiles, CalibrationsThatEndedOrHungTheProcessAreRefused) {
         {marker, "line 2: '---e:h' " + std::string(not_a_line)},
         {ended, "line 2: text after '...', the end of the document"},
         {control, "line 2: byte 1: a control character, not text"},
-        {latin, "line 1: byte 233: not ASCII (a calibration is ASCII)"}}) {
+        {latin, "line 1: byte 233: not ASCII (a calibration is ASCII)"},
+        {empty, "empty: no fields"},
+        {comment, "empty: no fields"}}) {
     try {
       mrpt_bridge::loadDepthCalibration(path);
       ADD_FAILURE() << path << " was read";

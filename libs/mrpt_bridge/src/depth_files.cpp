@@ -1,6 +1,7 @@
 #include "upd/mrpt_bridge/depth_files.h"
 
 #include "upd/io/atomic_file.h"
+#include "png_gray16.h"
 #include "yaml_text.h"
 
 #include <opencv2/core.hpp>
@@ -157,27 +158,21 @@ core::DepthImage readDepthPng(const std::string& png_path, double metres_per_uni
               " pixels by its header: a depth image has 1 to " + std::to_string(kMaxDepthSide) +
               " a side and at most " + std::to_string(kMaxDepthPixels) + " in all");
   }
-  cv::Mat img;
-  try {
-    img = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw bad("not a readable image (" + e.err + ")");
-  }
-  if (img.empty()) throw bad("not a readable image");
-  if (img.type() != CV_16UC1) {
-    throw bad(std::to_string(img.elemSize1() * 8) + "-bit, " + std::to_string(img.channels()) +
+  // (libpng itself, not through OpenCV: its errors come back as text, where OpenCV's decoder
+  // lets libpng print them on stderr.)
+  const detail::Gray16 img = detail::decodeGray16(bytes.data(), bytes.size(), kMaxDepthSide,
+                                                  kMaxDepthPixels);
+  if (!img.error.empty()) throw bad("damaged PNG (" + img.error + ")");
+  if (img.pixels.empty()) {
+    throw bad(std::to_string(img.bit_depth) + "-bit, " + std::to_string(img.channels) +
               " channel(s); a depth image is 16-bit single channel");
   }
   core::DepthImage d;
-  d.width = img.cols;
-  d.height = img.rows;
-  d.depth_m.resize(static_cast<std::size_t>(d.width) * d.height);
-  for (int v = 0; v < d.height; ++v) {
-    const auto* row = img.ptr<std::uint16_t>(v);
-    for (int u = 0; u < d.width; ++u) {
-      d.depth_m[static_cast<std::size_t>(v) * d.width + u] =
-          static_cast<float>(row[u] * metres_per_unit);
-    }
+  d.width = static_cast<int>(img.width);
+  d.height = static_cast<int>(img.height);
+  d.depth_m.resize(img.pixels.size());
+  for (std::size_t i = 0; i < img.pixels.size(); ++i) {
+    d.depth_m[i] = static_cast<float>(img.pixels[i] * metres_per_unit);
   }
   return d;
 }

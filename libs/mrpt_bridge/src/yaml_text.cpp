@@ -188,6 +188,9 @@ cv::FileStorage openCheckedYaml(const std::string& file, const std::string& what
     cv::FileStorage fs(yaml, cv::FileStorage::READ | cv::FileStorage::MEMORY |
                                  cv::FileStorage::FORMAT_YAML);
     if (!fs.isOpened()) throw fail("unreadable");
+    // (Empty, or only comments and directives: said so, not as the first field it lacks.)
+    const cv::FileNode root = fs.root();
+    if (root.empty() || (root.isMap() && root.size() == 0)) throw fail("empty: no fields");
     return fs;
   } catch (const cv::Exception& e) {
     throw fail("not valid YAML (" + e.err + ")");
