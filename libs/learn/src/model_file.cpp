@@ -1,14 +1,16 @@
 // Model files of the learned classifier: an OpenCV FileStorage written atomically
 // (classifier.h).
 #include "classifier_impl.h"
+#include "model_bytes.h"
 
 #include "upd/io/atomic_file.h"
 
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <ostream>
 #include <stdexcept>
-
-#include <unistd.h>
 
 namespace upd::learn {
 
@@ -34,22 +36,25 @@ std::string formatOf(const std::string& path, bool* gz = nullptr) {
 
 void writeModel(cv::FileStorage& fs, const PointClassifier::Impl& m);
 
-// A compressed file: OpenCV writes it to a temporary path, renamed into place.
-void saveCompressed(const std::string& path, const PointClassifier::Impl& m) {
-  const std::filesystem::path target(path);
-  const std::filesystem::path tmp = target.parent_path() /
-      ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()) + target.stem().extension().string() + ".gz");
-  try {
-    cv::FileStorage fs(tmp.string(), cv::FileStorage::WRITE);
-    if (!fs.isOpened()) throw fileError(path, "cannot open for writing");
-    writeModel(fs, m);
-    fs.release();
-    std::filesystem::rename(tmp, target);
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
-    throw;
+// The largest model file read, compressed or not (the shipped random trees: 5 MB of YAML).
+constexpr std::uintmax_t kMaxModelBytes = std::uintmax_t{1} << 30;
+
+// OpenCV's FileStorage format flag for the extension.
+int formatFlag(const std::string& format) {
+  if (format == ".xml") return cv::FileStorage::FORMAT_XML;
+  if (format == ".json") return cv::FileStorage::FORMAT_JSON;
+  return cv::FileStorage::FORMAT_YAML;
+}
+
+// What went wrong, in one line: OpenCV 4.6's parser errors hold their text ("(line): what") in
+// func and the parser's function's name in err; its other errors their text in err.
+std::string reasonOf(const cv::Exception& e) {
+  const std::size_t at = e.func.rfind("): ");
+  const std::size_t open = at == std::string::npos ? at : e.func.rfind('(', at);
+  if (open != std::string::npos) {
+    return "line " + e.func.substr(open + 1, at - open - 1) + ": " + e.func.substr(at + 3);
   }
+  return e.err;
 }
 
 cv::Ptr<cv::ml::StatModel> emptyModel(ModelKind kind) {
@@ -114,18 +119,37 @@ void writeModel(cv::FileStorage& fs, const PointClassifier::Impl& m) {
 void PointClassifier::save(const std::string& path) const {
   bool gz = false;
   const std::string format = formatOf(path, &gz);
-  if (gz) return saveCompressed(path, *impl_);
   cv::FileStorage fs(format, cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
   writeModel(fs, *impl_);
-  const std::string text = fs.releaseAndGetString();
-  io::writeFileAtomically(path, [&](std::ostream& out) { out << text; });
+  const std::string text = detail::withChecksum(fs.releaseAndGetString(), format);
+  const std::string bytes = gz ? detail::gzip(text) : text;
+  io::writeFileAtomically(path, [&](std::ostream& out) {
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  });
 }
 
 std::shared_ptr<PointClassifier> PointClassifier::load(const std::string& path) {
-  formatOf(path);
-  if (!std::filesystem::is_regular_file(path)) throw fileError(path, "no such file");
+  bool gz = false;
+  const std::string format = formatOf(path, &gz);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw fileError(path, "no such file");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec || size > kMaxModelBytes) {
+    throw fileError(path, ec ? "unreadable" : "larger than " + std::to_string(kMaxModelBytes) +
+                                                  " bytes: not a model upd wrote");
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw fileError(path, "unreadable");
+  // The bytes checked before OpenCV parses them (model_bytes.h).
   try {
-    cv::FileStorage fs(path, cv::FileStorage::READ);
+    if (gz) text = detail::gunzip(text, kMaxModelBytes);
+    detail::checkChecksum(text, format);
+  } catch (const std::runtime_error& e) {
+    throw fileError(path, e.what());
+  }
+  try {
+    cv::FileStorage fs(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | formatFlag(format));
     if (!fs.isOpened()) throw fileError(path, "cannot open for reading");
     auto impl = std::make_shared<Impl>(readMeta(fs[kMetaNode], path));
     impl->model = emptyModel(impl->kind);
@@ -133,7 +157,7 @@ std::shared_ptr<PointClassifier> PointClassifier::load(const std::string& path) 
     if (!impl->model->isTrained()) throw fileError(path, "its 'model' node holds no trained model");
     return std::make_shared<PointClassifier>(impl);
   } catch (const cv::Exception& e) {
-    throw fileError(path, "OpenCV cannot read it: " + e.msg);
+    throw fileError(path, "OpenCV cannot read it (" + reasonOf(e) + ")");
   }
 }
 

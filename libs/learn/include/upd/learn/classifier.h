@@ -11,9 +11,11 @@
 //
 // A model file is an OpenCV FileStorage (.yml, .yaml, .xml or .json): the node
 // `upd_point_classifier` (kind, FeatureParams, feature names, standardization, the sign of the
-// raw output) and the node `model` (OpenCV's own). It is written through a temporary file
-// renamed into place. Errors are std::runtime_error naming the file; bad arguments
-// std::invalid_argument.
+// raw output) and the node `model` (OpenCV's own); .gz: the same text, gzip-compressed. A YAML
+// or XML file has a comment after its first line with the CRC-32 and length of the text after
+// it, checked on reading (a .gz by gzip's own), so that a file cut short or changed is refused
+// as damage before OpenCV parses it. It is written through a temporary file renamed into place.
+// Errors are std::runtime_error naming the file; bad arguments std::invalid_argument.
 #pragma once
 
 #include "upd/core/point_features.h"
@@ -52,7 +54,8 @@ class PointClassifier : public core::PointLabeler {
                                                 const TrainParams& params);
   /// Reads a model file (header comment).
   static std::shared_ptr<PointClassifier> load(const std::string& path);
-  /// Writes it atomically; the extension picks the format (.yml, .yaml, .xml, .json).
+  /// Writes it atomically; the extension picks the format (.yml, .yaml, .xml, .json, each
+  /// + .gz).
   void save(const std::string& path) const;
 
   /// Probability of non-traversable per row of features (core::PointLabeler).
