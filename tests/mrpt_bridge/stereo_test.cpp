@@ -120,6 +120,29 @@ TEST(Stereo, YamlErrorsNameTheFile) {
   std::filesystem::remove(bad);
 }
 
+// A word among a matrix's numbers (OpenCV throws while reading it): one line naming the files.
+TEST(Stereo, WordInAMatrixIsOneLine) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string left = (dir / "upd_stereo_word_left.yaml").string();
+  const std::string right = (dir / "upd_stereo_word_right.yaml").string();
+  const std::string head = "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n";
+  std::ofstream(left) << head << "camera_matrix:\n   rows: 3\n   cols: 3\n"
+                      << "   data: [ 500., 0., 320., 0., focal, 240., 0., 0., 1. ]\n";
+  std::ofstream(right) << head << "projection_matrix:\n   rows: 3\n   cols: 4\n"
+                       << "   data: [ 500., 0., 320., -60., 0., 500., 240., 0., 0., 0., 1., 0. ]\n";
+  try {
+    upd::mrpt_bridge::loadStereoCalibrationYaml(left, right);
+    ADD_FAILURE() << "read";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("stereo calibration " + left + " / " + right + ": "), std::string::npos)
+        << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  std::filesystem::remove(left);
+  std::filesystem::remove(right);
+}
+
 TEST(Stereo, RtabmapPairGivesHorizontalFloorBelowCamera) {
   REQUIRE_PAIR(pair);
   const StereoMatchParams params;

@@ -246,7 +246,7 @@ StereoCalibration loadStereoCalibrationYaml(const std::string& left_yaml,
     }
     c.baseline_m = -p.at<double>(0, 3) / p.at<double>(0, 0);
   } catch (const cv::Exception& e) {
-    throw std::runtime_error("stereo calibration " + left_yaml + " / " + right_yaml + ": " + e.msg);
+    throw std::runtime_error("stereo calibration " + left_yaml + " / " + right_yaml + ": " + e.err);
   }
   try {
     c.validate();
