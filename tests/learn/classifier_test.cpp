@@ -142,15 +142,21 @@ TEST(PointClassifier, DamagedFilesAreRefusedAsDamage) {
         << name;
   }
   const std::string yml = readText(at("m.yml")), xml = readText(at("m.xml"));
+  const std::string json = readText(at("m.json"));
   const std::size_t yml_line2 = yml.find('\n') + 1;
   ASSERT_EQ(yml.compare(yml_line2, 16, "# upd-nav crc32 "), 0) << yml.substr(0, 80);
   ASSERT_EQ(xml.compare(xml.find('\n') + 1, 19, "<!-- upd-nav crc32 "), 0) << xml.substr(0, 80);
+  ASSERT_EQ(json.compare(json.find('\n') + 1, 22, "    \"upd_nav_crc32\": \""), 0)
+      << json.substr(0, 80);
   // (A digit in the model's last lines, one that OpenCV would read as another number.)
   const std::size_t digit = yml.find_last_of("123456789");
   std::string changed = yml, changed_xml = xml;
   changed[digit] = changed[digit] == '1' ? '2' : '1';
   const std::size_t xml_digit = xml.find_last_of("123456789");
   changed_xml[xml_digit] = changed_xml[xml_digit] == '1' ? '2' : '1';
+  std::string changed_json = json;
+  const std::size_t json_digit = json.find_last_of("123456789");
+  changed_json[json_digit] = changed_json[json_digit] == '1' ? '2' : '1';
   std::string bad_line = yml;
   bad_line.replace(yml_line2 + 16, 8, "zzzzzzzz");
   const std::string gz = readText(at("m.yml.gz"));
@@ -162,14 +168,15 @@ TEST(PointClassifier, DamagedFilesAreRefusedAsDamage) {
       {yml + "x: 1\n", "damaged: 5 bytes more than were written"},
       {bad_line, "damaged: its checksum line ('zzzzzzzz of "},
       {changed_xml, "damaged: its text does not match its checksum"},
+      {changed_json, "damaged: its text does not match its checksum"},
       {gz.substr(0, gz.size() - 100), "damaged: cut short"},
       {flipped_gz, "damaged: "},
       {gz + "junk", "damaged: 4 bytes after the end of the compressed data"},
   };
   int n = 0;
   for (const auto& [text, expected] : cases) {
-    // (The extension of the file it was cut from: the XML case is the fifth, gzip from the sixth.)
-    const char* ext = n == 4 ? ".xml" : n >= 5 ? ".yml.gz" : ".yml";
+    // (The extension of the file it was cut from: XML and JSON the fifth and sixth, gzip on.)
+    const char* ext = n == 4 ? ".xml" : n == 5 ? ".json" : n >= 6 ? ".yml.gz" : ".yml";
     const std::string path = at("damaged" + std::to_string(n++) + ext);
     writeText(path, text);
     const std::string what = loadError(path);

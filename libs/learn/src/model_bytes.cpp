@@ -19,6 +19,8 @@ bool commentOf(const std::string& format, std::string& open, std::string& close)
     open = "# upd-nav crc32 ", close = "\n";
   } else if (format == ".xml") {
     open = "<!-- upd-nav crc32 ", close = " -->\n";
+  } else if (format == ".json") {  // (no comments in JSON: a member OpenCV reads and we ignore)
+    open = "    \"upd_nav_crc32\": \"", close = "\",\n";
   } else {
     return false;
   }

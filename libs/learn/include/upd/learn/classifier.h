@@ -11,10 +11,10 @@
 //
 // A model file is an OpenCV FileStorage (.yml, .yaml, .xml or .json): the node
 // `upd_point_classifier` (kind, FeatureParams, feature names, standardization, the sign of the
-// raw output) and the node `model` (OpenCV's own); .gz: the same text, gzip-compressed. A YAML
-// or XML file has a comment after its first line with the CRC-32 and length of the text after
-// it, checked on reading (a .gz by gzip's own), so that a file cut short or changed is refused
-// as damage before OpenCV parses it. It is written through a temporary file renamed into place.
+// raw output) and the node `model` (OpenCV's own); .gz: the same text, gzip-compressed. The
+// text has a comment after its first line with the CRC-32 and length of the text after it (JSON,
+// without comments: a member `upd_nav_crc32`), checked on reading (a .gz by gzip's own too), so
+// that a file cut short or changed is refused as damage before OpenCV parses it. It is written through a temporary file renamed into place.
 // Errors are std::runtime_error naming the file; bad arguments std::invalid_argument.
 #pragma once
 
