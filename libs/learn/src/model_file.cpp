@@ -4,11 +4,10 @@
 #include "model_bytes.h"
 
 #include "upd/io/atomic_file.h"
+#include "upd/io/whole_file.h"
 
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <ostream>
 #include <stdexcept>
 
@@ -133,16 +132,10 @@ std::shared_ptr<PointClassifier> PointClassifier::load(const std::string& path) 
   const std::string format = formatOf(path, &gz);
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw fileError(path, "no such file");
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec || size > kMaxModelBytes) {
-    throw fileError(path, ec ? "unreadable" : "larger than " + std::to_string(kMaxModelBytes) +
-                                                  " bytes: not a model upd wrote");
-  }
-  std::ifstream in(path, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw fileError(path, "unreadable");
   // The bytes checked before OpenCV parses them (model_bytes.h).
+  std::string text;
   try {
+    text = io::readWholeFile(path, kMaxModelBytes);
     if (gz) text = detail::gunzip(text, kMaxModelBytes);
     detail::checkChecksum(text, format);
   } catch (const std::runtime_error& e) {

@@ -1,6 +1,7 @@
 #include "upd/mrpt_bridge/depth_files.h"
 
 #include "upd/io/atomic_file.h"
+#include "upd/io/whole_file.h"
 #include "png_gray16.h"
 #include "yaml_text.h"
 
@@ -8,12 +9,8 @@
 #include <opencv2/core/persistence.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <ostream>
 #include <stdexcept>
 #include <vector>
@@ -134,38 +131,31 @@ core::DepthImage readDepthPng(const std::string& png_path, double metres_per_uni
   const auto bad = [&](const std::string& why) {
     return std::runtime_error("depth image " + png_path + ": " + why);
   };
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(png_path, ec)) throw bad("not found");
-  std::ifstream in(png_path, std::ios::binary);
-  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
-                                         std::istreambuf_iterator<char>());
-  if (!in.eof() && in.fail()) throw bad("unreadable");
-  // The PNG signature, then the IHDR chunk's size: OpenCV would decode any format it knows
-  // and allocate whatever a damaged header claims (up to 2^30 pixels) before reading a row.
-  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (bytes.size() < 24 || !std::equal(kSignature, kSignature + 8, bytes.begin()) ||
-      !std::equal(bytes.begin() + 12, bytes.begin() + 16, "IHDR")) {
-    throw bad("not a PNG image");
-  }
-  const auto be32 = [&](std::size_t at) {
-    return std::uint32_t{bytes[at]} << 24 | std::uint32_t{bytes[at + 1]} << 16 |
-           std::uint32_t{bytes[at + 2]} << 8 | std::uint32_t{bytes[at + 3]};
-  };
-  const std::uint32_t width = be32(16), height = be32(20);
-  if (width == 0 || height == 0 || width > kMaxDepthSide || height > kMaxDepthSide ||
-      std::uint64_t{width} * height > kMaxDepthPixels) {
-    throw bad(std::to_string(width) + " x " + std::to_string(height) +
-              " pixels by its header: a depth image has 1 to " + std::to_string(kMaxDepthSide) +
-              " a side and at most " + std::to_string(kMaxDepthPixels) + " in all");
+  // (At most 128 MB: the largest image read, 2^25 pixels of 2 bytes, is 64 MB even stored.)
+  std::string bytes;
+  try {
+    bytes = io::readWholeFile(png_path, std::uintmax_t{1} << 27);
+  } catch (const std::runtime_error& e) {
+    throw bad(e.what());
   }
   // (libpng itself, not through OpenCV: its errors come back as text, where OpenCV's decoder
-  // lets libpng print them on stderr.)
-  const detail::Gray16 img = detail::decodeGray16(bytes.data(), bytes.size(), kMaxDepthSide,
-                                                  kMaxDepthPixels);
-  if (!img.error.empty()) throw bad("damaged PNG (" + img.error + ")");
-  if (img.pixels.empty()) {
-    throw bad(std::to_string(img.bit_depth) + "-bit, " + std::to_string(img.channels) +
-              " channel(s); a depth image is 16-bit single channel");
+  // lets libpng print them on stderr; and the header's size is checked before any allocation,
+  // where OpenCV allocates up to 2^30 pixels.)
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  const detail::Gray16 img =
+      detail::decodeGray16(data, bytes.size(), kMaxDepthSide, kMaxDepthPixels);
+  using Png = detail::Gray16::Status;
+  switch (img.status) {
+    case Png::NotPng: throw bad("not a PNG image");
+    case Png::TooLarge:
+      throw bad(std::to_string(img.width) + " x " + std::to_string(img.height) +
+                " pixels by its header: a depth image has 1 to " + std::to_string(kMaxDepthSide) +
+                " a side and at most " + std::to_string(kMaxDepthPixels) + " in all");
+    case Png::Damaged: throw bad("damaged PNG (" + img.error + ")");
+    case Png::NotGray16:
+      throw bad(std::to_string(img.bit_depth) + "-bit, " + std::to_string(img.channels) +
+                " channel(s); a depth image is 16-bit single channel");
+    case Png::Gray16: break;
   }
   core::DepthImage d;
   d.width = static_cast<int>(img.width);

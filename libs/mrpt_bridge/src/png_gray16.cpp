@@ -46,18 +46,19 @@ int channelsOf(int color_type) {
 // the image's buffers sized by the caller's resize callback before libpng writes into them.
 // Returns false where libpng reported an error (in src.error).
 template <class Resize>
-bool decodeInto(png_structp png, png_infop info, Source& src, Gray16& out, std::uint32_t max_side,
-                std::uint64_t max_pixels, Resize& resize) {
+bool decodeInto(png_structp png, png_infop info, Source& src, Gray16& out, Resize& resize) {
+  using Status = Gray16::Status;
   if (setjmp(png_jmpbuf(png))) return false;
-  png_set_user_limits(png, max_side, max_side);
   png_set_read_fn(png, &src, readBytes);
   png_read_info(png, info);
   out.width = png_get_image_width(png, info);
   out.height = png_get_image_height(png, info);
   out.bit_depth = png_get_bit_depth(png, info);
   out.channels = channelsOf(png_get_color_type(png, info));
-  if (out.bit_depth != 16 || out.channels != 1) return true;
-  if (std::uint64_t{out.width} * out.height > max_pixels) png_error(png, "too many pixels");
+  if (out.bit_depth != 16 || out.channels != 1) {
+    out.status = Status::NotGray16;
+    return true;
+  }
 #if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
   png_set_swap(png);  // (PNG's samples are big-endian)
 #endif
@@ -66,6 +67,7 @@ bool decodeInto(png_structp png, png_infop info, Source& src, Gray16& out, std::
   png_bytep* rows = resize(out);
   png_read_image(png, rows);
   png_read_end(png, nullptr);
+  out.status = Status::Gray16;
   return true;
 }
 
@@ -74,11 +76,24 @@ bool decodeInto(png_structp png, png_infop info, Source& src, Gray16& out, std::
 Gray16 decodeGray16(const unsigned char* bytes, std::size_t n, std::uint32_t max_side,
                     std::uint64_t max_pixels) {
   Gray16 out;
+  // The signature and the first chunk, IHDR, whose size is checked here, before libpng checks
+  // its CRC and allocates for it.
+  if (n < 24 || png_sig_cmp(bytes, 0, 8) != 0 || std::memcmp(bytes + 12, "IHDR", 4) != 0) {
+    return out;  // (NotPng)
+  }
+  out.width = png_get_uint_32(bytes + 16);
+  out.height = png_get_uint_32(bytes + 20);
+  if (out.width == 0 || out.height == 0 || out.width > max_side || out.height > max_side ||
+      std::uint64_t{out.width} * out.height > max_pixels) {
+    out.status = Gray16::Status::TooLarge;
+    return out;
+  }
   Source src{bytes, n, 0, {}};
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &src, keepError, dropWarning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!info) {
     png_destroy_read_struct(&png, nullptr, nullptr);
+    out.status = Gray16::Status::Damaged;
     out.error = "out of memory";
     return out;
   }
@@ -92,7 +107,8 @@ Gray16 decodeGray16(const unsigned char* bytes, std::size_t n, std::uint32_t max
     }
     return rows.data();
   };
-  if (!decodeInto(png, info, src, out, max_side, max_pixels, resize)) {
+  if (!decodeInto(png, info, src, out, resize)) {
+    out.status = Gray16::Status::Damaged;
     out.error = src.error;
     out.pixels.clear();
   }

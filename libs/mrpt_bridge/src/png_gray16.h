@@ -11,16 +11,22 @@ namespace upd::mrpt_bridge::detail {
 
 /// What decodeGray16 found.
 struct Gray16 {
-  std::uint32_t width = 0, height = 0;
-  std::vector<std::uint16_t> pixels;  ///< row by row, in the host's byte order
-  int bit_depth = 0, channels = 0;    ///< of the file, whatever it holds
-  std::string error;                  ///< empty where it decoded a 16-bit single-channel image
+  enum class Status {
+    Gray16,     ///< decoded into pixels
+    NotPng,     ///< no PNG signature and IHDR (text, another format, empty)
+    TooLarge,   ///< width x height by the header 0 or beyond the limits (nothing allocated)
+    Damaged,    ///< libpng's reason in error (a chunk's CRC, its data, the file cut short)
+    NotGray16,  ///< a PNG of another kind: bit_depth and channels say which
+  };
+  Status status = Status::NotPng;
+  std::uint32_t width = 0, height = 0;  ///< by the header
+  std::vector<std::uint16_t> pixels;    ///< row by row, in the host's byte order
+  int bit_depth = 0, channels = 0;      ///< of the file, whatever it holds
+  std::string error;                    ///< Damaged: libpng's reason
 };
 
-/// Decodes the PNG bytes[0, n): a 16-bit grey image into pixels; another kind of image leaves
-/// pixels empty with its bit depth and channels (error empty); a damaged file sets error to
-/// libpng's reason ("IHDR: CRC error", "file cut short"). At most max_side pixels a side and
-/// max_pixels in all (larger: an error before any allocation for them).
+/// Decodes the PNG bytes[0, n) where it is a 16-bit grey image of at most max_side pixels a
+/// side and max_pixels in all; else says why not (Gray16::Status).
 Gray16 decodeGray16(const unsigned char* bytes, std::size_t n, std::uint32_t max_side,
                     std::uint64_t max_pixels);
 

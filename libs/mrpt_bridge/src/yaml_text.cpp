@@ -1,13 +1,13 @@
 // Calibration YAMLs checked line by line, then opened by OpenCV's parser (yaml_text.h).
 #include "yaml_text.h"
 
+#include "upd/io/whole_file.h"
+
 #include <opencv2/core.hpp>
 
 #include <algorithm>
 #include <cctype>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
+#include <cstdint>
 #include <stdexcept>
 
 namespace upd::mrpt_bridge {
@@ -177,11 +177,13 @@ cv::FileStorage openCheckedYaml(const std::string& file, const std::string& what
   const auto fail = [&](const std::string& why) {
     return std::runtime_error(what + " " + file + ": " + why);
   };
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw fail("not found");
-  std::ifstream in(file, std::ios::binary);
-  std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw fail("unreadable");
+  // (A calibration is a few kB: 16 MB is no calibration.)
+  std::string yaml;
+  try {
+    yaml = io::readWholeFile(file, std::uintmax_t{1} << 24);
+  } catch (const std::runtime_error& e) {
+    throw fail(e.what());
+  }
   checkText(yaml, file, what);
   if (yaml.rfind("%YAML", 0) != 0) yaml = "%YAML:1.0\n---\n" + yaml;
   try {
