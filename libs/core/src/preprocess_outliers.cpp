@@ -352,13 +352,12 @@ void offerLeast(const float* d2, std::size_t n, std::size_t k, std::vector<float
                      order.end());
     bound = order[k - 1];
   }
-  for (std::size_t j = 0; j < n; ++j) {
+  for (std::size_t b = 0; b < n; b += kLeastBlock) {
     // (A block whose least lies beyond the bound passed over at once.)
-    if (j % kLeastBlock == 0 && j / kLeastBlock < blocks && mins[j / kLeastBlock] > bound) {
-      j += kLeastBlock - 1;
-      continue;
+    if (b / kLeastBlock < blocks && mins[b / kLeastBlock] > bound) continue;
+    for (std::size_t j = b; j < std::min(n, b + kLeastBlock); ++j) {
+      if (d2[j] <= bound) best.offer(d2[j]);
     }
-    if (d2[j] <= bound) best.offer(d2[j]);
   }
 }
 

@@ -124,11 +124,11 @@ std::string gunzip(const std::string& bytes, std::size_t max_bytes) {
       inflateEnd(&z);
       throw damaged("more than " + std::to_string(max_bytes) + " bytes uncompressed");
     }
-    if (r == Z_BUF_ERROR && z.avail_in == 0) break;  // (the input ended before the stream)
   }
   const std::string why = z.msg ? z.msg : "";
   const std::size_t left = z.avail_in;
   inflateEnd(&z);
+  // (Z_BUF_ERROR: no progress possible, the input used up before the stream's end)
   if (r == Z_BUF_ERROR) throw damaged("cut short (the compressed stream ends before its end mark)");
   if (r != Z_STREAM_END) throw damaged("not valid gzip (" + (why.empty() ? "zlib error" : why) + ")");
   if (left != 0) throw damaged(std::to_string(left) + " bytes after the end of the compressed data");
