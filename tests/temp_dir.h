@@ -20,6 +20,12 @@ inline std::string readFileBytes(const std::filesystem::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+/// Writes bytes to path, replacing it: what a test damages a file by.
+inline void writeFileBytes(const std::filesystem::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
 class TempDir {
  public:
   /// Named after the running test and tag (unique per process and construction).

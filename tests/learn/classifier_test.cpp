@@ -3,12 +3,12 @@
 // refused as damage before OpenCV parses them.
 #include "upd/learn/classifier.h"
 
+#include "error_of.h"
 #include "temp_dir.h"
 
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <iterator>
 #include <random>
 #include <string>
 
@@ -109,23 +109,9 @@ TEST(PointClassifier, FileRoundTripsAndBadFilesFail) {
   EXPECT_THROW(PointClassifier::train(f, one_class, fp, p), std::invalid_argument);
 }
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void writeText(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
-
 // PointClassifier::load's error on path, or "" when it loads.
 std::string loadError(const std::string& path) {
-  try {
-    PointClassifier::load(path);
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
+  return test::errorOf([&] { PointClassifier::load(path); });
 }
 
 TEST(PointClassifier, DamagedFilesAreRefusedAsDamage) {
@@ -133,63 +119,59 @@ TEST(PointClassifier, DamagedFilesAreRefusedAsDamage) {
   std::vector<Label> t;
   const auto c = smallModel(600, 4, 5, core::FeatureParams{}, f, t);
   const test::TempDir tmp;
-  const auto at = [&](const std::string& name) { return (tmp.path() / name).string(); };
   // Every format round-trips; the text ones carry their checksum after their first line.
   for (const char* name : {"m.yml", "m.xml", "m.json", "m.yml.gz"}) {
-    c->save(at(name));
-    EXPECT_EQ(PointClassifier::load(at(name))->probabilityOfFeatures(f),
+    c->save(tmp.file(name));
+    EXPECT_EQ(PointClassifier::load(tmp.file(name))->probabilityOfFeatures(f),
               c->probabilityOfFeatures(f))
         << name;
   }
-  const std::string yml = readText(at("m.yml")), xml = readText(at("m.xml"));
-  const std::string json = readText(at("m.json"));
+  const std::string yml = test::readFileBytes(tmp.file("m.yml"));
+  const std::string xml = test::readFileBytes(tmp.file("m.xml"));
+  const std::string json = test::readFileBytes(tmp.file("m.json"));
   const std::size_t yml_line2 = yml.find('\n') + 1;
   ASSERT_EQ(yml.compare(yml_line2, 16, "# upd-nav crc32 "), 0) << yml.substr(0, 80);
   ASSERT_EQ(xml.compare(xml.find('\n') + 1, 19, "<!-- upd-nav crc32 "), 0) << xml.substr(0, 80);
   ASSERT_EQ(json.compare(json.find('\n') + 1, 22, "    \"upd_nav_crc32\": \""), 0)
       << json.substr(0, 80);
   // (A digit in the model's last lines, one that OpenCV would read as another number.)
-  const std::size_t digit = yml.find_last_of("123456789");
-  std::string changed = yml, changed_xml = xml;
-  changed[digit] = changed[digit] == '1' ? '2' : '1';
-  const std::size_t xml_digit = xml.find_last_of("123456789");
-  changed_xml[xml_digit] = changed_xml[xml_digit] == '1' ? '2' : '1';
-  std::string changed_json = json;
-  const std::size_t json_digit = json.find_last_of("123456789");
-  changed_json[json_digit] = changed_json[json_digit] == '1' ? '2' : '1';
+  const auto digitChanged = [](std::string text) {
+    const std::size_t at = text.find_last_of("123456789");
+    text[at] = text[at] == '1' ? '2' : '1';
+    return text;
+  };
   std::string bad_line = yml;
   bad_line.replace(yml_line2 + 16, 8, "zzzzzzzz");
-  const std::string gz = readText(at("m.yml.gz"));
+  const std::string gz = test::readFileBytes(tmp.file("m.yml.gz"));
   std::string flipped_gz = gz;
   flipped_gz[gz.size() / 2] = static_cast<char>(flipped_gz[gz.size() / 2] ^ 0x10);
-  const std::pair<std::string, std::string> cases[] = {
-      {changed, "damaged: its text does not match its checksum"},
-      {yml.substr(0, yml.size() - 10), "damaged: cut short: "},
-      {yml + "x: 1\n", "damaged: 5 bytes more than were written"},
-      {bad_line, "damaged: its checksum line ('zzzzzzzz of "},
-      {changed_xml, "damaged: its text does not match its checksum"},
-      {changed_json, "damaged: its text does not match its checksum"},
-      {gz.substr(0, gz.size() - 100), "damaged: cut short"},
-      {flipped_gz, "damaged: "},
-      {gz + "junk", "damaged: 4 bytes after the end of the compressed data"},
+  // Each case: the damaged bytes, the extension they are read as, what the message says.
+  const std::string cases[][3] = {
+      {digitChanged(yml), ".yml", "damaged: its text does not match its checksum"},
+      {yml.substr(0, yml.size() - 10), ".yml", "damaged: cut short: "},
+      {yml + "x: 1\n", ".yml", "damaged: 5 bytes more than were written"},
+      {bad_line, ".yml", "damaged: its checksum line ('zzzzzzzz of "},
+      {digitChanged(xml), ".xml", "damaged: its text does not match its checksum"},
+      {digitChanged(json), ".json", "damaged: its text does not match its checksum"},
+      {gz.substr(0, gz.size() - 100), ".yml.gz", "damaged: cut short"},
+      {flipped_gz, ".yml.gz", "damaged: "},
+      {gz + "junk", ".yml.gz", "damaged: 4 bytes after the end of the compressed data"},
   };
   int n = 0;
-  for (const auto& [text, expected] : cases) {
-    // (The extension of the file it was cut from: XML and JSON the fifth and sixth, gzip on.)
-    const char* ext = n == 4 ? ".xml" : n == 5 ? ".json" : n >= 6 ? ".yml.gz" : ".yml";
-    const std::string path = at("damaged" + std::to_string(n++) + ext);
-    writeText(path, text);
+  for (const auto& [text, ext, expected] : cases) {
+    const std::string path = tmp.file("damaged" + std::to_string(n++) + ext);
+    test::writeFileBytes(path, text);
     const std::string what = loadError(path);
     EXPECT_NE(what.find("classifier '" + path + "': " + expected), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
   // Without its checksum line (written by hand): read as it is.
-  const std::string by_hand = at("by_hand.yml");
-  writeText(by_hand, yml.substr(0, yml_line2) + yml.substr(yml.find('\n', yml_line2) + 1));
+  const std::string by_hand = tmp.file("by_hand.yml");
+  test::writeFileBytes(by_hand, yml.substr(0, yml_line2) + yml.substr(yml.find('\n', yml_line2) + 1));
   EXPECT_EQ(loadError(by_hand), "");
   // OpenCV's parse error, in one line with its line number.
-  const std::string broken = at("broken.yml");
-  writeText(broken, "%YAML:1.0\n---\nupd_point_classifier:\n   kind: rtrees\n  - x\n");
+  const std::string broken = tmp.file("broken.yml");
+  test::writeFileBytes(broken, "%YAML:1.0\n---\nupd_point_classifier:\n   kind: rtrees\n  - x\n");
   const std::string what = loadError(broken);
   EXPECT_NE(what.find("OpenCV cannot read it (line "), std::string::npos) << what;
   EXPECT_EQ(what.find('\n'), std::string::npos) << what;

@@ -21,30 +21,19 @@
 #include <utility>
 #include <vector>
 
+#include "error_of.h"
 #include "temp_dir.h"
 #include "upd/mrpt_bridge/depth_files.h"
 
 namespace upd {
 namespace {
 
-std::vector<char> fileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void writeBytes(const std::string& path, const std::vector<char>& bytes) {
-  std::ofstream(path, std::ios::binary)
-      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
+using test::readFileBytes;
+using test::writeFileBytes;
 
 // readDepthPng's error on path, or "" when it reads.
 std::string readError(const std::string& path) {
-  try {
-    mrpt_bridge::readDepthPng(path);
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "";
+  return test::errorOf([&] { mrpt_bridge::readDepthPng(path); });
 }
 
 core::DepthImage ramp(int width, int height) {
@@ -77,29 +66,29 @@ TEST(DepthFiles, DamagedOrForeignFilesAreRefusedNamingTheFile) {
   const test::TempDir tmp("depth-png-bad");
   const std::string good = (tmp.path() / "good.png").string();
   mrpt_bridge::writeDepthPng(good, ramp(32, 24));
-  const std::vector<char> bytes = fileBytes(good);
+  const std::string bytes = readFileBytes(good);
   ASSERT_GT(bytes.size(), 40u);
 
   // Not a PNG: text, and a 16-bit TIFF (OpenCV would decode it by its content).
   const std::string text = (tmp.path() / "text.png").string();
-  writeBytes(text, {'d', 'e', 'p', 't', 'h'});
+  writeFileBytes(text, "depth");
   EXPECT_NE(readError(text).find("text.png: not a PNG image"), std::string::npos)
       << readError(text);
   const std::string tiff = (tmp.path() / "tiff.png").string();
   std::vector<unsigned char> tiff_bytes;
   ASSERT_TRUE(cv::imencode(".tiff", cv::Mat(24, 32, CV_16UC1, cv::Scalar(1000)), tiff_bytes));
-  writeBytes(tiff, std::vector<char>(tiff_bytes.begin(), tiff_bytes.end()));
+  writeFileBytes(tiff, std::string(tiff_bytes.begin(), tiff_bytes.end()));
   EXPECT_NE(readError(tiff).find("tiff.png: not a PNG image"), std::string::npos)
       << readError(tiff);
 
   // A header claiming 100,000 x 100,000 pixels (40 GB as 16-bit): refused by its size.
-  std::vector<char> huge = bytes;
+  std::string huge = bytes;
   for (std::size_t at : {16u, 20u}) {
     const std::uint32_t side = 100000;
     for (int b = 0; b < 4; ++b) huge[at + b] = static_cast<char>(side >> (24 - 8 * b));
   }
   const std::string big = (tmp.path() / "big.png").string();
-  writeBytes(big, huge);
+  writeFileBytes(big, huge);
   EXPECT_NE(readError(big).find("big.png: 100000 x 100000 pixels by its header"),
             std::string::npos)
       << readError(big);
@@ -109,17 +98,17 @@ TEST(DepthFiles, DamagedOrForeignFilesAreRefusedNamingTheFile) {
     const std::uint32_t side = 16000;
     for (int b = 0; b < 4; ++b) huge[at + b] = static_cast<char>(side >> (24 - 8 * b));
   }
-  writeBytes(big, huge);
+  writeFileBytes(big, huge);
   EXPECT_NE(readError(big).find("big.png: 16000 x 16000 pixels by its header"),
             std::string::npos)
       << readError(big);
 
   // Cut in the middle of its data, and empty.
   const std::string cut = (tmp.path() / "cut.png").string();
-  writeBytes(cut, std::vector<char>(bytes.begin(), bytes.begin() + bytes.size() / 2));
+  writeFileBytes(cut, bytes.substr(0, bytes.size() / 2));
   EXPECT_NE(readError(cut).find("cut.png: "), std::string::npos);
   const std::string empty = (tmp.path() / "empty.png").string();
-  writeBytes(empty, {});
+  writeFileBytes(empty, "");
   EXPECT_NE(readError(empty).find("empty.png: not a PNG image"), std::string::npos);
 
   // An 8-bit image.
@@ -164,7 +153,7 @@ TEST(DepthFiles, InterlacedPngReadsAsThePlainOne) {
   const std::string interlaced = (tmp.path() / "interlaced.png").string();
   mrpt_bridge::writeDepthPng(plain, d);
   writeInterlaced(interlaced, d);
-  ASSERT_EQ(fileBytes(interlaced).at(28), 1) << "IHDR's interlace method: Adam7";
+  ASSERT_EQ(readFileBytes(interlaced).at(28), 1) << "IHDR's interlace method: Adam7";
   const core::DepthImage a = mrpt_bridge::readDepthPng(plain);
   const core::DepthImage b = mrpt_bridge::readDepthPng(interlaced);
   ASSERT_EQ(b.width, 37);
@@ -181,20 +170,20 @@ TEST(DepthFiles, DamagedPngIsOneLineAndNothingOnStderr) {
   const test::TempDir tmp("depth-png-damaged");
   const std::string good = (tmp.path() / "good.png").string();
   mrpt_bridge::writeDepthPng(good, ramp(64, 48));
-  const std::vector<char> bytes = fileBytes(good);
+  const std::string bytes = readFileBytes(good);
   ASSERT_GT(bytes.size(), 100u);
-  std::vector<char> bad_header = bytes, bad_data = bytes;
+  std::string bad_header = bytes, bad_data = bytes;
   bad_header[28] ^= 0x01;  // IHDR's interlace byte: its CRC no longer matches
   for (std::size_t i = 50; i < 60; ++i) bad_data[i] ^= 0x5a;  // inside IDAT's compressed data
-  const std::pair<std::vector<char>, std::string> cases[] = {
+  const std::pair<std::string, std::string> cases[] = {
       {bad_header, "damaged PNG (IHDR: CRC error)"},
       {bad_data, "damaged PNG ("},
-      {std::vector<char>(bytes.begin(), bytes.end() - 20), "damaged PNG ("},  // IEND cut off
+      {bytes.substr(0, bytes.size() - 20), "damaged PNG ("},  // IEND cut off
   };
   int n = 0;
   for (const auto& [damaged, expected] : cases) {
     const std::string path = (tmp.path() / ("damaged" + std::to_string(n++) + ".png")).string();
-    writeBytes(path, damaged);
+    writeFileBytes(path, damaged);
     testing::internal::CaptureStderr();
     const std::string what = readError(path);
     const std::string printed = testing::internal::GetCapturedStderr();
@@ -246,52 +235,42 @@ TEST(DepthFiles, RosRtabmapAndOpenCvCalibrationsLoad) {
 // text after it, text after the document's end, a control byte, a byte beyond ASCII.
 TEST(DepthFiles, CalibrationsThatEndedOrHungTheProcessOrAreEmptyAreRefused) {
   const test::TempDir tmp("depth-yaml");
-  const std::string ros = (tmp.path() / "ros.yaml").string();
-  std::ofstream(ros) << "image_width: 16\nimage_height: 12\ncamera_matrix:\n  rows: 3\n"
-                        "  cols: 3\n  data: [13.1, 0, 7.5, 0, focal, 5.5, 0, 0, 1]\n";
-  const std::string rtabmap = (tmp.path() / "rtabmap.yaml").string();
-  std::ofstream(rtabmap) << "%YAML:1.0\n---\nimage_width: 16\nimage_height: 12\n"
-                            "camera_matrix:\n   rows: 3\n   cols: 3\n"
-                            "   data: [ 13.1, 0., 7.5, 0., 13.1, 5.5, 0., 0., 1. ]\n"
-                            "distortion_coefficients:\n   rows: 1\n   cols: 5\n"
-                            "   data: [ 0.1, \"\\xff\\xff\", 0., 0., 0. ]\n";
-  // A key with no name (OpenCV's parser threw std::length_error through the reader).
-  const std::string nameless = (tmp.path() / "nameless.yaml").string();
-  std::ofstream(nameless) << "%YAML:1.0\n---\nimage_width: 16\nlocal_transform:\n   rows: 3\n"
-                             "   :d aat[ 0., 0., 1. ]\n";
-  // A document marker with text after it, and text after the document's end, on which
-  // OpenCV's parser loops forever; a control byte.
-  const std::string marker = (tmp.path() / "marker.yaml").string();
-  std::ofstream(marker) << "%YAML:1.0\n---e:h\nima-\nc";
-  const std::string ended = (tmp.path() / "ended.yaml").string();
-  std::ofstream(ended) << "...\n-";
-  const std::string control = (tmp.path() / "control.yaml").string();
-  std::ofstream(control) << "image_width: 16\nimage_height: 1\x01\n";
-  const std::string latin = (tmp.path() / "latin.yaml").string();
-  std::ofstream(latin) << "camera_name: \"cam\xe9ra\"\nimage_width: 16\n";
-  // Empty, and only a comment and the directive: said so, not as the first field missing.
-  const std::string empty = (tmp.path() / "empty.yaml").string();
-  std::ofstream(empty) << "";
-  const std::string comment = (tmp.path() / "comment.yaml").string();
-  std::ofstream(comment) << "%YAML:1.0\n---\n# camera: to be calibrated\n";
-  const char* not_a_line = "is not a line of a calibration";
-  for (const auto& [path, field] :
-       {std::pair<std::string, std::string>{ros, "'camera_matrix' is not a list of numbers"},
-        {rtabmap, "line 12: '   data: [ 0.1, \""},
-        {nameless, "line 6: '   :d aat[ 0., 0., 1. ]' " + std::string(not_a_line)},
-        {marker, "line 2: '---e:h' " + std::string(not_a_line)},
-        {ended, "line 2: text after '...', the end of the document"},
-        {control, "line 2: byte 1: a control character, not text"},
-        {latin, "line 1: byte 233: not ASCII (a calibration is ASCII)"},
-        {empty, "empty: no fields"},
-        {comment, "empty: no fields"}}) {
-    try {
-      mrpt_bridge::loadDepthCalibration(path);
-      ADD_FAILURE() << path << " was read";
-    } catch (const std::runtime_error& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find("calibration " + path + ": " + field), std::string::npos) << what;
-    }
+  const std::string not_a_line = "is not a line of a calibration";
+  // Each case: the file's name, its text and what the message says after the file's name.
+  const std::string cases[][3] = {
+      {"ros.yaml",
+       "image_width: 16\nimage_height: 12\ncamera_matrix:\n  rows: 3\n"
+       "  cols: 3\n  data: [13.1, 0, 7.5, 0, focal, 5.5, 0, 0, 1]\n",
+       "'camera_matrix' is not a list of numbers"},
+      {"rtabmap.yaml",
+       "%YAML:1.0\n---\nimage_width: 16\nimage_height: 12\ncamera_matrix:\n   rows: 3\n"
+       "   cols: 3\n   data: [ 13.1, 0., 7.5, 0., 13.1, 5.5, 0., 0., 1. ]\n"
+       "distortion_coefficients:\n   rows: 1\n   cols: 5\n"
+       "   data: [ 0.1, \"\\xff\\xff\", 0., 0., 0. ]\n",
+       "line 12: '   data: [ 0.1, \""},
+      // A key with no name (OpenCV's parser threw std::length_error through the reader).
+      {"nameless.yaml",
+       "%YAML:1.0\n---\nimage_width: 16\nlocal_transform:\n   rows: 3\n"
+       "   :d aat[ 0., 0., 1. ]\n",
+       "line 6: '   :d aat[ 0., 0., 1. ]' " + not_a_line},
+      // A document marker with text after it, and text after the document's end, on which
+      // OpenCV's parser loops forever; a control byte, a byte beyond ASCII.
+      {"marker.yaml", "%YAML:1.0\n---e:h\nima-\nc", "line 2: '---e:h' " + not_a_line},
+      {"ended.yaml", "...\n-", "line 2: text after '...', the end of the document"},
+      {"control.yaml", "image_width: 16\nimage_height: 1\x01\n",
+       "line 2: byte 1: a control character, not text"},
+      {"latin.yaml", "camera_name: \"cam\xe9ra\"\nimage_width: 16\n",
+       "line 1: byte 233: not ASCII (a calibration is ASCII)"},
+      // Empty, and only a comment and the directive: said so, not as the first field missing.
+      {"empty.yaml", "", "empty: no fields"},
+      {"comment.yaml", "%YAML:1.0\n---\n# camera: to be calibrated\n", "empty: no fields"},
+  };
+  for (const auto& [name, text, field] : cases) {
+    const std::string path = tmp.file(name);
+    writeFileBytes(path, text);
+    const std::string what = test::errorOf([&] { mrpt_bridge::loadDepthCalibration(path); });
+    EXPECT_NE(what.find("calibration " + path + ": " + field), std::string::npos)
+        << name << ": " << what;
   }
 }
 
