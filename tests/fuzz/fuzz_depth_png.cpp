@@ -1,5 +1,5 @@
 // A depth PNG on arbitrary bytes, as `upd analyze --intrinsics` and TUM folders read it
-// (readDepthPng: our signature and header checks, then OpenCV's PNG decoder). Any input must
+// (readDepthPng: our signature and header checks, then libpng with our handlers). Any input must
 // give a depth image or a std::runtime_error, never a crash, a hang, a sanitizer report or an
 // allocation beyond the fuzzer's limit.
 #include "fuzz_input.h"
