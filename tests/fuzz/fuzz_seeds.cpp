@@ -5,10 +5,11 @@
 // sensors a robot records beside its depth camera (IMU, odometry, GNSS, point clouds, range
 // finders, JPEG camera images, a 360-degree RGB-D rig); with ROS 1, small bags (uncompressed,
 // BZ2 and LZ4 chunks) of depth frames and point clouds with their transforms; for the depth
-// files a small 16-bit depth PNG and calibrations as ROS and RTAB-Map write them.
+// files a small 16-bit depth PNG and calibrations as ROS and RTAB-Map write them; with the
+// learned classifier, small models of each kind.
 // scripts/fuzz.sh adds the seeds taken from ../shared/data.
 //   fuzz_seeds OUTDIR   ->  OUTDIR/{pcd,ply,xyz,kitti_bin,pipeline,rawlog,bag,depth_png,
-//                                   calibration}/...
+//                                   calibration,classifier}/...
 #include "io/cloud_samples.h"
 
 #include "upd/io/cloud_io.h"
@@ -44,6 +45,9 @@
 
 #ifdef UPD_FUZZ_HAVE_ROS1
 #include "ros/small_bag.h"
+#endif
+#ifdef UPD_FUZZ_HAVE_LEARN
+#include "upd/learn/classifier.h"
 #endif
 
 #include <cstdio>
@@ -277,6 +281,31 @@ void putSensorsRawlog(const fs::path& dir) {
 }
 
 
+#ifdef UPD_FUZZ_HAVE_LEARN
+// A small model of each kind as YAML (random trees of 2 trees of depth 3; boosting; SVM).
+void putModels(const fs::path& dir) {
+  const int n = 200, width = upd::core::kFeatureCount;
+  std::vector<float> f(static_cast<std::size_t>(n * width));
+  std::vector<upd::core::Label> t(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < width; ++j) {
+      f[i * width + j] = static_cast<float>((i * 7 + j * 13) % 29) / 29.f;
+    }
+    t[i] = f[i * width] < 0.5f ? upd::core::Label::NonTraversable : upd::core::Label::Traversable;
+  }
+  fs::create_directories(dir);
+  for (const auto kind : {upd::learn::ModelKind::RandomTrees, upd::learn::ModelKind::Boost,
+                          upd::learn::ModelKind::Svm}) {
+    upd::learn::TrainParams p;
+    p.kind = kind;
+    p.trees = 2;
+    p.max_depth = 3;
+    const fs::path file = dir / (std::string(upd::learn::toString(kind)) + ".yml");
+    upd::learn::PointClassifier::train(f, t, upd::core::FeatureParams{}, p)->save(file.string());
+  }
+}
+#endif
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -332,6 +361,9 @@ int main(int argc, char** argv) {
     bag.compression = compression;
     upd::test::writeSmallBag((out / "bag" / name).string(), bag);
   }
+#endif
+#ifdef UPD_FUZZ_HAVE_LEARN
+  putModels(out / "classifier");
 #endif
   return 0;
 }

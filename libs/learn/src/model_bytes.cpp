@@ -60,7 +60,10 @@ void checkChecksum(const std::string& text, const std::string& format) {
   const std::size_t eol = text.find('\n');
   if (!commentOf(format, open, close) || eol == std::string::npos ||
       text.compare(eol + 1, open.size(), open) != 0) {
-    return;  // (no checksum line after the first: a file written by hand)
+    throw std::runtime_error(
+        std::string("no checksum ") + (format == ".json" ? "member" : "line") +
+        " after its first line: a model is read only as `upd train` wrote it (OpenCV's reader "
+        "trusts a model's structure: a model made or edited by hand can hang or crash it)");
   }
   // "<open>XXXXXXXX of N bytes<close>", then the N bytes it covers.
   const std::size_t at = eol + 1 + open.size();
