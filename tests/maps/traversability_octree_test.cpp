@@ -224,6 +224,40 @@ TEST(TraversabilityOctree, InsertIsTheSameOnOneThreadAndTwoAcrossChunks) {
   }
 }
 
+// The insert updates only the inner nodes above the voxels a frame changes, so that a frame's
+// cost does not grow with the map: frame after frame of a sensor moving over a noisy floor
+// (its points on both sides of the voxel boundary z = 0) towards a wall, the box moving and
+// the tiles kept outside it coming back, the tree is byte for byte what an update of every
+// inner node gives.
+TEST(TraversabilityOctree, InsertUpdatesTheInnerNodesAsAWholeTreeUpdate) {
+  OctreeParams p = fixedParams();  // (0.1 m voxels) in a small box that follows the sensor
+  p.follow_robot = true;
+  p.extent_m = 4.0;
+  p.keep_outside_box = true;
+  TraversabilityOcTree tree(p);
+  for (int step = 0; step < 40; ++step) {
+    const double x = step < 20 ? 0.3 * step : 0.3 * (39 - step);  // out and back
+    Frame f;
+    for (int u = 0; u < 30; ++u) {
+      for (int v = 0; v < 20; ++v) {
+        const float fx = static_cast<float>(x + 0.5 + 0.05 * u), fy = -0.5f + 0.05f * v;
+        f.add(fx, fy, 0.003f * static_cast<float>((u + 2 * v) % 3 - 1),
+              (u * v) % 17 == 0 ? core::Label::NonTraversable : core::Label::Traversable, 0.97f,
+              0.05f, 0.2f);
+      }
+      f.add(static_cast<float>(x + 2.0), 0.1f, 0.05f * static_cast<float>(u),
+            core::Label::NonTraversable, 0.8f, 1.2f, 1.0f);
+    }
+    upd::maps::insertScan(tree, f.view(), {x, 0.0, 0.6}, p, FusionParams{});
+    std::ostringstream inserted, whole;
+    tree.write(inserted);
+    tree.updateInnerOccupancy();
+    tree.write(whole);
+    ASSERT_EQ(inserted.str(), whole.str()) << "frame " << step;
+  }
+  EXPECT_GT(tree.keptTiles(), 0u);
+}
+
 TEST(TraversabilityOctree, DiscretizedInsertMatchesOctomapsOwnAndCountsEveryPoint) {
   // Nine points per ground voxel, off the voxel centres, and a wall: many points per end
   // voxel, as in a depth image.

@@ -4,9 +4,12 @@
 
 #include <octomap/Pointcloud.h>
 
+#include "upd/core/vector_clones.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <unordered_map>
@@ -127,48 +130,98 @@ inline void addToRun(FrameVoxel& run, const PointsWorld& points, std::size_t i, 
   }
 }
 
-// Step 1 of insertScan for the points [begin, end): each point's voxel key, the changes of
-// voxel, and the labelled points of each run in one voxel summed (with discretize, a voxel
-// marks hit when its centre is within range and inside the box).
+// A point's voxel key packed in 48 bits (x | y << 16 | z << 32), or why it has none.
+constexpr std::uint64_t kNotFinite = ~std::uint64_t{0}, kOutsideTree = kNotFinite - 1;
+inline octomap::OcTreeKey unpack(std::uint64_t code) {
+  return octomap::OcTreeKey(static_cast<octomap::key_type>(code & 0xFFFF),
+                            static_cast<octomap::key_type>((code >> 16) & 0xFFFF),
+                            static_cast<octomap::key_type>(code >> 32));
+}
+
+// The codes of points [0, n): OctoMap's coordToKeyChecked exactly (the key floor(v) + 32768
+// of v = factor * coordinate in double, within [0, 65536)), without a call to floor per
+// coordinate (the library's baseline x86-64 has no rounding instruction), so that the loop
+// vectorizes.
+UPD_VECTOR_CLONES
+void keyCodes(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+              std::size_t n, double factor, std::uint64_t* __restrict code) {
+  constexpr double kHalf = 32768.0;  // OctoMap's tree_max_val: 16 levels
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool finite = (x[i] - x[i]) + (y[i] - y[i]) + (z[i] - z[i]) == 0.f;
+    const double v[3] = {factor * x[i], factor * y[i], factor * z[i]};
+    std::uint64_t key = 0;
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) {
+      inside = inside & (v[a] >= -kHalf) & (v[a] < kHalf);  // (NaN: false)
+      const double w = v[a] >= -kHalf && v[a] < kHalf ? v[a] : 0.0;
+      const auto t = static_cast<std::int64_t>(w);
+      const std::int64_t floor = t - (w < static_cast<double>(t));  // (exact: |w| < 2^15)
+      key |= static_cast<std::uint64_t>(floor + 32768) << (16 * a);
+    }
+    code[i] = !finite ? kNotFinite : !inside ? kOutsideTree : key;
+  }
+}
+
+// Step 1 of insertScan for the points [begin, end): each point's voxel key, the voxels as
+// they open (with discretize: each whose centre marks hit when within range and inside the
+// box), and the labelled points of each run in one voxel summed. Two runs stay open, the last
+// two voxels met: a surface on a voxel boundary (a floor at z = 0 in the world frame, its
+// points' noise across it) alternates between two voxels from point to point, which one open
+// run closed at every other point.
 void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
                const OctreeParams& params, const HitTest& marksHit, std::size_t begin,
                std::size_t end, Chunk& ch) {
-  octomap::OcTreeKey last_key;  // a default key is a real voxel: hence have_last
-  bool have_last = false, last_hit = false;
-  FrameVoxel run;
-  const auto flush = [&] {
-    if (run.n_nontrav + run.n_trav > 0) ch.runs.emplace_back(last_key, run);
-    run = FrameVoxel{};
+  struct Open {
+    std::uint64_t code = kOutsideTree;  // (none)
+    bool hit = false;
+    FrameVoxel run;
   };
-  for (std::size_t i = begin; i < end; ++i) {
-    const float x = points.x[i], y = points.y[i], z = points.z[i];
-    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
-      ++ch.invalid;
-      continue;
-    }
-    ++ch.inserted;
-    const octomap::point3d p(x, y, z);
-    octomap::OcTreeKey key;
-    const bool in_tree = tree.coordToKeyChecked(p, key);
-    if (!params.discretize) ch.ray_ends.push_back(p);
-    if (in_tree && !(have_last && key == last_key)) {
-      flush();
-      last_key = key;
-      have_last = true;
-      if (params.discretize) {
-        ch.voxels.push_back(key);
-        last_hit = marksHit(tree.keyToCoord(key));
+  Open open[2];  // the voxel met last first
+  const auto close = [&](Open& o) {
+    if (o.run.n_nontrav + o.run.n_trav > 0) ch.runs.emplace_back(unpack(o.code), o.run);
+    o = Open{};
+  };
+  constexpr std::size_t kBlock = 2048;
+  std::uint64_t codes[kBlock];
+  const double factor = 1.0 / tree.getResolution();  // (OctoMap's resolution_factor)
+  for (std::size_t b = begin; b < end; b += kBlock) {
+    const std::size_t n = std::min(kBlock, end - b);
+    keyCodes(points.x + b, points.y + b, points.z + b, n, factor, codes);
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::uint64_t code = codes[j];
+      if (code == kNotFinite) {
+        ++ch.invalid;
+        continue;
       }
+      const std::size_t i = b + j;
+      ++ch.inserted;
+      const octomap::point3d p(points.x[i], points.y[i], points.z[i]);
+      const bool in_tree = code != kOutsideTree;
+      if (!params.discretize) ch.ray_ends.push_back(p);
+      if (in_tree && code != open[0].code) {
+        if (code == open[1].code) {
+          std::swap(open[0], open[1]);
+        } else {
+          close(open[1]);
+          std::swap(open[0], open[1]);
+          open[0].code = code;
+          if (params.discretize) {
+            ch.voxels.push_back(unpack(code));
+            open[0].hit = marksHit(tree.keyToCoord(unpack(code)));
+          }
+        }
+      }
+      const core::Label label = points.label[i];
+      if (label != core::Label::Traversable && label != core::Label::NonTraversable) {
+        ++ch.unknown;
+        continue;
+      }
+      if (!in_tree || !(params.discretize ? open[0].hit : marksHit(p))) continue;
+      addToRun(open[0].run, points, i, label);
     }
-    const core::Label label = points.label[i];
-    if (label != core::Label::Traversable && label != core::Label::NonTraversable) {
-      ++ch.unknown;
-      continue;
-    }
-    if (!in_tree || !(params.discretize ? last_hit : marksHit(p))) continue;
-    addToRun(run, points, i, label);
   }
-  flush();
+  close(open[1]);
+  close(open[0]);
 }
 
 using FrameVoxels = std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash>;
@@ -194,15 +247,118 @@ void mergeChunks(const TraversabilityOcTree& tree, const std::vector<Chunk>& chu
   }
 }
 
+// A set of voxel keys without an allocation per key (OctoMap's KeySet allocates a node for
+// each): open addressing over the keys packed in 48 bits; keys() lists them in the order
+// first added.
+class FlatKeySet {
+ public:
+  void clear(std::size_t expected) {
+    std::size_t cap = 64;
+    while (cap < 2 * expected) cap *= 2;
+    slots_.assign(cap, kEmpty);
+    keys_.clear();
+  }
+  bool insert(const octomap::OcTreeKey& k) {
+    if (2 * (keys_.size() + 1) > slots_.size()) grow();
+    return place(pack(k), k);
+  }
+  bool contains(const octomap::OcTreeKey& k) const {
+    const std::uint64_t v = pack(k);
+    for (std::size_t i = slot(v);; i = (i + 1) & (slots_.size() - 1)) {
+      if (slots_[i] == v) return true;
+      if (slots_[i] == kEmpty) return false;
+    }
+  }
+  const std::vector<octomap::OcTreeKey>& keys() const { return keys_; }
+
+ private:
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+  static std::uint64_t pack(const octomap::OcTreeKey& k) {
+    return std::uint64_t{k[0]} | std::uint64_t{k[1]} << 16 | std::uint64_t{k[2]} << 32;
+  }
+  std::size_t slot(std::uint64_t v) const {
+    return static_cast<std::size_t>((v * 0x9E3779B97F4A7C15ull) >> 20) & (slots_.size() - 1);
+  }
+  bool place(std::uint64_t v, const octomap::OcTreeKey& k) {
+    for (std::size_t i = slot(v);; i = (i + 1) & (slots_.size() - 1)) {
+      if (slots_[i] == v) return false;
+      if (slots_[i] == kEmpty) {
+        slots_[i] = v;
+        keys_.push_back(k);
+        return true;
+      }
+    }
+  }
+  void grow() {
+    const std::vector<octomap::OcTreeKey> keys = std::move(keys_);
+    clear(keys.size() + 1);
+    for (const auto& k : keys) place(pack(k), k);
+  }
+  std::vector<std::uint64_t> slots_;
+  std::vector<octomap::OcTreeKey> keys_;
+};
+
+// The keys a ray of a chunk of ends marks: the free voxels along it (from its end back to the
+// box's edge) and its end voxel, as OctoMap's computeUpdate finds them with an update box.
+struct RayKeys {
+  std::vector<octomap::OcTreeKey> free, occupied;
+};
+
+// OctoMap's insertPointCloud(ends, origin, max_range, lazy_eval = true) for a tree with an
+// update box: the same free and occupied voxels (a voxel both is occupied), each updated once,
+// without OctoMap's set nodes and its critical sections around every insert; the rays cast in
+// fixed chunks on the team, their keys gathered in chunk order.
+void updateOccupancy(TraversabilityOcTree& tree, const octomap::Pointcloud& ends,
+                     const octomap::point3d& origin, double max_range,
+                     std::vector<octomap::OcTreeKey>& changed) {
+  constexpr std::size_t kRays = 256;
+  std::vector<RayKeys> chunks((ends.size() + kRays - 1) / kRays);
+#pragma omp parallel
+  {
+    octomap::KeyRay ray;
+#pragma omp for schedule(dynamic, 1)
+    for (std::ptrdiff_t c = 0; c < static_cast<std::ptrdiff_t>(chunks.size()); ++c) {
+      RayKeys& out = chunks[static_cast<std::size_t>(c)];
+      const std::size_t e = std::min(ends.size(), (static_cast<std::size_t>(c) + 1) * kRays);
+      for (std::size_t i = static_cast<std::size_t>(c) * kRays; i < e; ++i) {
+        const octomap::point3d& p = ends[i];
+        if (!tree.inBBX(p) || (max_range >= 0.0 && (p - origin).norm() > max_range)) continue;
+        octomap::OcTreeKey key;
+        if (tree.coordToKeyChecked(p, key)) out.occupied.push_back(key);
+        if (!tree.computeRayKeys(origin, p, ray)) continue;
+        for (auto k = ray.rbegin(); k != ray.rend() && tree.inBBX(*k); ++k) out.free.push_back(*k);
+      }
+    }
+  }
+  thread_local FlatKeySet free, occupied;
+  std::size_t n_free = 0, n_occupied = 0;
+  for (const RayKeys& c : chunks) n_free += c.free.size(), n_occupied += c.occupied.size();
+  free.clear(n_free / 8);
+  occupied.clear(n_occupied);
+  for (const RayKeys& c : chunks) {
+    for (const auto& k : c.occupied) occupied.insert(k);
+  }
+  for (const RayKeys& c : chunks) {
+    for (const auto& k : c.free) {
+      if (!occupied.contains(k)) free.insert(k);
+    }
+  }
+  for (const auto& k : free.keys()) tree.updateNode(k, false, /*lazy_eval=*/true);
+  for (const auto& k : occupied.keys()) tree.updateNode(k, true, /*lazy_eval=*/true);
+  changed.insert(changed.end(), free.keys().begin(), free.keys().end());
+  changed.insert(changed.end(), occupied.keys().begin(), occupied.keys().end());
+}
+
 void checkInsertArgs(const TraversabilityOcTree& tree, const PointsWorld& points,
                      const Eigen::Vector3d& sensor_origin_world, const OctreeParams& params,
                      const FusionParams& fusion) {
   params.validate();
   fusion.validate();
   points.validate();
-  core::requireParam(std::abs(tree.getResolution() - params.resolution_m) <= 1e-9 * params.resolution_m,
-               "insertScan", "OctreeParams.resolution_m", params.resolution_m,
-               "differs from the tree's resolution");
+  core::requireParam(
+      std::abs(tree.getResolution() - params.resolution_m) <= 1e-9 * params.resolution_m,
+      "insertScan", "OctreeParams.resolution_m", params.resolution_m,
+      "differs from the tree's resolution");
   core::requireParam(sensor_origin_world.allFinite(), "insertScan", "sensor_origin_world",
                std::to_string(sensor_origin_world.x()) + "," +
                    std::to_string(sensor_origin_world.y()) + "," +
@@ -240,15 +396,29 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
   FrameVoxels frame;
   mergeChunks(tree, chunks, params.discretize, cloud, frame, stats);
 
-  tree.insertPointCloud(cloud, origin, max_range, /*lazy_eval=*/true);
+  // The voxels this frame changes, whose inner nodes are updated after (the rest of the tree
+  // is up to date: updateBox's crop updated it whole).
+  thread_local std::vector<octomap::OcTreeKey> changed;
+  changed.clear();
+  const bool whole = !tree.bbxSet();  // (updateBox always sets a box)
+  if (whole) {
+    tree.insertPointCloud(cloud, origin, max_range, /*lazy_eval=*/true);
+  } else {
+    updateOccupancy(tree, cloud, origin, max_range, changed);
+  }
   for (const auto& [key, v] : frame) {
     const float cost = v.n_cost > 0 ? static_cast<float>(v.cost_sum / v.n_cost)
                                     : std::numeric_limits<float>::quiet_NaN();
     if (tree.integrateTraversability(key, v.n_nontrav, v.n_trav, v.zeta_min, cost, fusion)) {
       ++stats.voxels_traversability;
+      changed.push_back(key);
     }
   }
-  tree.updateInnerOccupancy();
+  if (whole) {
+    tree.updateInnerOccupancy();
+  } else {
+    tree.updateInnerOccupancy(changed);
+  }
   return stats;
 }
 

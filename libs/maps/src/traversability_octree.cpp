@@ -196,6 +196,53 @@ void TraversabilityOcTree::updateInnerOccupancyRecurs(TraversabilityOcTreeNode* 
   node->updateTraversabilityChildren();
 }
 
+namespace {
+
+// The key's Morton code: from the root down, each level's child index (OctoMap's
+// computeChildIdx: x bit 1, y bit 2, z bit 4) in 3 bits, the root's child the highest.
+std::uint64_t mortonOf(const octomap::OcTreeKey& k) {
+  const auto spread = [](std::uint64_t v) {  // bit i to bit 3 i
+    v = (v | v << 16) & 0x0000FF0000FFull;
+    v = (v | v << 8) & 0x00F00F00F00Full;
+    v = (v | v << 4) & 0x0C30C30C30C3ull;
+    return (v | v << 2) & 0x249249249249ull;
+  };
+  return spread(k[0]) | spread(k[1]) << 1 | spread(k[2]) << 2;
+}
+
+}  // namespace
+
+void TraversabilityOcTree::updateInnerOccupancy(const std::vector<octomap::OcTreeKey>& changed) {
+  if (root == nullptr || changed.empty()) return;
+  thread_local std::vector<std::uint64_t> codes;
+  codes.resize(changed.size());
+  for (std::size_t i = 0; i < changed.size(); ++i) codes[i] = mortonOf(changed[i]);
+  std::sort(codes.begin(), codes.end());
+  codes.erase(std::unique(codes.begin(), codes.end()), codes.end());
+  updateInnerOccupancyRecurs(root, 0, codes.data(), codes.data() + codes.size());
+}
+
+void TraversabilityOcTree::updateInnerOccupancyRecurs(TraversabilityOcTreeNode* node,
+                                                      unsigned int depth, const std::uint64_t* lo,
+                                                      const std::uint64_t* hi) {
+  if (!nodeHasChildren(node)) return;
+  if (depth < tree_depth) {
+    // (The codes under one child are consecutive: sorted, its index their highest bits left.)
+    const unsigned int shift = 3 * (tree_depth - 1 - depth);
+    for (const std::uint64_t* a = lo; a < hi;) {
+      const auto child = static_cast<unsigned int>((*a >> shift) & 7);
+      const std::uint64_t* b = a + 1;
+      while (b < hi && ((*b >> shift) & 7) == child) ++b;
+      if (nodeChildExists(node, child)) {
+        updateInnerOccupancyRecurs(getNodeChild(node, child), depth + 1, a, b);
+      }
+      a = b;
+    }
+  }
+  node->updateOccupancyChildren();
+  node->updateTraversabilityChildren();
+}
+
 void TraversabilityOcTree::cropToKeyBox(const octomap::OcTreeKey& min_key,
                                         const octomap::OcTreeKey& max_key) {
   if (root == nullptr) return;

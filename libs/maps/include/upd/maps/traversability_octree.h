@@ -45,6 +45,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace octomap {
 class ColorOcTree;
@@ -173,6 +174,9 @@ class TraversabilityOcTree : public octomap::OccupancyOcTreeBase<TraversabilityO
 
   /// Updates inner nodes' occupancy (max child) and traversability (worst child).
   void updateInnerOccupancy();
+  /// The same for the inner nodes above the voxels at changed only (the others must be up to
+  /// date): what a frame's updates need, at a cost that does not grow with the tree.
+  void updateInnerOccupancy(const std::vector<octomap::OcTreeKey>& changed);
 
   /// Deletes every node that lies entirely outside the box (OcTreeKey bounds, inclusive),
   /// expanding pruned nodes that straddle it, then refreshes the inner nodes.
@@ -195,6 +199,9 @@ class TraversabilityOcTree : public octomap::OccupancyOcTreeBase<TraversabilityO
 
  protected:
   void updateInnerOccupancyRecurs(TraversabilityOcTreeNode* node, unsigned int depth);
+  /// The nodes above the keys of Morton codes [lo, hi) (sorted) below node.
+  void updateInnerOccupancyRecurs(TraversabilityOcTreeNode* node, unsigned int depth,
+                                  const std::uint64_t* lo, const std::uint64_t* hi);
   /// Returns true when the caller should delete node (nothing of it is inside the box).
   /// keep: where the deleted subtrees go (nullptr: nowhere).
   bool cropRecurs(TraversabilityOcTreeNode* node, const octomap::OcTreeKey& key, unsigned int depth,
