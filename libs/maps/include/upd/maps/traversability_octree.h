@@ -12,8 +12,9 @@
 // zeta_min, the highest cost and the most observations (and, as in OctoMap, the highest
 // occupancy), so a coarse query never hides an obstacle.
 //
-// Insertion is batched: one insertPointCloud with lazy evaluation, the traversability of the hit
-// voxels, then a single updateInnerOccupancy() per frame.
+// Insertion is batched: the occupancy of OctoMap's insertPointCloud with lazy evaluation (the
+// same free and occupied voxels, each updated once), the traversability of the hit voxels, then
+// one update of the inner nodes above the voxels the frame changed.
 //
 // Bounded memory: updates are limited to a box (OctoMap's BBX limit). With follow_robot the box
 // (extent_m x extent_m x height_m) is re-centred on the sensor whenever the sensor gets farther
@@ -241,8 +242,8 @@ struct OctreeInsertStats {
 
 /// Inserts one frame: occupancy by ray casting from sensor_origin_world (OctoMap's batch update
 /// with lazy evaluation, limited to the update box and to max_range_m), then the traversability
-/// of the end-point voxels, then one inner-node update. Moves and crops the box first when
-/// follow_robot. Throws std::invalid_argument for bad parameters, an invalid view, or
+/// of the end-point voxels, then the inner nodes above the voxels it changed. Moves and crops
+/// the box first when follow_robot. Throws std::invalid_argument for bad parameters, an invalid view, or
 /// params.resolution_m different from the tree's.
 OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& points,
                              const Eigen::Vector3d& sensor_origin_world, const OctreeParams& params,
