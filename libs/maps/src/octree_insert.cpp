@@ -176,7 +176,8 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
     bool hit = false;
     FrameVoxel run;
   };
-  Open open[2];  // the voxel met last first
+  Open open[2];
+  int last = 0;  // open[last]: the voxel met last
   const auto close = [&](Open& o) {
     if (o.run.n_nontrav + o.run.n_trav > 0) ch.runs.emplace_back(unpack(o.code), o.run);
     o = Open{};
@@ -198,16 +199,14 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
       const octomap::point3d p(points.x[i], points.y[i], points.z[i]);
       const bool in_tree = code != kOutsideTree;
       if (!params.discretize) ch.ray_ends.push_back(p);
-      if (in_tree && code != open[0].code) {
-        if (code == open[1].code) {
-          std::swap(open[0], open[1]);
-        } else {
-          close(open[1]);
-          std::swap(open[0], open[1]);
-          open[0].code = code;
+      if (in_tree && code != open[last].code) {
+        last ^= 1;  // (the other one: the voxel met before, or the one to close and reopen)
+        if (code != open[last].code) {
+          close(open[last]);
+          open[last].code = code;
           if (params.discretize) {
             ch.voxels.push_back(unpack(code));
-            open[0].hit = marksHit(tree.keyToCoord(unpack(code)));
+            open[last].hit = marksHit(tree.keyToCoord(unpack(code)));
           }
         }
       }
@@ -216,12 +215,12 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
         ++ch.unknown;
         continue;
       }
-      if (!in_tree || !(params.discretize ? open[0].hit : marksHit(p))) continue;
-      addToRun(open[0].run, points, i, label);
+      if (!in_tree || !(params.discretize ? open[last].hit : marksHit(p))) continue;
+      addToRun(open[last].run, points, i, label);
     }
   }
-  close(open[1]);
-  close(open[0]);
+  close(open[last ^ 1]);
+  close(open[last]);
 }
 
 using FrameVoxels = std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash>;
