@@ -304,9 +304,10 @@ struct RayKeys {
 };
 
 // OctoMap's insertPointCloud(ends, origin, max_range, lazy_eval = true) for a tree with an
-// update box: the same free and occupied voxels (a voxel both is occupied), each updated once,
-// without OctoMap's set nodes and its critical sections around every insert; the rays cast in
-// fixed chunks on the team, their keys gathered in chunk order.
+// update box (updateBox sets one before): the same free and occupied voxels (a voxel both is
+// occupied), each updated once, without OctoMap's set nodes and its critical sections around
+// every insert; the rays cast in fixed chunks on the team, their keys gathered in chunk order.
+// The voxels updated are appended to changed.
 void updateOccupancy(TraversabilityOcTree& tree, const octomap::Pointcloud& ends,
                      const octomap::point3d& origin, double max_range,
                      std::vector<octomap::OcTreeKey>& changed) {
@@ -329,23 +330,23 @@ void updateOccupancy(TraversabilityOcTree& tree, const octomap::Pointcloud& ends
       }
     }
   }
-  thread_local FlatKeySet free, occupied;
+  thread_local FlatKeySet free_cells, occupied_cells;
   std::size_t n_free = 0, n_occupied = 0;
   for (const RayKeys& c : chunks) n_free += c.free.size(), n_occupied += c.occupied.size();
-  free.clear(n_free / 8);
-  occupied.clear(n_occupied);
+  free_cells.clear(n_free / 8);  // (most keys repeat: it grows where they do not)
+  occupied_cells.clear(n_occupied);
   for (const RayKeys& c : chunks) {
-    for (const auto& k : c.occupied) occupied.insert(k);
+    for (const auto& k : c.occupied) occupied_cells.insert(k);
   }
   for (const RayKeys& c : chunks) {
     for (const auto& k : c.free) {
-      if (!occupied.contains(k)) free.insert(k);
+      if (!occupied_cells.contains(k)) free_cells.insert(k);
     }
   }
-  for (const auto& k : free.keys()) tree.updateNode(k, false, /*lazy_eval=*/true);
-  for (const auto& k : occupied.keys()) tree.updateNode(k, true, /*lazy_eval=*/true);
-  changed.insert(changed.end(), free.keys().begin(), free.keys().end());
-  changed.insert(changed.end(), occupied.keys().begin(), occupied.keys().end());
+  for (const auto& k : free_cells.keys()) tree.updateNode(k, false, /*lazy_eval=*/true);
+  for (const auto& k : occupied_cells.keys()) tree.updateNode(k, true, /*lazy_eval=*/true);
+  changed.insert(changed.end(), free_cells.keys().begin(), free_cells.keys().end());
+  changed.insert(changed.end(), occupied_cells.keys().begin(), occupied_cells.keys().end());
 }
 
 void checkInsertArgs(const TraversabilityOcTree& tree, const PointsWorld& points,
@@ -399,12 +400,7 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
   // is up to date: updateBox's crop updated it whole).
   thread_local std::vector<octomap::OcTreeKey> changed;
   changed.clear();
-  const bool whole = !tree.bbxSet();  // (updateBox always sets a box)
-  if (whole) {
-    tree.insertPointCloud(cloud, origin, max_range, /*lazy_eval=*/true);
-  } else {
-    updateOccupancy(tree, cloud, origin, max_range, changed);
-  }
+  updateOccupancy(tree, cloud, origin, max_range, changed);
   for (const auto& [key, v] : frame) {
     const float cost = v.n_cost > 0 ? static_cast<float>(v.cost_sum / v.n_cost)
                                     : std::numeric_limits<float>::quiet_NaN();
@@ -413,11 +409,7 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
       changed.push_back(key);
     }
   }
-  if (whole) {
-    tree.updateInnerOccupancy();
-  } else {
-    tree.updateInnerOccupancy(changed);
-  }
+  tree.updateInnerOccupancy(changed);
   return stats;
 }
 
