@@ -258,6 +258,37 @@ TEST(TraversabilityOctree, InsertUpdatesTheInnerNodesAsAWholeTreeUpdate) {
   EXPECT_GT(tree.keptTiles(), 0u);
 }
 
+// The insert computes a block of points' voxel keys at once, not by OctoMap's coordToKeyChecked:
+// points on and beside voxel boundaries, at negative coordinates and at -0, each end in the
+// voxel OctoMap's own key names (occupied, with its traversability); points that are not
+// finite are counted and left out.
+TEST(TraversabilityOctree, PointsEndInTheVoxelsOfOctomapsKeys) {
+  const OctreeParams p = fixedParams();
+  TraversabilityOcTree tree(p);
+  const float edges[] = {-0.2f, -0.1f, -0.05f, -1e-7f, -0.0f, 0.0f, 1e-7f, 0.1f, 0.2f, 0.3f};
+  Frame f;
+  std::vector<octomap::point3d> ends;
+  for (int i = 0; i < 10; ++i) {
+    for (int j = 0; j < 10; ++j) {
+      const auto fi = static_cast<float>(i), fj = static_cast<float>(j);
+      const octomap::point3d e(-2.0f + 0.5f * fi + edges[j], -2.0f + 0.5f * fj + edges[i],
+                               edges[(i + j) % 10]);
+      f.add(e.x(), e.y(), e.z(), core::Label::Traversable);
+      ends.push_back(e);
+    }
+  }
+  f.add(kNan, 0.f, 0.f, core::Label::Traversable);
+  f.add(std::numeric_limits<float>::infinity(), 0.f, 0.f, core::Label::Traversable);
+  const auto stats = upd::maps::insertScan(tree, f.view(), {0.0, 0.0, 1.0}, p, FusionParams{});
+  EXPECT_EQ(stats.points_invalid, 2u);
+  for (const octomap::point3d& e : ends) {
+    const TraversabilityOcTreeNode* node = tree.search(e);  // (OctoMap's key of e)
+    ASSERT_NE(node, nullptr) << e;
+    EXPECT_TRUE(tree.isNodeOccupied(node)) << e;
+    EXPECT_TRUE(node->hasTraversability()) << e;
+  }
+}
+
 TEST(TraversabilityOctree, DiscretizedInsertMatchesOctomapsOwnAndCountsEveryPoint) {
   // Nine points per ground voxel, off the voxel centres, and a wall: many points per end
   // voxel, as in a depth image.

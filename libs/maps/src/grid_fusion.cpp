@@ -1,5 +1,6 @@
 #include "upd/maps/grid_fusion.h"
 
+#include "keep_if.h"
 #include "upd/core/openmp.h"
 #include "upd/core/vector_clones.h"
 
@@ -65,15 +66,7 @@ std::uint32_t addSaturating(std::uint32_t a, std::uint32_t b) {
       std::min<std::uint64_t>(s, std::numeric_limits<std::uint32_t>::max()));
 }
 
-// v where keep, +0 elsewhere: a select that the compiler cannot turn into a branch, nor look
-// through to fuse a product into a multiply-add.
-inline double keepIf(bool keep, double v) {
-  std::uint64_t bits;
-  std::memcpy(&bits, &v, sizeof bits);
-  bits &= 0 - static_cast<std::uint64_t>(keep);
-  std::memcpy(&v, &bits, sizeof v);
-  return v;
-}
+using detail::keepIf;
 
 // floor(v) - lo where inside (v in [lo, hi)), anything elsewhere. The rounded v - lo (0 - 0
 // outside, where v may be NaN or far) is at most the next whole number, so its integer part is

@@ -4,6 +4,7 @@
 
 #include <octomap/Pointcloud.h>
 
+#include "keep_if.h"
 #include "upd/core/vector_clones.h"
 
 #include <algorithm>
@@ -148,17 +149,24 @@ void keyCodes(const float* __restrict x, const float* __restrict y, const float*
   constexpr double kHalf = 32768.0;  // OctoMap's tree_max_val: 16 levels
   for (std::size_t i = 0; i < n; ++i) {
     const bool finite = (x[i] - x[i]) + (y[i] - y[i]) + (z[i] - z[i]) == 0.f;
-    const double v[3] = {factor * x[i], factor * y[i], factor * z[i]};
-    std::uint64_t key = 0;
-    bool inside = true;
-    for (int a = 0; a < 3; ++a) {
-      inside = inside & (v[a] >= -kHalf) & (v[a] < kHalf);  // (NaN: false)
-      const double w = v[a] >= -kHalf && v[a] < kHalf ? v[a] : 0.0;
-      const auto t = static_cast<std::int64_t>(w);
-      const std::int64_t floor = t - (w < static_cast<double>(t));  // (exact: |w| < 2^15)
-      key |= static_cast<std::uint64_t>(floor + 32768) << (16 * a);
-    }
-    code[i] = !finite ? kNotFinite : !inside ? kOutsideTree : key;
+    const double vx = factor * x[i], vy = factor * y[i], vz = factor * z[i];
+    const bool inside = (vx >= -kHalf) & (vx < kHalf) & (vy >= -kHalf) & (vy < kHalf) &
+                        (vz >= -kHalf) & (vz < kHalf);  // (NaN: false)
+    // floor(v) as truncation, one less below a negative v's whole part (|v| < 2^15: exact);
+    // v outside taken as 0 (a conversion of NaN or a huge v would be undefined).
+    const double wx = detail::keepIf(inside, vx), wy = detail::keepIf(inside, vy),
+                 wz = detail::keepIf(inside, vz);
+    const auto tx = static_cast<std::int32_t>(wx), ty = static_cast<std::int32_t>(wy),
+               tz = static_cast<std::int32_t>(wz);
+    const std::int32_t fx = tx - (wx < static_cast<double>(tx)),
+                       fy = ty - (wy < static_cast<double>(ty)),
+                       fz = tz - (wz < static_cast<double>(tz));
+    const std::uint64_t key = static_cast<std::uint64_t>(fx + 32768) |
+                              static_cast<std::uint64_t>(fy + 32768) << 16 |
+                              static_cast<std::uint64_t>(fz + 32768) << 32;
+    // (Masks, not a select: no branch. kOutsideTree is kNotFinite - 1.)
+    const std::uint64_t ok = 0 - static_cast<std::uint64_t>(finite & inside);
+    code[i] = (key & ok) | ((kNotFinite - static_cast<std::uint64_t>(finite)) & ~ok);
   }
 }
 
