@@ -204,17 +204,18 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
       }
       const std::size_t i = b + j;
       ++ch.inserted;
-      const octomap::point3d p(points.x[i], points.y[i], points.z[i]);
+      const auto point = [&] { return octomap::point3d(points.x[i], points.y[i], points.z[i]); };
       const bool in_tree = code != kOutsideTree;
-      if (!params.discretize) ch.ray_ends.push_back(p);
+      if (!params.discretize) ch.ray_ends.push_back(point());
       if (in_tree && code != open[last].code) {
         last ^= 1;  // (the other one: the voxel met before, or the one to close and reopen)
         if (code != open[last].code) {
           close(open[last]);
           open[last].code = code;
           if (params.discretize) {
-            ch.voxels.push_back(unpack(code));
-            open[last].hit = marksHit(tree.keyToCoord(unpack(code)));
+            const octomap::OcTreeKey key = unpack(code);
+            ch.voxels.push_back(key);
+            open[last].hit = marksHit(tree.keyToCoord(key));
           }
         }
       }
@@ -223,35 +224,12 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
         ++ch.unknown;
         continue;
       }
-      if (!in_tree || !(params.discretize ? open[last].hit : marksHit(p))) continue;
+      if (!in_tree || !(params.discretize ? open[last].hit : marksHit(point()))) continue;
       addToRun(open[last].run, points, i, label);
     }
   }
   close(open[last ^ 1]);
   close(open[last]);
-}
-
-using FrameVoxels = std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash>;
-
-// Step 2: the chunks in order: the rays (one per distinct end voxel with discretize) and the
-// per-voxel sums of the frame.
-void mergeChunks(const TraversabilityOcTree& tree, const std::vector<Chunk>& chunks,
-                 bool discretize, octomap::Pointcloud& cloud, FrameVoxels& frame,
-                 OctreeInsertStats& stats) {
-  octomap::KeySet ends;
-  std::size_t n_ends = 0;
-  for (const Chunk& ch : chunks) n_ends += discretize ? ch.voxels.size() : ch.ray_ends.size();
-  cloud.reserve(n_ends);
-  for (const Chunk& ch : chunks) {
-    stats.points_inserted += ch.inserted;
-    stats.points_invalid += ch.invalid;
-    stats.points_unknown += ch.unknown;
-    for (const octomap::point3d& p : ch.ray_ends) cloud.push_back(p);
-    for (const octomap::OcTreeKey& key : ch.voxels) {
-      if (ends.insert(key).second) cloud.push_back(tree.keyToCoord(key));
-    }
-    for (const auto& [key, run] : ch.runs) frame[key].add(run);
-  }
 }
 
 // A set of voxel keys without an allocation per key (OctoMap's KeySet allocates a node for
@@ -304,6 +282,30 @@ class FlatKeySet {
   std::vector<std::uint64_t> slots_;
   std::vector<octomap::OcTreeKey> keys_;
 };
+
+using FrameVoxels = std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash>;
+
+// Step 2: the chunks in order: the rays (one per distinct end voxel with discretize) and the
+// per-voxel sums of the frame.
+void mergeChunks(const TraversabilityOcTree& tree, const std::vector<Chunk>& chunks,
+                 bool discretize, octomap::Pointcloud& cloud, FrameVoxels& frame,
+                 OctreeInsertStats& stats) {
+  std::size_t n_ends = 0;
+  for (const Chunk& ch : chunks) n_ends += discretize ? ch.voxels.size() : ch.ray_ends.size();
+  cloud.reserve(n_ends);
+  thread_local FlatKeySet ends;
+  ends.clear(discretize ? n_ends : 0);
+  for (const Chunk& ch : chunks) {
+    stats.points_inserted += ch.inserted;
+    stats.points_invalid += ch.invalid;
+    stats.points_unknown += ch.unknown;
+    for (const octomap::point3d& p : ch.ray_ends) cloud.push_back(p);
+    for (const octomap::OcTreeKey& key : ch.voxels) {
+      if (ends.insert(key)) cloud.push_back(tree.keyToCoord(key));
+    }
+    for (const auto& [key, run] : ch.runs) frame[key].add(run);
+  }
+}
 
 // The keys a ray of a chunk of ends marks: the free voxels along it (from its end back to the
 // box's edge) and its end voxel, as OctoMap's computeUpdate finds them with an update box.
