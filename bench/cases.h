@@ -70,4 +70,10 @@ json paperPipelineCases(const std::vector<Frame>& frames, const Options& o, Repo
 /// The sensor-rate path on each frame against PCL's IntegralImageNormalEstimation alone.
 json sensorRateCases(const std::vector<Frame>& frames, const Options& o, Report& report);
 
+// ---- The OctoMap update (octree_cases.cpp) ----
+
+/// upd::maps::insertScan against OctoMap's own insert on each frame scored by the sensor-rate
+/// path, into a new tree and as the fifth insert of the frame.
+json octreeCases(const std::vector<Frame>& frames, const Options& o);
+
 }  // namespace upd::bench

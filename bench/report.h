@@ -25,7 +25,7 @@ struct Options {
   std::string json_path;
   bool quick = false;
   bool frames_only = false;  // the frame pipeline timings alone (one core, two cores, memory)
-  std::string only;          // "paper" or "sensor-rate": that table alone
+  std::string only;          // "paper", "sensor-rate" or "octree": that table alone
   int repeats = 15;
 };
 

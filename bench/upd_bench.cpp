@@ -10,8 +10,9 @@
 //   --quick      skip the PCL peer and use fewer exact samples (minutes instead of ~15)
 //   --frames-only  only the frame pipeline timings (one core, two cores, memory): seconds
 //   --repeats N  timed runs per case for the medians (default 15; big clouds use fewer)
-//   --only paper | sensor-rate   that table alone: the paper's whole pipeline against PCL's,
-//                or the sensor-rate path against PCL's integral-image normals
+//   --only paper | sensor-rate | octree   that table alone: the paper's whole pipeline against
+//                PCL's, the sensor-rate path against PCL's integral-image normals, or the
+//                OctoMap update against OctoMap's own insert
 //
 // What is timed, per case (medians over the runs after one warm-up run):
 //  - frame pipeline (organized 640 x 480): depth image (or organized cloud) -> normals -> UPD
@@ -19,6 +20,7 @@
 //  - PCL settings: voxel 0.02 m, normals 0.05 m, d_m 0.5 m on both sides: our fast path, our
 //    exact path and the PCL peer (run once: it takes seconds) (peer_cases.cpp);
 //  - normals alone: computeNormalsOrganized against PCL's IntegralImageNormalEstimation;
+//  - the OctoMap update of `upd playback` against OctoMap's own insert (octree_cases.cpp);
 //  - the LiDAR scan, the corner, and generated clouds of growing size and growing d_m.
 // Agreement with the exact path is measured on the same pre-processed cloud: exact normals for
 // every point and the exact UPD for every point or, where that would take minutes, for an evenly
@@ -48,11 +50,10 @@ int run(const Options& o) {
   root["map_stage"] = mapStageKind();
 
   const std::vector<Frame> frames = kinectFrames(o);
-  if (o.only == "paper" || o.only == "sensor-rate") {
-    root[o.only == "paper" ? "paper_pipeline" : "sensor_rate"] =
-        o.only == "paper" ? paperPipelineCases(frames, o, report) : sensorRateCases(frames, o, report);
-    return finish(report, o, bandwidth);
-  }
+  if (o.only == "paper") root["paper_pipeline"] = paperPipelineCases(frames, o, report);
+  if (o.only == "sensor-rate") root["sensor_rate"] = sensorRateCases(frames, o, report);
+  if (o.only == "octree") root["octree"] = octreeCases(frames, o);
+  if (!o.only.empty()) return finish(report, o, bandwidth);
   std::vector<core::PipelineResult> frame_results;
   json frame_cases = frameTimingCases(frames, o, report, frame_results);
   if (o.frames_only) {
@@ -63,6 +64,7 @@ int run(const Options& o) {
   root["normals_alone"] = normalsAloneCases(frames, o);
   root["sensor_rate"] = sensorRateCases(frames, o, report);
   root["paper_pipeline"] = paperPipelineCases(frames, o, report);
+  root["octree"] = octreeCases(frames, o);
   root["pcl_settings"] = pclSettingsCases(frames, o, report);
   root["growth_with_size"] = growthWithSizeCases(o, report);
   root["growth_with_radius"] = growthWithRadiusCases(frames.back(), o, report);
@@ -88,8 +90,8 @@ bool parseOptions(int argc, char** argv, Options& o) {
       o.frames_only = true;
     } else if (a == "--only") {
       o.only = value();
-      if (o.only != "paper" && o.only != "sensor-rate") {
-        throw std::invalid_argument("--only takes paper or sensor-rate, not " + o.only);
+      if (o.only != "paper" && o.only != "sensor-rate" && o.only != "octree") {
+        throw std::invalid_argument("--only takes paper, sensor-rate or octree, not " + o.only);
       }
     } else if (a == "--repeats") {
       o.repeats = std::stoi(value());
@@ -97,7 +99,7 @@ bool parseOptions(int argc, char** argv, Options& o) {
     } else if (a == "--help" || a == "-h") {
       std::printf(
           "usage: upd_bench [--data DIR] [--json OUT.json] [--quick] [--frames-only] "
-          "[--only paper|sensor-rate] [--repeats N]\n");
+          "[--only paper|sensor-rate|octree] [--repeats N]\n");
       return false;
     } else {
       throw std::invalid_argument("unknown option " + a + " (see --help)");

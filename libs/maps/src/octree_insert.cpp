@@ -5,6 +5,7 @@
 #include <octomap/Pointcloud.h>
 
 #include "keep_if.h"
+#include "key_sets.h"
 #include "upd/core/vector_clones.h"
 
 #include <algorithm>
@@ -13,7 +14,6 @@
 #include <cstdint>
 #include <limits>
 #include <string>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -232,78 +232,39 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
   close(open[last]);
 }
 
-// A set of voxel keys without an allocation per key (OctoMap's KeySet allocates a node for
-// each): open addressing over the keys packed in 48 bits; keys() lists them in the order
-// first added.
-class FlatKeySet {
- public:
-  void clear(std::size_t expected) {
-    std::size_t cap = 64;
-    while (cap < 2 * expected) cap *= 2;
-    slots_.assign(cap, kEmpty);
-    keys_.clear();
-  }
-  bool insert(const octomap::OcTreeKey& k) {
-    if (2 * (keys_.size() + 1) > slots_.size()) grow();
-    return place(pack(k), k);
-  }
-  bool contains(const octomap::OcTreeKey& k) const {
-    const std::uint64_t v = pack(k);
-    for (std::size_t i = slot(v);; i = (i + 1) & (slots_.size() - 1)) {
-      if (slots_[i] == v) return true;
-      if (slots_[i] == kEmpty) return false;
-    }
-  }
-  const std::vector<octomap::OcTreeKey>& keys() const { return keys_; }
-
- private:
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
-  static std::uint64_t pack(const octomap::OcTreeKey& k) {
-    return std::uint64_t{k[0]} | std::uint64_t{k[1]} << 16 | std::uint64_t{k[2]} << 32;
-  }
-  std::size_t slot(std::uint64_t v) const {
-    return static_cast<std::size_t>((v * 0x9E3779B97F4A7C15ull) >> 20) & (slots_.size() - 1);
-  }
-  bool place(std::uint64_t v, const octomap::OcTreeKey& k) {
-    for (std::size_t i = slot(v);; i = (i + 1) & (slots_.size() - 1)) {
-      if (slots_[i] == v) return false;
-      if (slots_[i] == kEmpty) {
-        slots_[i] = v;
-        keys_.push_back(k);
-        return true;
-      }
-    }
-  }
-  void grow() {
-    const std::vector<octomap::OcTreeKey> keys = std::move(keys_);
-    clear(keys.size() + 1);
-    for (const auto& k : keys) place(pack(k), k);
-  }
-  std::vector<std::uint64_t> slots_;
-  std::vector<octomap::OcTreeKey> keys_;
+// The frame's labelled points summed per voxel: voxels.keys()[i]'s sums in sums[i].
+struct FrameVoxels {
+  detail::FlatKeySet voxels;
+  std::vector<FrameVoxel> sums;
 };
-
-using FrameVoxels = std::unordered_map<octomap::OcTreeKey, FrameVoxel, octomap::OcTreeKey::KeyHash>;
 
 // Step 2: the chunks in order: the rays (one per distinct end voxel with discretize) and the
 // per-voxel sums of the frame.
 void mergeChunks(const TraversabilityOcTree& tree, const std::vector<Chunk>& chunks,
                  bool discretize, octomap::Pointcloud& cloud, FrameVoxels& frame,
                  OctreeInsertStats& stats) {
-  std::size_t n_ends = 0;
-  for (const Chunk& ch : chunks) n_ends += discretize ? ch.voxels.size() : ch.ray_ends.size();
+  std::size_t n_ends = 0, n_runs = 0;
+  for (const Chunk& ch : chunks) {
+    n_ends += discretize ? ch.voxels.size() : ch.ray_ends.size();
+    n_runs += ch.runs.size();
+  }
   cloud.reserve(n_ends);
-  thread_local FlatKeySet ends;
+  detail::FlatKeySet ends;
   ends.clear(discretize ? n_ends : 0);
+  frame.voxels.clear(n_runs / 2);  // (most voxels hold several runs: it grows where not)
   for (const Chunk& ch : chunks) {
     stats.points_inserted += ch.inserted;
     stats.points_invalid += ch.invalid;
     stats.points_unknown += ch.unknown;
     for (const octomap::point3d& p : ch.ray_ends) cloud.push_back(p);
     for (const octomap::OcTreeKey& key : ch.voxels) {
-      if (ends.insert(key)) cloud.push_back(tree.keyToCoord(key));
+      if (ends.insert(key).second) cloud.push_back(tree.keyToCoord(key));
     }
-    for (const auto& [key, run] : ch.runs) frame[key].add(run);
+    for (const auto& [key, run] : ch.runs) {
+      const auto [i, added] = frame.voxels.insert(key);
+      if (added) frame.sums.emplace_back();
+      frame.sums[i].add(run);
+    }
   }
 }
 
@@ -340,23 +301,20 @@ void updateOccupancy(TraversabilityOcTree& tree, const octomap::Pointcloud& ends
       }
     }
   }
-  thread_local FlatKeySet free_cells, occupied_cells;
-  std::size_t n_free = 0, n_occupied = 0;
-  for (const RayKeys& c : chunks) n_free += c.free.size(), n_occupied += c.occupied.size();
-  free_cells.clear(n_free / 8);  // (most keys repeat: it grows where they do not)
-  occupied_cells.clear(n_occupied);
+  detail::VoxelMarks marks;  // (a few allocations a frame; thread_local costs a call a use)
+  std::size_t n_keys = 0;
+  for (const RayKeys& c : chunks) n_keys += c.free.size() + c.occupied.size();
+  marks.clear(n_keys / 32);  // (most keys repeat, and a brick holds 64: it grows where not)
   for (const RayKeys& c : chunks) {
-    for (const auto& k : c.occupied) occupied_cells.insert(k);
+    for (const auto& k : c.occupied) marks.markOccupied(k);
   }
   for (const RayKeys& c : chunks) {
-    for (const auto& k : c.free) {
-      if (!occupied_cells.contains(k)) free_cells.insert(k);
-    }
+    for (const auto& k : c.free) marks.markFree(k);
   }
-  for (const auto& k : free_cells.keys()) tree.updateNode(k, false, /*lazy_eval=*/true);
-  for (const auto& k : occupied_cells.keys()) tree.updateNode(k, true, /*lazy_eval=*/true);
-  changed.insert(changed.end(), free_cells.keys().begin(), free_cells.keys().end());
-  changed.insert(changed.end(), occupied_cells.keys().begin(), occupied_cells.keys().end());
+  for (const auto& k : marks.free()) tree.updateNode(k, false, /*lazy_eval=*/true);
+  for (const auto& k : marks.occupied()) tree.updateNode(k, true, /*lazy_eval=*/true);
+  changed.insert(changed.end(), marks.free().begin(), marks.free().end());
+  changed.insert(changed.end(), marks.occupied().begin(), marks.occupied().end());
 }
 
 void checkInsertArgs(const TraversabilityOcTree& tree, const PointsWorld& points,
@@ -411,7 +369,9 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
   thread_local std::vector<octomap::OcTreeKey> changed;
   changed.clear();
   updateOccupancy(tree, cloud, origin, max_range, changed);
-  for (const auto& [key, v] : frame) {
+  for (std::size_t i = 0; i < frame.sums.size(); ++i) {
+    const octomap::OcTreeKey& key = frame.voxels.keys()[i];
+    const FrameVoxel& v = frame.sums[i];
     const float cost = v.n_cost > 0 ? static_cast<float>(v.cost_sum / v.n_cost)
                                     : std::numeric_limits<float>::quiet_NaN();
     if (tree.integrateTraversability(key, v.n_nontrav, v.n_trav, v.zeta_min, cost, fusion)) {

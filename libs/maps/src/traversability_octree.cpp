@@ -3,6 +3,7 @@
 #include "upd/io/atomic_file.h"
 #include "upd/maps/grid_export.h"
 
+#include "key_sets.h"
 #include "octree_tiles.h"
 
 #include <octomap/AbstractOcTree.h>
@@ -10,11 +11,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <istream>
 #include <ostream>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace upd::maps {
 
@@ -214,10 +218,9 @@ std::uint64_t mortonOf(const octomap::OcTreeKey& k) {
 
 void TraversabilityOcTree::updateInnerOccupancy(const std::vector<octomap::OcTreeKey>& changed) {
   if (root == nullptr || changed.empty()) return;
-  thread_local std::vector<std::uint64_t> codes;
-  codes.resize(changed.size());
+  std::vector<std::uint64_t> codes(changed.size()), buffer;
   for (std::size_t i = 0; i < changed.size(); ++i) codes[i] = mortonOf(changed[i]);
-  std::sort(codes.begin(), codes.end());
+  detail::radixSort48(codes, buffer);  // (the order only spares visits: any order updates all)
   codes.erase(std::unique(codes.begin(), codes.end()), codes.end());
   updateInnerOccupancyRecurs(root, 0, codes.data(), codes.data() + codes.size());
 }
