@@ -529,6 +529,36 @@ TEST(TraversabilityOctree, RealOctomapFileLoadsAndRoundTrips) {
   EXPECT_EQ(occupiedLeaves(*upd::maps::readTraversabilityOt(dir.file("geb.ot"))), occ);
 }
 
+// A voxel's traversability is updated only by points that mark it hit, as its occupancy: a
+// frame whose points lie beyond max_range of the sensor, or outside the update box, leaves the
+// voxels they fall in as they were, in both insert modes.
+TEST(TraversabilityOctree, PointsBeyondRangeOrOutsideTheBoxLeaveTraversabilityAlone) {
+  for (const bool discretize : {true, false}) {
+    OctreeParams p = fixedParams();  // a fixed box of 20 x 20 x 6 m around the origin
+    p.discretize = discretize;
+    p.max_range_m = 3.0;
+    TraversabilityOcTree tree(p);
+    const auto wall = [](float x, core::Label l) {
+      Frame f;
+      for (int k = 0; k < 5; ++k) f.add(x, 0.05f, 0.15f + 0.1f * k, l, 0.8f, 1.2f, 1.0f);
+      return f;
+    };
+    // Seen once within range (traversable), then from 5 m away as non-traversable.
+    upd::maps::insertScan(tree, wall(2.05f, core::Label::Traversable).view(), {0.0, 0.0, 0.5}, p,
+                          FusionParams{});
+    upd::maps::insertScan(tree, wall(2.05f, core::Label::NonTraversable).view(),
+                          {-3.0, 0.0, 0.5}, p, FusionParams{});
+    const TraversabilityOcTreeNode* node = tree.search(2.05, 0.05, 0.35);
+    ASSERT_NE(node, nullptr);
+    EXPECT_EQ(node->getObservations(), 1u) << discretize;
+    EXPECT_LT(node->getNonTraversableProbability(), 0.5f) << discretize;
+    // A wall beyond the box's edge (x = 10 m), seen from within range: no voxel of it.
+    upd::maps::insertScan(tree, wall(10.05f, core::Label::NonTraversable).view(), {8.0, 0.0, 0.5},
+                          p, FusionParams{});
+    EXPECT_EQ(tree.search(10.05, 0.05, 0.35), nullptr) << discretize;
+  }
+}
+
 TEST(TraversabilityOctree, UpdateBoxFollowsTheRobotAndBoundsMemory) {
   OctreeParams p;
   p.resolution_m = 0.2;

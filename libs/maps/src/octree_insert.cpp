@@ -115,19 +115,22 @@ struct Chunk {
 };
 constexpr std::size_t kChunk = 16384;
 
-// Adds labelled point i to the run of its voxel.
-inline void addToRun(FrameVoxel& run, const PointsWorld& points, std::size_t i, core::Label label) {
-  if (label == core::Label::NonTraversable) {
-    ++run.n_nontrav;
-  } else {
-    ++run.n_trav;
+// Adds point i to the run of its voxel when add (a labelled point whose voxel marks hit), by
+// masks rather than branches: the labels and the NaN of unscored points are mixed in a frame.
+inline void addToRun(FrameVoxel& run, const PointsWorld& points, std::size_t i, core::Label label,
+                     bool add) {
+  run.n_nontrav += add & (label == core::Label::NonTraversable);
+  run.n_trav += add & (label == core::Label::Traversable);
+  if (points.zeta != nullptr) {
+    const float z = points.zeta[i];
+    // (fmin's result: NaN, none yet, gives z; a NaN z, unscored, changes nothing)
+    run.zeta_min = add & !(run.zeta_min <= z) & std::isfinite(z) ? z : run.zeta_min;
   }
-  if (points.zeta != nullptr && std::isfinite(points.zeta[i])) {
-    run.zeta_min = std::fmin(run.zeta_min, points.zeta[i]);
-  }
-  if (points.cost != nullptr && std::isfinite(points.cost[i])) {
-    run.cost_sum += points.cost[i];
-    ++run.n_cost;
+  if (points.cost != nullptr) {
+    const float c = points.cost[i];
+    const bool finite = add & std::isfinite(c);
+    run.cost_sum += finite ? c : 0.f;
+    run.n_cost += finite;
   }
 }
 
@@ -171,8 +174,9 @@ void keyCodes(const float* __restrict x, const float* __restrict y, const float*
 }
 
 // Step 1 of insertScan for the points [begin, end): each point's voxel key, the voxels as
-// they open (with discretize: each whose centre marks hit when within range and inside the
-// box), and the labelled points of each run in one voxel summed. Two runs stay open, the last
+// they open, and the labelled points of each run in one voxel summed (without discretize, only
+// the points that mark their voxel hit; with it, whether the voxel's centre does is asked
+// once per voxel of the frame, after the merge). Two runs stay open, the last
 // two voxels met: a surface on a voxel boundary (a floor at z = 0 in the world frame, its
 // points' noise across it) alternates between two voxels from point to point, which one open
 // run closed at every other point.
@@ -181,7 +185,6 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
                std::size_t end, Chunk& ch) {
   struct Open {
     std::uint64_t code = kOutsideTree;  // (none)
-    bool hit = false;
     FrameVoxel run;
   };
   Open open[2];
@@ -212,20 +215,16 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
         if (code != open[last].code) {
           close(open[last]);
           open[last].code = code;
-          if (params.discretize) {
-            const octomap::OcTreeKey key = unpack(code);
-            ch.voxels.push_back(key);
-            open[last].hit = marksHit(tree.keyToCoord(key));
-          }
+          if (params.discretize) ch.voxels.push_back(unpack(code));
         }
       }
       const core::Label label = points.label[i];
-      if (label != core::Label::Traversable && label != core::Label::NonTraversable) {
-        ++ch.unknown;
-        continue;
-      }
-      if (!in_tree || !(params.discretize ? open[last].hit : marksHit(point()))) continue;
-      addToRun(open[last].run, points, i, label);
+      const bool labelled =
+          (label == core::Label::Traversable) | (label == core::Label::NonTraversable);
+      ch.unknown += !labelled;
+      if (!in_tree) continue;
+      addToRun(open[last].run, points, i, label,
+               params.discretize ? labelled : labelled && marksHit(point()));
     }
   }
   close(open[last ^ 1]);
@@ -371,6 +370,7 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
   updateOccupancy(tree, cloud, origin, max_range, changed);
   for (std::size_t i = 0; i < frame.sums.size(); ++i) {
     const octomap::OcTreeKey& key = frame.voxels.keys()[i];
+    if (params.discretize && !marks_hit(tree.keyToCoord(key))) continue;
     const FrameVoxel& v = frame.sums[i];
     const float cost = v.n_cost > 0 ? static_cast<float>(v.cost_sum / v.n_cost)
                                     : std::numeric_limits<float>::quiet_NaN();
