@@ -115,24 +115,47 @@ struct Chunk {
 };
 constexpr std::size_t kChunk = 16384;
 
-// Adds point i to the run of its voxel when add (a labelled point whose voxel marks hit), by
-// masks rather than branches: the labels and the NaN of unscored points are mixed in a frame.
-inline void addToRun(FrameVoxel& run, const PointsWorld& points, std::size_t i, core::Label label,
-                     bool add) {
-  run.n_nontrav += add & (label == core::Label::NonTraversable);
-  run.n_trav += add & (label == core::Label::Traversable);
-  if (points.zeta != nullptr) {
-    const float z = points.zeta[i];
-    // (fmin's result: NaN, none yet, gives z; a NaN z, unscored, changes nothing)
-    run.zeta_min = add & !(run.zeta_min <= z) & std::isfinite(z) ? z : run.zeta_min;
+// A point's share of its run's sums: nothing unless on (a labelled point whose voxel marks
+// hit); its zeta and cost only where finite (a run's zeta_min +inf while it has none).
+struct PointShare {
+  std::uint32_t nontrav, trav, has_cost;
+  float zeta, cost;
+  PointShare(const PointsWorld& points, std::size_t i, core::Label label, bool on) {
+    nontrav = on & (label == core::Label::NonTraversable);
+    trav = on & (label == core::Label::Traversable);
+    const float z = points.zeta != nullptr ? points.zeta[i] : kNanF;
+    const float c = points.cost != nullptr ? points.cost[i] : kNanF;
+    zeta = on & std::isfinite(z) ? z : kInfF;
+    has_cost = on & std::isfinite(c);
+    cost = has_cost ? c : 0.f;
   }
-  if (points.cost != nullptr) {
-    const float c = points.cost[i];
-    const bool finite = add & std::isfinite(c);
-    run.cost_sum += finite ? c : 0.f;
-    run.n_cost += finite;
+  static constexpr float kNanF = std::numeric_limits<float>::quiet_NaN();
+  static constexpr float kInfF = std::numeric_limits<float>::infinity();
+};
+
+// A run's sums as the scan keeps them: in registers, its share added without a branch (the
+// labels and the NaN of unscored points are mixed in a frame), or not at all when !on.
+struct RunSums {
+  std::uint32_t nontrav = 0, trav = 0, n_cost = 0;
+  float zeta_min = PointShare::kInfF;
+  double cost_sum = 0;
+  void add(const PointShare& p, bool on) {
+    nontrav += on ? p.nontrav : 0;
+    trav += on ? p.trav : 0;
+    zeta_min = std::min(zeta_min, on ? p.zeta : PointShare::kInfF);
+    cost_sum += on ? p.cost : 0.f;
+    n_cost += on ? p.has_cost : 0;
   }
-}
+  FrameVoxel voxel() const {
+    FrameVoxel v;
+    v.n_nontrav = nontrav;
+    v.n_trav = trav;
+    v.zeta_min = zeta_min < PointShare::kInfF ? zeta_min : PointShare::kNanF;  // (none: NaN)
+    v.cost_sum = cost_sum;
+    v.n_cost = n_cost;
+    return v;
+  }
+};
 
 // A point's voxel key packed in 48 bits (x | y << 16 | z << 32), or why it has none.
 constexpr std::uint64_t kNotFinite = ~std::uint64_t{0}, kOutsideTree = kNotFinite - 1;
@@ -183,15 +206,13 @@ void keyCodes(const float* __restrict x, const float* __restrict y, const float*
 void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
                const OctreeParams& params, const HitTest& marksHit, std::size_t begin,
                std::size_t end, Chunk& ch) {
-  struct Open {
-    std::uint64_t code = kOutsideTree;  // (none)
-    FrameVoxel run;
-  };
-  Open open[2];
-  int last = 0;  // open[last]: the voxel met last
-  const auto close = [&](Open& o) {
-    if (o.run.n_nontrav + o.run.n_trav > 0) ch.runs.emplace_back(unpack(o.code), o.run);
-    o = Open{};
+  // The two open runs, named rather than an array indexed by the one met last, which the
+  // compiler would keep in memory (each point's sums a load and a store behind the last).
+  std::uint64_t code0 = kOutsideTree, code1 = kOutsideTree;  // (none)
+  RunSums run0, run1;
+  bool last = false;  // the voxel met last: code1's
+  const auto close = [&](std::uint64_t code, RunSums run) {
+    if (run.nontrav + run.trav > 0) ch.runs.emplace_back(unpack(code), run.voxel());
   };
   constexpr std::size_t kBlock = 2048;
   std::uint64_t codes[kBlock];
@@ -210,11 +231,16 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
       const auto point = [&] { return octomap::point3d(points.x[i], points.y[i], points.z[i]); };
       const bool in_tree = code != kOutsideTree;
       if (!params.discretize) ch.ray_ends.push_back(point());
-      if (in_tree && code != open[last].code) {
-        last ^= 1;  // (the other one: the voxel met before, or the one to close and reopen)
-        if (code != open[last].code) {
-          close(open[last]);
-          open[last].code = code;
+      if (in_tree && code != (last ? code1 : code0)) {
+        last = !last;  // (the other one: the voxel met before, or the one to close and reopen)
+        if (code != (last ? code1 : code0)) {
+          if (last) {
+            close(code1, run1);
+            code1 = code, run1 = RunSums{};
+          } else {
+            close(code0, run0);
+            code0 = code, run0 = RunSums{};
+          }
           if (params.discretize) ch.voxels.push_back(unpack(code));
         }
       }
@@ -223,12 +249,14 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
           (label == core::Label::Traversable) | (label == core::Label::NonTraversable);
       ch.unknown += !labelled;
       if (!in_tree) continue;
-      addToRun(open[last].run, points, i, label,
-               params.discretize ? labelled : labelled && marksHit(point()));
+      const PointShare share(points, i, label,
+                             params.discretize ? labelled : labelled && marksHit(point()));
+      run0.add(share, !last);
+      run1.add(share, last);
     }
   }
-  close(open[last ^ 1]);
-  close(open[last]);
+  close(last ? code0 : code1, last ? run0 : run1);  // (the one met before last first)
+  close(last ? code1 : code0, last ? run1 : run0);
 }
 
 // The frame's labelled points summed per voxel: voxels.keys()[i]'s sums in sums[i].
