@@ -93,15 +93,19 @@ TEST(KeySets, FlatKeySetGivesEachKeyItsPlaceInTheList) {
 
 TEST(KeySets, RadixSortOfMortonCodesIsStdSortsOrder) {
   std::mt19937_64 rng(7);
-  for (const std::uint64_t high : {std::uint64_t{0}, std::uint64_t{0xABC} << 36}) {
-    for (const std::uint64_t mask : {0xFFFFFFFFFFFFull, 0xFFFFFFull, 0xFFF000FFFull}) {
-      std::vector<std::uint64_t> codes(5000);
-      for (auto& c : codes) c = high | (rng() & mask);  // (digits all share, and some not)
-      codes.push_back(codes[17]);                       // (a repeat)
-      std::vector<std::uint64_t> expected = codes, buffer;
-      std::sort(expected.begin(), expected.end());
-      upd::maps::detail::radixSort48(codes, buffer);
-      EXPECT_EQ(codes, expected) << std::hex << high << " " << mask;
+  for (const int bits : {48, 49}) {
+    const std::uint64_t top = std::uint64_t{1} << (bits - 1);  // (a 49th bit: the fifth digit)
+    for (const std::uint64_t high : {std::uint64_t{0}, std::uint64_t{0xABC} << 36, top}) {
+      for (const std::uint64_t mask :
+           {top - 1 + top, std::uint64_t{0xFFFFFF}, std::uint64_t{0xFFF000FFF}}) {
+        std::vector<std::uint64_t> codes(5000);
+        for (auto& c : codes) c = high | (rng() & mask);  // (digits all share, and some not)
+        codes.push_back(codes[17]);                       // (a repeat)
+        std::vector<std::uint64_t> expected = codes, buffer;
+        std::sort(expected.begin(), expected.end());
+        upd::maps::detail::radixSort(codes, buffer, bits);
+        EXPECT_EQ(codes, expected) << bits << " " << std::hex << high << " " << mask;
+      }
     }
   }
 }

@@ -258,6 +258,44 @@ TEST(TraversabilityOctree, InsertUpdatesTheInnerNodesAsAWholeTreeUpdate) {
   EXPECT_GT(tree.keptTiles(), 0u);
 }
 
+// updateNodes gives the tree OctoMap's updateNode calls one after the other give, on a tree
+// with pruned nodes (saturated free space collapsed), voxels at both clamping bounds, voxels
+// between them and space with no node: the early stop at a saturated voxel or pruned node, the
+// expansion of a pruned node, the nodes created; byte for byte.
+TEST(TraversabilityOctree, UpdateNodesIsOctomapsUpdateNodeOneAfterTheOther) {
+  std::unique_ptr<TraversabilityOcTree> trees[2] = {sceneTree(12), sceneTree(12)};
+  std::size_t pruned = 0;
+  for (auto& t : trees) {
+    const std::size_t before = t->size();
+    t->prune();
+    pruned = before - t->size();
+    t->updateNode(t->coordToKey(2.55, 0.05, 0.35), true, true);  // (one voxel between the bounds)
+  }
+  ASSERT_GT(pruned, 100u);
+  std::vector<octomap::OcTreeKey> free, occupied;
+  for (int i = -5; i < 45; ++i) {
+    for (int j = -12; j < 12; ++j) {
+      for (int k = -2; k < 12; ++k) {
+        const octomap::OcTreeKey key = trees[0]->coordToKey(0.1 * i + 0.05, 0.1 * j + 0.05,
+                                                            0.1 * k + 0.05);
+        if ((i + 2 * j + 3 * k) % 7 == 0) continue;  // (keys left alone)
+        // (occupied keys on one side of the sensor and at the far end only: pruned free space
+        // on the other side, saturated, gets free keys alone and stays pruned)
+        const bool hit = (i >= 30 || (j < 0 && i < 10)) && (i * j + k) % 3 == 0;
+        (hit ? occupied : free).push_back(key);
+      }
+    }
+  }
+  trees[0]->updateNodes(free, occupied);
+  for (const auto& k : free) trees[1]->updateNode(k, false, true);
+  for (const auto& k : occupied) trees[1]->updateNode(k, true, true);
+  std::ostringstream batched, one_by_one;
+  trees[0]->write(batched);
+  trees[1]->write(one_by_one);
+  EXPECT_EQ(trees[0]->size(), trees[1]->size());
+  EXPECT_EQ(batched.str(), one_by_one.str());
+}
+
 // The insert computes a block of points' voxel keys at once, not by OctoMap's coordToKeyChecked:
 // points on and beside voxel boundaries, at negative coordinates and at -0, each end in the
 // voxel OctoMap's own key names (occupied, with its traversability); points that are not

@@ -139,16 +139,19 @@ class VoxelMarks {
   std::vector<octomap::OcTreeKey> occupied_, free_;
 };
 
-// Sorts 48-bit codes (std::sort's order): least significant digit first, 12 bits a digit, a
-// digit every code shares skipped (a frame's voxels share their Morton codes' highest digits).
-inline void radixSort48(std::vector<std::uint64_t>& codes, std::vector<std::uint64_t>& buffer) {
-  constexpr int kDigits = 4, kBits = 12, kBins = 1 << kBits;
-  std::vector<std::uint32_t> counts(kDigits * kBins, 0);
+// Sorts codes of `bits` bits (std::sort's order): least significant digit first, 12 bits a
+// digit, a digit every code shares skipped (a frame's voxels share their Morton codes' highest
+// digits).
+inline void radixSort(std::vector<std::uint64_t>& codes, std::vector<std::uint64_t>& buffer,
+                      int bits) {
+  constexpr int kBits = 12, kBins = 1 << kBits;
+  const int digits = (bits + kBits - 1) / kBits;
+  std::vector<std::uint32_t> counts(static_cast<std::size_t>(digits) * kBins, 0);
   for (const std::uint64_t c : codes) {
-    for (int d = 0; d < kDigits; ++d) ++counts[d * kBins + ((c >> (d * kBits)) & (kBins - 1))];
+    for (int d = 0; d < digits; ++d) ++counts[d * kBins + ((c >> (d * kBits)) & (kBins - 1))];
   }
   buffer.resize(codes.size());
-  for (int d = 0; d < kDigits; ++d) {
+  for (int d = 0; d < digits; ++d) {
     std::uint32_t* count = counts.data() + d * kBins;
     const std::uint64_t first = codes.empty() ? 0 : (codes[0] >> (d * kBits)) & (kBins - 1);
     if (count[first] == codes.size()) continue;

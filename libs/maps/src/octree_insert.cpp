@@ -338,8 +338,7 @@ void updateOccupancy(TraversabilityOcTree& tree, const octomap::Pointcloud& ends
   for (const RayKeys& c : chunks) {
     for (const auto& k : c.free) marks.markFree(k);
   }
-  for (const auto& k : marks.free()) tree.updateNode(k, false, /*lazy_eval=*/true);
-  for (const auto& k : marks.occupied()) tree.updateNode(k, true, /*lazy_eval=*/true);
+  tree.updateNodes(marks.free(), marks.occupied());
   changed.insert(changed.end(), marks.free().begin(), marks.free().end());
   changed.insert(changed.end(), marks.occupied().begin(), marks.occupied().end());
 }

@@ -220,9 +220,59 @@ void TraversabilityOcTree::updateInnerOccupancy(const std::vector<octomap::OcTre
   if (root == nullptr || changed.empty()) return;
   std::vector<std::uint64_t> codes(changed.size()), buffer;
   for (std::size_t i = 0; i < changed.size(); ++i) codes[i] = mortonOf(changed[i]);
-  detail::radixSort48(codes, buffer);  // (the order only spares visits: any order updates all)
+  detail::radixSort(codes, buffer, 48);  // (the order only spares visits: any order updates all)
   codes.erase(std::unique(codes.begin(), codes.end()), codes.end());
   updateInnerOccupancyRecurs(root, 0, codes.data(), codes.data() + codes.size());
+}
+
+void TraversabilityOcTree::updateNodes(const std::vector<octomap::OcTreeKey>& free,
+                                       const std::vector<octomap::OcTreeKey>& occupied) {
+  // The keys in Morton order, each code's lowest bit whether it is occupied.
+  std::vector<std::uint64_t> codes, buffer;
+  codes.reserve(free.size() + occupied.size());
+  for (const auto& k : free) codes.push_back(mortonOf(k) << 1);
+  for (const auto& k : occupied) codes.push_back(mortonOf(k) << 1 | 1);
+  if (codes.empty()) return;
+  detail::radixSort(codes, buffer, 49);
+  bool created = false;
+  if (root == nullptr) {
+    root = new TraversabilityOcTreeNode();
+    ++tree_size;
+    created = true;
+  }
+  updateNodesRecurs(root, created, 0, codes.data(), codes.data() + codes.size());
+}
+
+void TraversabilityOcTree::updateNodesRecurs(TraversabilityOcTreeNode* node, bool just_created,
+                                             unsigned int depth, std::uint64_t* lo,
+                                             std::uint64_t* hi) {
+  if (!just_created && !nodeHasChildren(node)) {
+    // What OctoMap's search finds for these keys (their voxel, or a pruned node above them):
+    // where an update would go towards the clamping bound it already holds, updateNode stops.
+    const float value = node->getLogOdds();
+    hi = std::remove_if(lo, hi, [&](std::uint64_t code) {
+      const float update = (code & 1) != 0 ? prob_hit_log : prob_miss_log;
+      return (update >= 0 && value >= clamping_thres_max) ||
+             (update <= 0 && value <= clamping_thres_min);
+    });
+    if (lo == hi) return;
+    if (depth < tree_depth) expandNode(node);  // (a pruned node: its copies below)
+  }
+  if (depth == tree_depth) {  // (one key: they are distinct)
+    updateNodeLogOdds(node, (*lo & 1) != 0 ? prob_hit_log : prob_miss_log);
+    return;
+  }
+  // (The codes under one child are consecutive: sorted, its index their highest bits left.)
+  const unsigned int shift = 3 * (tree_depth - 1 - depth) + 1;
+  for (std::uint64_t* a = lo; a < hi;) {
+    const auto child = static_cast<unsigned int>((*a >> shift) & 7);
+    std::uint64_t* b = a + 1;
+    while (b < hi && ((*b >> shift) & 7) == child) ++b;
+    const bool create = !nodeChildExists(node, child);
+    if (create) createNodeChild(node, child);
+    updateNodesRecurs(getNodeChild(node, child), create, depth + 1, a, b);
+    a = b;
+  }
 }
 
 void TraversabilityOcTree::updateInnerOccupancyRecurs(TraversabilityOcTreeNode* node,

@@ -173,6 +173,12 @@ class TraversabilityOcTree : public octomap::OccupancyOcTreeBase<TraversabilityO
                                                     float zeta_min, float cost_mean,
                                                     const FusionParams& params);
 
+  /// OctoMap's updateNode(key, false / true, lazy_eval = true) for each of the free and
+  /// occupied keys (distinct; none in both), in one descent of the tree in Morton order: the
+  /// same tree as the calls one after the other, in any order (inner nodes left stale).
+  void updateNodes(const std::vector<octomap::OcTreeKey>& free,
+                   const std::vector<octomap::OcTreeKey>& occupied);
+
   /// Updates inner nodes' occupancy (max child) and traversability (worst child).
   void updateInnerOccupancy();
   /// The same for the inner nodes above the voxels at changed only (the others must be up to
@@ -203,6 +209,10 @@ class TraversabilityOcTree : public octomap::OccupancyOcTreeBase<TraversabilityO
   /// The nodes above the keys of Morton codes [lo, hi) (sorted) below node.
   void updateInnerOccupancyRecurs(TraversabilityOcTreeNode* node, unsigned int depth,
                                   const std::uint64_t* lo, const std::uint64_t* hi);
+  /// updateNodes below node (on the path of every key of the codes [lo, hi), sorted; created
+  /// by this descent when just_created); may reorder the codes.
+  void updateNodesRecurs(TraversabilityOcTreeNode* node, bool just_created, unsigned int depth,
+                         std::uint64_t* lo, std::uint64_t* hi);
   /// Returns true when the caller should delete node (nothing of it is inside the box).
   /// keep: where the deleted subtrees go (nullptr: nowhere).
   bool cropRecurs(TraversabilityOcTreeNode* node, const octomap::OcTreeKey& key, unsigned int depth,
