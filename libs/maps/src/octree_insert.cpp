@@ -133,18 +133,18 @@ struct PointShare {
   static constexpr float kInfF = std::numeric_limits<float>::infinity();
 };
 
-// A run's sums as the scan keeps them: in registers, its share added without a branch (the
-// labels and the NaN of unscored points are mixed in a frame), or not at all when !on.
+// A run's sums as the scan keeps them: in registers, a point's share added without a branch
+// (the labels and the NaN of unscored points are mixed in a frame) when the point is in it.
 struct RunSums {
   std::uint32_t nontrav = 0, trav = 0, n_cost = 0;
   float zeta_min = PointShare::kInfF;
   double cost_sum = 0;
-  void add(const PointShare& p, bool on) {
-    nontrav += on ? p.nontrav : 0;
-    trav += on ? p.trav : 0;
-    zeta_min = std::min(zeta_min, on ? p.zeta : PointShare::kInfF);
-    cost_sum += on ? p.cost : 0.f;
-    n_cost += on ? p.has_cost : 0;
+  void add(const PointShare& p, bool in_run) {
+    nontrav += in_run ? p.nontrav : 0;
+    trav += in_run ? p.trav : 0;
+    zeta_min = std::min(zeta_min, in_run ? p.zeta : PointShare::kInfF);
+    cost_sum += in_run ? p.cost : 0.f;
+    n_cost += in_run ? p.has_cost : 0;
   }
   FrameVoxel voxel() const {
     FrameVoxel v;
