@@ -214,6 +214,20 @@ std::uint64_t mortonOf(const octomap::OcTreeKey& k) {
   return spread(k[0]) | spread(k[1]) << 1 | spread(k[2]) << 2;
 }
 
+// Calls f(child, a, b) for each run [a, b) of the sorted codes [lo, hi) under one child of a
+// node, the child's index the 3 bits at shift: the codes under one child are consecutive
+// (sorted, its index their highest bits left).
+template <class Code, class F>
+void forEachChildRun(Code* lo, Code* hi, unsigned int shift, F&& f) {
+  for (Code* a = lo; a < hi;) {
+    const auto child = static_cast<unsigned int>((*a >> shift) & 7);
+    Code* b = a + 1;
+    while (b < hi && ((*b >> shift) & 7) == child) ++b;
+    f(child, a, b);
+    a = b;
+  }
+}
+
 }  // namespace
 
 void TraversabilityOcTree::updateInnerOccupancy(const std::vector<octomap::OcTreeKey>& changed) {
@@ -262,17 +276,12 @@ void TraversabilityOcTree::updateNodesRecurs(TraversabilityOcTreeNode* node, boo
     updateNodeLogOdds(node, (*lo & 1) != 0 ? prob_hit_log : prob_miss_log);
     return;
   }
-  // (The codes under one child are consecutive: sorted, its index their highest bits left.)
-  const unsigned int shift = 3 * (tree_depth - 1 - depth) + 1;
-  for (std::uint64_t* a = lo; a < hi;) {
-    const auto child = static_cast<unsigned int>((*a >> shift) & 7);
-    std::uint64_t* b = a + 1;
-    while (b < hi && ((*b >> shift) & 7) == child) ++b;
+  const unsigned int shift = 3 * (tree_depth - 1 - depth) + 1;  // (+ 1: the occupied bit)
+  forEachChildRun(lo, hi, shift, [&](unsigned int child, auto a, auto b) {
     const bool create = !nodeChildExists(node, child);
     if (create) createNodeChild(node, child);
     updateNodesRecurs(getNodeChild(node, child), create, depth + 1, a, b);
-    a = b;
-  }
+  });
 }
 
 void TraversabilityOcTree::updateInnerOccupancyRecurs(TraversabilityOcTreeNode* node,
@@ -280,17 +289,12 @@ void TraversabilityOcTree::updateInnerOccupancyRecurs(TraversabilityOcTreeNode* 
                                                       const std::uint64_t* hi) {
   if (!nodeHasChildren(node)) return;
   if (depth < tree_depth) {
-    // (The codes under one child are consecutive: sorted, its index their highest bits left.)
     const unsigned int shift = 3 * (tree_depth - 1 - depth);
-    for (const std::uint64_t* a = lo; a < hi;) {
-      const auto child = static_cast<unsigned int>((*a >> shift) & 7);
-      const std::uint64_t* b = a + 1;
-      while (b < hi && ((*b >> shift) & 7) == child) ++b;
+    forEachChildRun(lo, hi, shift, [&](unsigned int child, auto a, auto b) {
       if (nodeChildExists(node, child)) {
         updateInnerOccupancyRecurs(getNodeChild(node, child), depth + 1, a, b);
       }
-      a = b;
-    }
+    });
   }
   node->updateOccupancyChildren();
   node->updateTraversabilityChildren();
