@@ -204,6 +204,10 @@ Frame generatedFrame() {
   return f;
 }
 
+core::PointCloud inputCloud(const Frame& f) {
+  return f.depth ? core::depthToCloud(*f.depth, f.intrinsics) : f.cloud;
+}
+
 std::vector<Frame> kinectFrames(const Options& o) {
   std::vector<Frame> frames;
   frames.push_back(pcdFrame(o, "office1", "pcl/office1.pcd", {0.f, -1.f, 0.01f}));

@@ -37,6 +37,9 @@ Frame pcdFrame(const Options& o, const std::string& name, const std::string& rel
 /// makeWorld("mixed") rendered by a simulated Kinect.
 Frame generatedFrame();
 
+/// The frame as the pipeline takes it: its depth image converted, or its organized cloud.
+core::PointCloud inputCloud(const Frame& f);
+
 /// The three Kinect frames of the report, in its order.
 std::vector<Frame> kinectFrames(const Options& o);
 

@@ -44,7 +44,7 @@ struct ScoredFrame {
 
 ScoredFrame scoreFrame(const Frame& fr) {
   ScoredFrame s;
-  const core::PointCloud cloud = fr.depth ? core::depthToCloud(*fr.depth, fr.intrinsics) : fr.cloud;
+  const core::PointCloud cloud = inputCloud(fr);
   core::runPipeline(cloud, sensorRateParams(fr.up), s.result);
   core::transformCloud(s.result.cloud, fr.pose_world_cloud.cast<double>(), s.world);
   s.origin = fr.pose_world_cloud.translation().cast<double>();

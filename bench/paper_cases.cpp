@@ -94,7 +94,7 @@ json paperCase(const Frame& fr, const Options& o, Report& report) {
     std::printf("%-30s skipped: %s\n", fr.name.c_str(), fr.skip_reason.c_str());
     return c;
   }
-  const core::PointCloud cloud = fr.depth ? core::depthToCloud(*fr.depth, fr.intrinsics) : fr.cloud;
+  const core::PointCloud cloud = inputCloud(fr);
   const core::PipelineParams p = paperParams(fr.up);
   const PaperTiming t = timePaperPipeline(cloud, p, o.repeats);
   const double pre = t.stages["preprocess_ms"].get<double>();

@@ -206,7 +206,7 @@ json pclSettingsCases(const std::vector<Frame>& frames, const Options& o, Report
       peer_cases.push_back({{"name", fr.name + " (voxel 0.02)"}, {"skipped", fr.skip_reason}});
       continue;
     }
-    const core::PointCloud cloud = fr.depth ? core::depthToCloud(*fr.depth, fr.intrinsics) : fr.cloud;
+    const core::PointCloud cloud = inputCloud(fr);
     peer_cases.push_back(peerCase(fr.name + " voxel 0.02", fr.source, cloud,
                                   pclSettings(fr.up, 0.02, 0.05, 0.5), o, o.repeats, report, true));
   }
