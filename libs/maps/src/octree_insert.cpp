@@ -21,21 +21,6 @@ namespace upd::maps {
 
 namespace {
 
-struct FrameVoxel {
-  std::uint32_t n_nontrav = 0, n_trav = 0;
-  float zeta_min = std::numeric_limits<float>::quiet_NaN();
-  double cost_sum = 0;
-  std::uint32_t n_cost = 0;
-
-  void add(const FrameVoxel& o) {
-    n_nontrav += o.n_nontrav;
-    n_trav += o.n_trav;
-    zeta_min = std::fmin(zeta_min, o.zeta_min);  // NaN (none yet) gives the other
-    cost_sum += o.cost_sum;
-    n_cost += o.n_cost;
-  }
-};
-
 // Key of a coordinate, clamped to the tree's key range (box corners may lie beyond it). OctoMap's
 // occupancy trees have 16 levels: keys 0..65535, the world origin at key 32768 (tree_max_val).
 octomap::OcTreeKey clampedKey(const TraversabilityOcTree& tree, const octomap::point3d& p) {
@@ -94,8 +79,8 @@ bool updateBox(TraversabilityOcTree& tree, const Eigen::Vector3d& sensor,
   return true;
 }
 
-// Whether a ray ending at `end` marks its end voxel hit: within range and inside the box, as
-// OctoMap's computeUpdate tests.
+// Whether a ray ending at `end` is cast and marks its end voxel hit: within range and inside
+// the box, as OctoMap's computeUpdate tests (the traversability of the voxel asks the same).
 struct HitTest {
   const TraversabilityOcTree& tree;
   octomap::point3d origin;
@@ -105,15 +90,6 @@ struct HitTest {
            !(tree.bbxSet() && !tree.inBBX(end));
   }
 };
-
-// One fixed chunk of points, scanned on its own (the result does not depend on the threads).
-struct Chunk {
-  std::vector<octomap::point3d> ray_ends;  // points, or the centres of new voxels
-  std::vector<octomap::OcTreeKey> voxels;  // discretize: each change of voxel, in order
-  std::vector<std::pair<octomap::OcTreeKey, FrameVoxel>> runs;
-  std::size_t inserted = 0, invalid = 0, unknown = 0;
-};
-constexpr std::size_t kChunk = 16384;
 
 // A point's share of its run's sums: nothing unless on (a labelled point whose voxel marks
 // hit); its zeta and cost only where finite (a run's zeta_min +inf while it has none).
@@ -133,11 +109,12 @@ struct PointShare {
   static constexpr float kInfF = std::numeric_limits<float>::infinity();
 };
 
-// A run's sums as the scan keeps them: in registers, a point's share added without a branch
-// (the labels and the NaN of unscored points are mixed in a frame) when the point is in it.
-struct RunSums {
+// The labelled points' sums of a run of points in one voxel, or of a voxel over the frame (the
+// runs' sums added). The scan keeps its runs' in registers, a point's share added without a
+// branch (the labels and the NaN of unscored points are mixed in a frame) when it is in the run.
+struct VoxelSums {
   std::uint32_t nontrav = 0, trav = 0, n_cost = 0;
-  float zeta_min = PointShare::kInfF;
+  float zeta_min = PointShare::kInfF;  // (+inf: none)
   double cost_sum = 0;
   void add(const PointShare& p, bool in_run) {
     nontrav += in_run ? p.nontrav : 0;
@@ -146,16 +123,23 @@ struct RunSums {
     cost_sum += in_run ? p.cost : 0.f;
     n_cost += in_run ? p.has_cost : 0;
   }
-  FrameVoxel voxel() const {
-    FrameVoxel v;
-    v.n_nontrav = nontrav;
-    v.n_trav = trav;
-    v.zeta_min = zeta_min < PointShare::kInfF ? zeta_min : PointShare::kNanF;  // (none: NaN)
-    v.cost_sum = cost_sum;
-    v.n_cost = n_cost;
-    return v;
+  void add(const VoxelSums& o) {
+    nontrav += o.nontrav;
+    trav += o.trav;
+    zeta_min = std::min(zeta_min, o.zeta_min);
+    cost_sum += o.cost_sum;
+    n_cost += o.n_cost;
   }
 };
+
+// One fixed chunk of points, scanned on its own (the result does not depend on the threads).
+struct Chunk {
+  std::vector<octomap::point3d> ray_ends;  // points, or the centres of new voxels
+  std::vector<octomap::OcTreeKey> voxels;  // discretize: each change of voxel, in order
+  std::vector<std::pair<octomap::OcTreeKey, VoxelSums>> runs;
+  std::size_t inserted = 0, invalid = 0, unknown = 0;
+};
+constexpr std::size_t kChunk = 16384;
 
 // A point's voxel key packed in 48 bits (x | y << 16 | z << 32), or why it has none.
 constexpr std::uint64_t kNotFinite = ~std::uint64_t{0}, kOutsideTree = kNotFinite - 1;
@@ -209,10 +193,10 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
   // The two open runs, named rather than an array indexed by the one met last, which the
   // compiler would keep in memory (each point's sums a load and a store behind the last).
   std::uint64_t code0 = kOutsideTree, code1 = kOutsideTree;  // (none)
-  RunSums run0, run1;
+  VoxelSums run0, run1;
   bool last = false;  // the voxel met last: code1's
-  const auto close = [&](std::uint64_t code, RunSums run) {
-    if (run.nontrav + run.trav > 0) ch.runs.emplace_back(unpack(code), run.voxel());
+  const auto close = [&](std::uint64_t code, VoxelSums run) {
+    if (run.nontrav + run.trav > 0) ch.runs.emplace_back(unpack(code), run);
   };
   constexpr std::size_t kBlock = 2048;
   std::uint64_t codes[kBlock];
@@ -236,10 +220,10 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
         if (code != (last ? code1 : code0)) {
           if (last) {
             close(code1, run1);
-            code1 = code, run1 = RunSums{};
+            code1 = code, run1 = VoxelSums{};
           } else {
             close(code0, run0);
-            code0 = code, run0 = RunSums{};
+            code0 = code, run0 = VoxelSums{};
           }
           if (params.discretize) ch.voxels.push_back(unpack(code));
         }
@@ -262,7 +246,7 @@ void scanChunk(const TraversabilityOcTree& tree, const PointsWorld& points,
 // The frame's labelled points summed per voxel: voxels.keys()[i]'s sums in sums[i].
 struct FrameVoxels {
   detail::FlatKeySet voxels;
-  std::vector<FrameVoxel> sums;
+  std::vector<VoxelSums> sums;
 };
 
 // Step 2: the chunks in order: the rays (one per distinct end voxel with discretize) and the
@@ -307,8 +291,7 @@ struct RayKeys {
 // every insert; the rays cast in fixed chunks on the team, their keys gathered in chunk order.
 // The voxels updated are appended to changed.
 void updateOccupancy(TraversabilityOcTree& tree, const octomap::Pointcloud& ends,
-                     const octomap::point3d& origin, double max_range,
-                     std::vector<octomap::OcTreeKey>& changed) {
+                     const HitTest& marksHit, std::vector<octomap::OcTreeKey>& changed) {
   constexpr std::size_t kRays = 256;
   std::vector<RayKeys> chunks((ends.size() + kRays - 1) / kRays);
 #pragma omp parallel
@@ -320,10 +303,10 @@ void updateOccupancy(TraversabilityOcTree& tree, const octomap::Pointcloud& ends
       const std::size_t e = std::min(ends.size(), (static_cast<std::size_t>(c) + 1) * kRays);
       for (std::size_t i = static_cast<std::size_t>(c) * kRays; i < e; ++i) {
         const octomap::point3d& p = ends[i];
-        if (!tree.inBBX(p) || (max_range >= 0.0 && (p - origin).norm() > max_range)) continue;
+        if (!marksHit(p)) continue;
         octomap::OcTreeKey key;
         if (tree.coordToKeyChecked(p, key)) out.occupied.push_back(key);
-        if (!tree.computeRayKeys(origin, p, ray)) continue;
+        if (!tree.computeRayKeys(marksHit.origin, p, ray)) continue;
         for (auto k = ray.rbegin(); k != ray.rend() && tree.inBBX(*k); ++k) out.free.push_back(*k);
       }
     }
@@ -394,14 +377,15 @@ OctreeInsertStats insertScan(TraversabilityOcTree& tree, const PointsWorld& poin
   // is up to date: updateBox's crop updated it whole).
   thread_local std::vector<octomap::OcTreeKey> changed;
   changed.clear();
-  updateOccupancy(tree, cloud, origin, max_range, changed);
+  updateOccupancy(tree, cloud, marks_hit, changed);
   for (std::size_t i = 0; i < frame.sums.size(); ++i) {
     const octomap::OcTreeKey& key = frame.voxels.keys()[i];
     if (params.discretize && !marks_hit(tree.keyToCoord(key))) continue;
-    const FrameVoxel& v = frame.sums[i];
+    const VoxelSums& v = frame.sums[i];
     const float cost = v.n_cost > 0 ? static_cast<float>(v.cost_sum / v.n_cost)
-                                    : std::numeric_limits<float>::quiet_NaN();
-    if (tree.integrateTraversability(key, v.n_nontrav, v.n_trav, v.zeta_min, cost, fusion)) {
+                                    : PointShare::kNanF;
+    const float zeta_min = v.zeta_min < PointShare::kInfF ? v.zeta_min : PointShare::kNanF;
+    if (tree.integrateTraversability(key, v.nontrav, v.trav, zeta_min, cost, fusion)) {
       ++stats.voxels_traversability;
       changed.push_back(key);
     }
