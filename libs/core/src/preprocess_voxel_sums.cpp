@@ -17,45 +17,13 @@
 
 #include "fast_cell_map.h"
 #include "preprocess_internal.h"
+#include "preprocess_voxel_team.h"
 #include "upd/core/openmp.h"
 #include "upd/core/vector_clones.h"
 
 namespace upd::core::detail {
 
 namespace {
-
-// A Bloom filter of one hash over the keys a thread's map holds (in a team): a later thread asks
-// it before it looks a voxel up in that map. Most of its voxels are not there, and each probe of
-// the other thread's map would miss the cache (another core filled it).
-class SeenKeys {
- public:
-  void clear() { bits_.assign(kWords, 0); }
-  void add(std::uint64_t key) {
-    const std::size_t i = slot(key);
-    bits_[i >> 6] |= std::uint64_t{1} << (i & 63);
-  }
-  bool mayHold(std::uint64_t key) const {
-    const std::size_t i = slot(key);
-    return ((bits_[i >> 6] >> (i & 63)) & 1) != 0;
-  }
-
- private:
-  // (64 KB: ~3 % false positives at a Kinect frame's ~16,000 voxels a thread.)
-  static constexpr int kBits = 19;
-  static constexpr std::size_t kWords = (std::size_t{1} << kBits) / 64;
-  static std::size_t slot(std::uint64_t key) {
-    return static_cast<std::size_t>((key * 0xD6E8FEB86659FD93ull) >> (64 - kBits));
-  }
-  std::vector<std::uint64_t> bits_;
-};
-
-// Per voxel: the sums of the points relative to the anchor, of the colours (exact: below 2^32
-// for any voxel of fewer than 2^24 points), and the count.
-struct VoxelSums {
-  double sx = 0, sy = 0, sz = 0;
-  std::uint32_t r = 0, g = 0, b = 0;
-  std::uint32_t n = 0;
-};
 
 // The per-thread buffers of voxelize, kept from call to call (no allocation in a warm loop).
 struct VoxelScratch {
@@ -66,6 +34,7 @@ struct VoxelScratch {
   std::vector<std::uint32_t> voxel_first, voxel_last;
   std::vector<char> merged;
   std::vector<std::uint32_t> own;          // (those not merged, whose centroids it stores)
+  SharedVoxels shared;                     // (the voxels this thread merges)
   SeenKeys seen;                           // (in a team:) a bit for every key the map holds
   std::size_t held = 0;                    // (their number)
   std::size_t expected = 0;                // the voxels the map is sized for
@@ -449,12 +418,15 @@ UPD_NOIPA void sumShare(VoxelScratch& s, VoxelPass& pass, const Team& t, std::si
 }
 
 // The voxels [v0, v1) of thread `later` that an earlier thread also has: their points added to
-// the earliest one's sums, one at a time in point order (after the earlier threads' own and
-// those of the threads between, merged before); merged set for them.
-void mergeInto(const Team& t, int later, std::size_t v0, std::size_t v1) {
+// the earliest one's sums (after the earlier threads' own and those of the threads between,
+// merged before), in point order, by one pass over the span of their points. (A voxel on the
+// rows where the threads meet spans two rows or more: a scan of each voxel's span would read
+// ~1,200 points a voxel, and those voxels come first in the later thread's order, so all in the
+// first thread's share of them.) merged set for them; mine: the calling thread's scratch.
+void mergeInto(const Team& t, int later, std::size_t v0, std::size_t v1, VoxelScratch& mine) {
   VoxelScratch& s = *t.scratch[later];
-  const bool colour = t.in.hasColor();
-  const Eigen::Vector3d& ref = t.st.ref;
+  SharedVoxels& shared = mine.shared;
+  shared.clear();
   for (std::size_t v = v0; v < v1; ++v) {
     const std::uint64_t key = s.voxel_keys[v];
     s.merged[v] = 0;
@@ -463,18 +435,25 @@ void mergeInto(const Team& t, int later, std::size_t v0, std::size_t v1) {
       if (!e.seen.mayHold(key)) continue;
       const std::uint32_t id = e.map.find(key);
       if (id == kNoIndex) continue;
-      VoxelSums& a = e.voxels[id];
-      for (std::size_t i = s.voxel_first[v]; i <= s.voxel_last[v]; ++i) {
-        if (t.keys[i] != key) continue;
-        a.sx += static_cast<double>(t.in.x[i]) - ref.x();
-        a.sy += static_cast<double>(t.in.y[i]) - ref.y();
-        a.sz += static_cast<double>(t.in.z[i]) - ref.z();
-        if (colour) a.r += t.in.r[i], a.g += t.in.g[i], a.b += t.in.b[i];
-        ++a.n;
-      }
+      shared.add(key, &e.voxels[id], s.voxel_first[v], s.voxel_last[v]);
       s.merged[v] = 1;
       break;
     }
+  }
+  if (shared.empty()) return;
+  const bool colour = t.in.hasColor();
+  const Eigen::Vector3d& ref = t.st.ref;
+  std::uint64_t last_key = kNoKey;
+  VoxelSums* a = nullptr;
+  for (std::size_t i = shared.lo(); i <= shared.hi(); ++i) {
+    const std::uint64_t key = t.keys[i];
+    if (key != last_key) a = key == kNoKey ? nullptr : shared.find(key), last_key = key;
+    if (a == nullptr) continue;
+    a->sx += static_cast<double>(t.in.x[i]) - ref.x();
+    a->sy += static_cast<double>(t.in.y[i]) - ref.y();
+    a->sz += static_cast<double>(t.in.z[i]) - ref.z();
+    if (colour) a->r += t.in.r[i], a->g += t.in.g[i], a->b += t.in.b[i];
+    ++a->n;
   }
 }
 
@@ -498,7 +477,7 @@ std::size_t sumTeamVoxels(VoxelScratch& s, const Team& t, int team, int me, std:
 #pragma omp barrier
   for (int later = 1; later < team; ++later) {
     const std::size_t n = t.voxels[later];
-    mergeInto(t, later, n * me / team, n * (me + 1) / team);
+    mergeInto(t, later, n * me / team, n * (me + 1) / team, s);
 #pragma omp barrier
   }
   return pass.passed();
