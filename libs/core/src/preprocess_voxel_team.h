@@ -50,7 +50,7 @@ class SeenKeys {
 class SharedVoxels {
  public:
   void clear() {
-    map_.clear(16);
+    map_.clear(std::max<std::size_t>(sums_.size(), 16));  // (sized as last time: no new table)
     sums_.clear();
     lo_ = ~std::size_t{0}, hi_ = 0;
   }
