@@ -422,10 +422,9 @@ UPD_NOIPA void sumShare(VoxelScratch& s, VoxelPass& pass, const Team& t, std::si
 // merged before), in point order, by one pass over the span of their points. (A voxel on the
 // rows where the threads meet spans two rows or more: a scan of each voxel's span would read
 // ~1,200 points a voxel, and those voxels come first in the later thread's order, so all in the
-// first thread's share of them.) merged set for them; mine: the calling thread's scratch.
-void mergeInto(const Team& t, int later, std::size_t v0, std::size_t v1, VoxelScratch& mine) {
+// first thread's share of them.) merged set for them; shared: the calling thread's own.
+void mergeInto(const Team& t, int later, std::size_t v0, std::size_t v1, SharedVoxels& shared) {
   VoxelScratch& s = *t.scratch[later];
-  SharedVoxels& shared = mine.shared;
   shared.clear();
   for (std::size_t v = v0; v < v1; ++v) {
     const std::uint64_t key = s.voxel_keys[v];
@@ -477,7 +476,7 @@ std::size_t sumTeamVoxels(VoxelScratch& s, const Team& t, int team, int me, std:
 #pragma omp barrier
   for (int later = 1; later < team; ++later) {
     const std::size_t n = t.voxels[later];
-    mergeInto(t, later, n * me / team, n * (me + 1) / team, s);
+    mergeInto(t, later, n * me / team, n * (me + 1) / team, s.shared);
 #pragma omp barrier
   }
   return pass.passed();
