@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -253,8 +254,8 @@ TEST(Preprocess, RangeCutIntoReusedBuffersEqualsTheCopyingPath) {
 namespace upd::core {
 namespace {
 
-// transformCloud and rotateVectors equal Eigen's per-point products; NaN stays NaN; the layout,
-// the colour and the sensor origin follow.
+// transformCloud, transformInPlace and rotateVectors equal Eigen's per-point products; NaN
+// stays NaN; the layout, the colour and the sensor origin follow.
 TEST(PointCloud, TransformAndRotateEqualEigenPerPoint) {
   PointCloud c;
   for (int i = 0; i < 70000; ++i) {  // over the size that runs in parallel
@@ -283,11 +284,20 @@ TEST(PointCloud, TransformAndRotateEqualEigenPerPoint) {
   EXPECT_TRUE(out.sensor_origin.isApprox(r * c.sensor_origin + tr, 1e-6f));
   EXPECT_THROW(transformCloud(c, t, c), std::invalid_argument);
 
-  std::vector<float> ox(c.size()), oy(c.size()), oz(c.size());
-  rotateVectors(r, c.size(), c.x.data(), c.y.data(), c.z.data(), ox.data(), oy.data(), oz.data());
-  EXPECT_TRUE(std::isnan(ox[5]));
+  PointCloud moved = c;
+  transformInPlace(moved, t);
+  const std::size_t bytes = c.size() * sizeof(float);  // the same products, in place
+  EXPECT_EQ(std::memcmp(moved.x.data(), out.x.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(moved.y.data(), out.y.data(), bytes), 0);
+  EXPECT_EQ(std::memcmp(moved.z.data(), out.z.data(), bytes), 0);
+  EXPECT_EQ(moved.r, c.r);
+  EXPECT_EQ(moved.sensor_origin, out.sensor_origin);
+
+  std::vector<float> vx = c.x, vy = c.y, vz = c.z;
+  rotateVectors(r, c.size(), vx.data(), vy.data(), vz.data());
+  EXPECT_TRUE(std::isnan(vx[5]));
   for (std::size_t i = 1; i < c.size(); i += 1009) {
-    EXPECT_TRUE(Eigen::Vector3f(ox[i], oy[i], oz[i]).isApprox(r * c.point(i), 1e-5f)) << i;
+    EXPECT_TRUE(Eigen::Vector3f(vx[i], vy[i], vz[i]).isApprox(r * c.point(i), 1e-5f)) << i;
   }
 }
 

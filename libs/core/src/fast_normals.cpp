@@ -437,16 +437,23 @@ std::size_t cellNormals(const RadiusGrid& g, std::size_t c, float radius2,
 
 Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
                            const Eigen::Vector3f& up) {
+  Normals out;
+  computeNormalsGrid(cloud, params, up, out);
+  return out;
+}
+
+void computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
+                        const Eigen::Vector3f& up, Normals& out) {
   params.validate();
   requireParam(params.knn == 0, "NormalParams", "knn", params.knn,
                "computeNormalsGrid finds radius neighbourhoods: it needs knn = 0");
   const std::size_t N = cloud.size();
-  Normals out = Normals::unset(N);
+  out.setUnset(N);
   std::size_t first = 0;
   while (first < N && !cloud.isFinite(first)) ++first;
   if (first == N) {
     out.invalid = N;
-    return out;
+    return;
   }
   RadiusGrid g;
   binByRadius(cloud, first, params.radius_m, g);
@@ -471,7 +478,6 @@ Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
     invalid += batch.flush(cloud, orient, out);
   }
   out.invalid = invalid;
-  return out;
 }
 
 }  // namespace upd::core

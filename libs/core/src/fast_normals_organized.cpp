@@ -502,7 +502,7 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
   if (pitch_u.empty() || pitch_v.empty()) {
     // Not a central projection we can measure (too few neighbouring valid pixels, or all rays
     // equal): the hash grid finds the same neighbours.
-    out = computeNormalsGrid(cloud, params, up);
+    computeNormalsGrid(cloud, params, up, out);
     return;
   }
   const WindowScan scan(im, pitch_u, pitch_v, params.radius_m, params.fast_scan_px);

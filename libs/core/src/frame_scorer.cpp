@@ -81,33 +81,23 @@ void scoreRoughness(const PointCloud& cloud, const FrameScorerParams& params,
   res.timings.total_ms = total.elapsedMs();
 }
 
-// out = the cloud-frame results moved by pose (copies reuse out's buffers).
-void moveToWorld(const PipelineResult& in, const Eigen::Isometry3d& pose, ScoredFrame& out) {
-  if (pose.matrix() == Eigen::Matrix4d::Identity()) {
-    out.cloud_world = in.cloud;
-    out.normals_world = in.normals;
-    out.upd = in.upd;
-  } else {
-    transformCloud(in.cloud, pose, out.cloud_world);
-    const Eigen::Matrix3f rotation = pose.linear().cast<float>();
-    const std::size_t n = in.normals.size();
-    Normals& normals = out.normals_world;
-    normals.nx.resize(n), normals.ny.resize(n), normals.nz.resize(n);
-    rotateVectors(rotation, n, in.normals.nx.data(), in.normals.ny.data(), in.normals.nz.data(),
-                  normals.nx.data(), normals.ny.data(), normals.nz.data());
-    normals.curvature = in.normals.curvature;
-    normals.invalid = in.normals.invalid;
-    const std::size_t m = in.upd.rx.size();
-    UpdResult& upd = out.upd;
-    upd.rx.resize(m), upd.ry.resize(m), upd.rz.resize(m);
-    rotateVectors(rotation, m, in.upd.rx.data(), in.upd.ry.data(), in.upd.rz.data(),
-                  upd.rx.data(), upd.ry.data(), upd.rz.data());
-    upd.zeta = in.upd.zeta;
-    upd.k = in.upd.k;
-    upd.invalid = in.upd.invalid;
-  }
-  out.classes = in.classes;  // labels, costs and slopes are the same in both frames
-  out.preprocess_stats = in.preprocess_stats;
+// out = the cloud-frame results in scratch moved by pose. The buffers are swapped, not copied:
+// scratch takes out's of the last frame, which the next frame's pipeline overwrites (it writes
+// every element), and the points and vectors are moved in place (no copy of the colours, zeta,
+// k, curvature and classes; a pass over each moved array instead of a read and a write of two).
+void moveToWorld(PipelineResult& scratch, const Eigen::Isometry3d& pose, ScoredFrame& out) {
+  std::swap(out.cloud_world, scratch.cloud);
+  std::swap(out.normals_world, scratch.normals);
+  std::swap(out.upd, scratch.upd);
+  std::swap(out.classes, scratch.classes);  // labels, costs and slopes are the same in both frames
+  out.preprocess_stats = scratch.preprocess_stats;
+  if (pose.matrix() == Eigen::Matrix4d::Identity()) return;
+  transformInPlace(out.cloud_world, pose);
+  const Eigen::Matrix3f rotation = pose.linear().cast<float>();
+  Normals& n = out.normals_world;
+  rotateVectors(rotation, n.size(), n.nx.data(), n.ny.data(), n.nz.data());
+  UpdResult& u = out.upd;
+  rotateVectors(rotation, u.rx.size(), u.rx.data(), u.ry.data(), u.rz.data());
 }
 
 void collectObstacles(ScoredFrame& out) {

@@ -58,7 +58,7 @@ void runPipeline(const PointCloud& input, const PipelineParams& params, Pipeline
     if (res.organized_normals) {
       computeNormalsOrganized(res.cloud, params.normals, up, res.normals);
     } else {
-      res.normals = computeNormalsGrid(res.cloud, params.normals, up);
+      computeNormalsGrid(res.cloud, params.normals, up, res.normals);
     }
     res.timings.normals_ms = lapMs(lap);
     FastUpdStats stats;

@@ -12,21 +12,24 @@
 namespace upd::core {
 
 namespace {
-// out = r * p + t for n points. The rotation and translation are plain local floats (firstprivate
-// in the parallel loop): read through a matrix or a struct, they would be reloaded after every
-// store (the compiler cannot rule out aliasing) and the loop would stay scalar.
+// out = r * p + t for n points; out may be the input arrays themselves (in place): a point's
+// coordinates are read before its own are written, and `simd` states that the points do not
+// depend on one another (no run-time alias check, which would send the in-place call to a scalar
+// loop). The rotation and translation are plain local floats (firstprivate in the parallel loop):
+// read through a matrix or a struct, they would be reloaded after every store.
 void applyTransform(const Eigen::Matrix3f& r, const Eigen::Vector3f& t, std::size_t n,
-                    const float* __restrict x, const float* __restrict y, const float* __restrict z,
-                    float* __restrict ox, float* __restrict oy, float* __restrict oz) {
+                    const float* x, const float* y, const float* z, float* ox, float* oy,
+                    float* oz) {
   const float r00 = r(0, 0), r01 = r(0, 1), r02 = r(0, 2), tx = t.x();
   const float r10 = r(1, 0), r11 = r(1, 1), r12 = r(1, 2), ty = t.y();
   const float r20 = r(2, 0), r21 = r(2, 1), r22 = r(2, 2), tz = t.z();
-#pragma omp parallel for schedule(static) if (n > 65536)
+#pragma omp parallel for simd schedule(static) if (n > 65536)
   for (std::ptrdiff_t ii = 0; ii < static_cast<std::ptrdiff_t>(n); ++ii) {
     const auto i = static_cast<std::size_t>(ii);
-    ox[i] = r00 * x[i] + r01 * y[i] + r02 * z[i] + tx;
-    oy[i] = r10 * x[i] + r11 * y[i] + r12 * z[i] + ty;
-    oz[i] = r20 * x[i] + r21 * y[i] + r22 * z[i] + tz;
+    const float a = x[i], b = y[i], c = z[i];
+    ox[i] = r00 * a + r01 * b + r02 * c + tx;
+    oy[i] = r10 * a + r11 * b + r12 * c + ty;
+    oz[i] = r20 * a + r21 * b + r22 * c + tz;
   }
 }
 
@@ -128,9 +131,16 @@ PointCloud transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& tran
   return out;
 }
 
-void rotateVectors(const Eigen::Matrix3f& rotation, std::size_t n, const float* x, const float* y,
-                   const float* z, float* out_x, float* out_y, float* out_z) {
-  applyTransform(rotation, Eigen::Vector3f::Zero(), n, x, y, z, out_x, out_y, out_z);
+void transformInPlace(PointCloud& cloud, const Eigen::Isometry3d& transform) {
+  const Eigen::Matrix3f r = transform.linear().cast<float>();
+  const Eigen::Vector3f t = transform.translation().cast<float>();
+  float *x = cloud.x.data(), *y = cloud.y.data(), *z = cloud.z.data();
+  applyTransform(r, t, cloud.size(), x, y, z, x, y, z);
+  cloud.sensor_origin = r * cloud.sensor_origin + t;
+}
+
+void rotateVectors(const Eigen::Matrix3f& rotation, std::size_t n, float* x, float* y, float* z) {
+  applyTransform(rotation, Eigen::Vector3f::Zero(), n, x, y, z, x, y, z);
 }
 
 }  // namespace upd::core

@@ -56,5 +56,8 @@ void computeNormalsOrganized(const PointCloud& cloud, const NormalParams& params
 /// up to the order of summation; Gaussian weights are supported. up must be unit length.
 Normals computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
                            const Eigen::Vector3f& up);
+/// The same into out, whose buffers are reused.
+void computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
+                        const Eigen::Vector3f& up, Normals& out);
 
 }  // namespace upd::core

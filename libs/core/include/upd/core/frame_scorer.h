@@ -14,9 +14,10 @@
 // an obstacle.
 //
 // The scorer holds only its parameters: score() is const and may run on several threads, each
-// with its own ScoredFrame. Pass the same ScoredFrame every frame: its buffers (and the scratch
-// it keeps for the cloud-frame results) are reused, so a frame of the size of the previous one
-// allocates no new storage for the results. The pre-processing reuses them too when the voxel
+// with its own ScoredFrame. Pass the same ScoredFrame every frame: its buffers and the scratch
+// it keeps for the cloud-frame results trade places every frame (the results are moved to the
+// world in place, not copied), so from the third frame on a frame of the size of the previous
+// ones allocates no new storage for the results. The pre-processing reuses them too when the voxel
 // grid is on (the outlier filter's search buffers are those of the scoring thread, kept from
 // frame to frame); the outlier filter without the voxel grid still builds fresh clouds.
 #pragma once

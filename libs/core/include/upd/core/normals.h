@@ -79,13 +79,18 @@ struct Normals {
 
   /// n points, no normal yet (NaN): where the exact and fast paths start.
   static Normals unset(std::size_t n) {
-    const float nan = std::numeric_limits<float>::quiet_NaN();
     Normals out;
-    out.nx.assign(n, nan);
-    out.ny.assign(n, nan);
-    out.nz.assign(n, nan);
-    out.curvature.assign(n, nan);
+    out.setUnset(n);
     return out;
+  }
+  /// The same in place, keeping the buffers' storage.
+  void setUnset(std::size_t n) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    nx.assign(n, nan);
+    ny.assign(n, nan);
+    nz.assign(n, nan);
+    curvature.assign(n, nan);
+    invalid = 0;
   }
 };
 

@@ -99,10 +99,13 @@ std::size_t copyCloud(const PointCloud& in, PointCloud& out);
 void transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform, PointCloud& out);
 PointCloud transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform);
 
-/// out_i = rotation * (x_i, y_i, z_i) for n vectors (normals, UPD vectors r; NaN stays NaN).
-/// The output arrays must not overlap the input ones.
-void rotateVectors(const Eigen::Matrix3f& rotation, std::size_t n, const float* x, const float* y,
-                   const float* z, float* out_x, float* out_y, float* out_z);
+/// transformCloud in place: the cloud's points and sensor origin moved, its buffers kept (a
+/// frame's results handed on without a copy; each thread moves the static share it wrote).
+void transformInPlace(PointCloud& cloud, const Eigen::Isometry3d& transform);
+
+/// (x_i, y_i, z_i) = rotation * (x_i, y_i, z_i) for n vectors, in place (normals, UPD vectors
+/// r; NaN stays NaN). The three arrays must not overlap one another.
+void rotateVectors(const Eigen::Matrix3f& rotation, std::size_t n, float* x, float* y, float* z);
 
 /// Per-point ground truth and classification labels (values are stable: written to PLY files).
 enum class Label : std::uint8_t { Traversable = 0, NonTraversable = 1, Unknown = 2 };
