@@ -111,6 +111,18 @@ std::size_t copyCloud(const PointCloud& in, PointCloud& out) {
   return finite;
 }
 
+namespace {
+// out's points and sensor origin = transform * in's (out may be in: in place). Its buffers
+// must hold in's points.
+void movePoints(const PointCloud& in, const Eigen::Isometry3d& transform, PointCloud& out) {
+  const Eigen::Matrix3f r = transform.linear().cast<float>();
+  const Eigen::Vector3f t = transform.translation().cast<float>();
+  applyTransform(r, t, in.size(), in.x.data(), in.y.data(), in.z.data(), out.x.data(),
+                 out.y.data(), out.z.data());
+  out.sensor_origin = r * in.sensor_origin + t;
+}
+}  // namespace
+
 void transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform, PointCloud& out) {
   if (&out == &cloud) throw std::invalid_argument("transformCloud: out must not be the input");
   const std::size_t n = cloud.size();
@@ -118,11 +130,7 @@ void transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform,
   copyColour(cloud, out);
   out.width = cloud.width;
   out.height = cloud.height;
-  const Eigen::Matrix3f r = transform.linear().cast<float>();
-  const Eigen::Vector3f t = transform.translation().cast<float>();
-  applyTransform(r, t, n, cloud.x.data(), cloud.y.data(), cloud.z.data(), out.x.data(),
-                 out.y.data(), out.z.data());
-  out.sensor_origin = r * cloud.sensor_origin + t;
+  movePoints(cloud, transform, out);
 }
 
 PointCloud transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& transform) {
@@ -132,11 +140,7 @@ PointCloud transformCloud(const PointCloud& cloud, const Eigen::Isometry3d& tran
 }
 
 void transformInPlace(PointCloud& cloud, const Eigen::Isometry3d& transform) {
-  const Eigen::Matrix3f r = transform.linear().cast<float>();
-  const Eigen::Vector3f t = transform.translation().cast<float>();
-  float *x = cloud.x.data(), *y = cloud.y.data(), *z = cloud.z.data();
-  applyTransform(r, t, cloud.size(), x, y, z, x, y, z);
-  cloud.sensor_origin = r * cloud.sensor_origin + t;
+  movePoints(cloud, transform, cloud);
 }
 
 void rotateVectors(const Eigen::Matrix3f& rotation, std::size_t n, float* x, float* y, float* z) {
