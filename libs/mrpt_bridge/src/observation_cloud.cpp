@@ -1,12 +1,11 @@
 #include "upd/mrpt_bridge/observation_cloud.h"
 
 #include "mrpt_util.h"
+#include "observation_stereo.h"
 #include "upd/core/params.h"
 #include "upd/mrpt_bridge/pose_source.h"
 
-#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <mrpt/img/CImage.h>
 #include <mrpt/maps/CColouredPointsMap.h>
@@ -64,6 +63,31 @@ void setPoint(core::PointCloud& c, std::size_t i, const Eigen::Vector3f& p) {
   c.z[i] = p.z();
 }
 
+// The cloud sized w x h, organized, without colour, for a pass that writes every point.
+void sizeOrganized(core::PointCloud& c, std::size_t w, std::size_t h) {
+  c.x.resize(w * h), c.y.resize(w * h), c.z.resize(w * h);
+  c.r.clear(), c.g.clear(), c.b.clear();
+  c.width = w, c.height = h;
+}
+
+// The points of one row of a range image in the robot frame: NaN where raw is 0 (no return),
+// else the pixel's unit ray (kx, ky, kz) times raw * units moved by robot_from_sensor. No
+// branch, so that the loop vectorizes.
+void rangeRow(const std::uint16_t* __restrict raw, float units, const float* __restrict kx,
+              const float* __restrict ky, const float* __restrict kz,
+              const Transform& robot_from_sensor, int w, float* __restrict x,
+              float* __restrict y, float* __restrict z) {
+  const Transform tf = robot_from_sensor;  // (a local copy: not reloaded after each store)
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int u = 0; u < w; ++u) {
+    // (NaN carried through the products and sums to every coordinate; the select is between
+    // two values, not an arithmetic result, so that it needs no branch.)
+    const float range = static_cast<float>(raw[u]) * (raw[u] != 0 ? units : nan);
+    const Eigen::Vector3f p = tf(Eigen::Vector3f(kx[u] * range, ky[u] * range, kz[u] * range));
+    x[u] = p.x(), y[u] = p.y(), z[u] = p.z();
+  }
+}
+
 void allocateColor(core::PointCloud& c) {
   c.r.assign(c.size(), 255);
   c.g.assign(c.size(), 255);
@@ -83,11 +107,6 @@ void pixelColor(const cv::Mat& img, int u, int v, std::uint8_t& r, std::uint8_t&
   }
 }
 
-bool usableImage(const cv::Mat& m) {
-  return !m.empty() && m.depth() == CV_8U &&
-         (m.channels() == 1 || m.channels() == 3 || m.channels() == 4);
-}
-
 // ---------------------------------------------------------------------------------------------
 // CObservation3DRangeScan
 
@@ -101,7 +120,7 @@ class RangeScanColour {
   RangeScanColour(const mrpt::obs::CObservation3DRangeScan& o, bool enabled, core::PointCloud& c) {
     if (!enabled || !o.hasIntensityImage) return;
     img_ = &o.intensityImage.asCvMatRef();
-    if (!usableImage(*img_)) {
+    if (!detail::usableImage(*img_)) {
       img_ = nullptr;
       return;
     }
@@ -118,6 +137,7 @@ class RangeScanColour {
     intensity_from_depth_ = Transform(toIsometry(o.relativePoseIntensityWRTDepth).inverse());
   }
 
+  bool enabled() const { return img_ != nullptr; }
   // Colours point pix (p_sensor: in the depth sensor frame).
   void paint(const Eigen::Vector3f& p_sensor, int pix, core::PointCloud& c) const {
     if (img_ == nullptr) return;
@@ -174,20 +194,23 @@ void convertRangeScan(const mrpt::obs::CObservation3DRangeScan& o, const SourceP
     // MRPT's unit ray (or unit-depth ray when range_is_depth) of every pixel, in the sensor
     // frame, with the lens distortion undone: the same numbers unprojectInto() uses.
     const auto& lut = o.get_unproj_lut();
-    c.resizeOrganized(static_cast<std::size_t>(w), static_cast<std::size_t>(h));
+    sizeOrganized(c, static_cast<std::size_t>(w), static_cast<std::size_t>(h));
     const RangeScanColour colour(o, params.color_enabled, c);
-    // Rows in parallel, in the static shares of the frame stages after (each pixel is its own).
+    // Rows in parallel, in the static shares of the frame stages after (each pixel is its own):
+    // every point written, NaN where there is no return (no fill of the cloud first).
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < h; ++v) {
+      rangeRow(&o.rangeImage(v, 0), o.rangeUnits, &lut.Kxs[v * w], &lut.Kys[v * w],
+               &lut.Kzs[v * w], robot_from_sensor, w, &c.x[v * w], &c.y[v * w], &c.z[v * w]);
+      if (!colour.enabled()) continue;
       for (int u = 0; u < w; ++u) {
         const std::uint16_t raw = o.rangeImage.coeff(v, u);
         if (raw == 0) continue;  // no return
         const int pix = v * w + u;
         const float range = static_cast<float>(raw) * o.rangeUnits;
-        const Eigen::Vector3f p_sensor(lut.Kxs[pix] * range, lut.Kys[pix] * range,
-                                       lut.Kzs[pix] * range);
-        setPoint(c, static_cast<std::size_t>(pix), robot_from_sensor(p_sensor));
-        colour.paint(p_sensor, pix, c);
+        colour.paint(Eigen::Vector3f(lut.Kxs[pix] * range, lut.Kys[pix] * range,
+                                     lut.Kzs[pix] * range),
+                     pix, c);
       }
     }
     return;
@@ -390,148 +413,6 @@ void convertRotatingScan(const mrpt::obs::CObservationRotatingScan& o, const Sou
   }
 }
 
-// ---------------------------------------------------------------------------------------------
-// Stereo
-
-cv::Mat intrinsicMatrix(const mrpt::img::TCamera& cam) {
-  cv::Mat k = cv::Mat::eye(3, 3, CV_64F);
-  k.at<double>(0, 0) = cam.fx();
-  k.at<double>(1, 1) = cam.fy();
-  k.at<double>(0, 2) = cam.cx();
-  k.at<double>(1, 2) = cam.cy();
-  return k;
-}
-
-cv::Mat distortion(const mrpt::img::TCamera& cam) {
-  cv::Mat d(1, 8, CV_64F);  // MRPT and OpenCV share the order k1 k2 p1 p2 k3 k4 k5 k6
-  for (int i = 0; i < 8; ++i) d.at<double>(0, i) = cam.dist[i];
-  return d;
-}
-
-// The pair's images, loaded; false (and out.skipped_reason) when they are missing or unusable.
-bool loadStereoPair(const mrpt::obs::CObservationStereoImages& o, cv::Mat& left, cv::Mat& right,
-                    ObservationCloud& out) {
-  if (!o.hasImageRight) {
-    out.skipped_reason = "CObservationStereoImages without a right image";
-    return false;
-  }
-  try {
-    o.imageLeft.forceLoad();
-    o.imageRight.forceLoad();
-    left = o.imageLeft.asCvMatRef();
-    right = o.imageRight.asCvMatRef();
-  } catch (const std::exception& e) {
-    out.skipped_reason = "CObservationStereoImages: cannot load its images (" +
-                         detail::condenseMessage(e.what()) + ")";
-    return false;
-  }
-  if (!usableImage(left) || !usableImage(right) || left.size() != right.size()) {
-    out.skipped_reason =
-        "CObservationStereoImages: the images are empty, not 8-bit, or differ in size";
-    return false;
-  }
-  return true;
-}
-
-// Rectifies a distorted pair with OpenCV in place, sets the rectified calibration and returns
-// the rectified frame's pose in the left camera frame.
-Eigen::Isometry3d rectifyPair(const mrpt::img::TCamera& lc, const mrpt::img::TCamera& rc,
-                              const mrpt::poses::CPose3D& right_in_left, cv::Mat& left,
-                              cv::Mat& right, StereoCalibration& calib) {
-  // OpenCV wants the transform from the left to the right camera frame (p_right = R p_left +
-  // T); MRPT gives the right camera's pose in the left frame, its inverse.
-  const Eigen::Isometry3d left_to_right = toIsometry(right_in_left).inverse();
-  cv::Mat r(3, 3, CV_64F), t(3, 1, CV_64F);
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) r.at<double>(i, j) = left_to_right.linear()(i, j);
-    t.at<double>(i, 0) = left_to_right.translation()(i);
-  }
-  cv::Mat r1, r2, p1, p2, q;
-  const cv::Size size(left.cols, left.rows);
-  cv::stereoRectify(intrinsicMatrix(lc), distortion(lc), intrinsicMatrix(rc), distortion(rc),
-                    size, r, t, r1, r2, p1, p2, q, cv::CALIB_ZERO_DISPARITY, 0);
-  cv::Mat mx, my, left_rect, right_rect;
-  cv::initUndistortRectifyMap(intrinsicMatrix(lc), distortion(lc), r1, p1, size, CV_32FC1, mx,
-                              my);
-  cv::remap(left, left_rect, mx, my, cv::INTER_LINEAR);
-  cv::initUndistortRectifyMap(intrinsicMatrix(rc), distortion(rc), r2, p2, size, CV_32FC1, mx,
-                              my);
-  cv::remap(right, right_rect, mx, my, cv::INTER_LINEAR);
-  left = left_rect;
-  right = right_rect;
-  calib.fx_px = p1.at<double>(0, 0);
-  calib.fy_px = p1.at<double>(1, 1);
-  calib.cx_px = p1.at<double>(0, 2);
-  calib.cy_px = p1.at<double>(1, 2);
-  calib.baseline_m = -p2.at<double>(0, 3) / p2.at<double>(0, 0);
-  // R1 rotates left-camera coordinates into the rectified frame: p_rect = R1 p_left.
-  Eigen::Matrix3d r1e;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) r1e(i, j) = r1.at<double>(i, j);
-  }
-  Eigen::Isometry3d rectified_in_left = Eigen::Isometry3d::Identity();
-  rectified_in_left.linear() = r1e.transpose();
-  return rectified_in_left;
-}
-
-// The calibration the observation carries (rectifying the pair when it is distorted); false
-// (and out.skipped_reason) when it has none usable.
-bool calibrationFromObservation(const mrpt::obs::CObservationStereoImages& o, cv::Mat& left,
-                                cv::Mat& right, StereoCalibration& calib,
-                                Eigen::Isometry3d& rectified_in_left, ObservationCloud& out) {
-  mrpt::img::TCamera lc = o.leftCamera, rc = o.rightCamera;
-  if (lc.ncols != static_cast<uint32_t>(left.cols) ||
-      lc.nrows != static_cast<uint32_t>(left.rows)) {
-    lc.scaleToResolution(left.cols, left.rows);
-  }
-  if (rc.ncols != static_cast<uint32_t>(left.cols) ||
-      rc.nrows != static_cast<uint32_t>(left.rows)) {
-    rc.scaleToResolution(left.cols, left.rows);
-  }
-  const mrpt::poses::CPose3D right_in_left(o.rightCameraPose);
-  if (!(lc.fx() > 0) || !(lc.fy() > 0) || !(right_in_left.x() > 0)) {
-    out.skipped_reason =
-        "CObservationStereoImages without a usable calibration (fx = " + std::to_string(lc.fx()) +
-        " px, right camera x = " + std::to_string(right_in_left.x()) +
-        " m); set stereo_fx_px, stereo_fy_px, stereo_cx_px, stereo_cy_px, stereo_baseline_m in "
-        "[SourceParams]";
-    return false;
-  }
-  if (o.areImagesRectified()) {
-    calib.fx_px = lc.fx();
-    calib.fy_px = lc.fy();
-    calib.cx_px = lc.cx();
-    calib.cy_px = lc.cy();
-    calib.baseline_m = right_in_left.x();
-  } else {
-    rectified_in_left = rectifyPair(lc, rc, right_in_left, left, right, calib);
-  }
-  return true;
-}
-
-void convertStereo(const mrpt::obs::CObservationStereoImages& o, const SourceParams& params,
-                   ObservationCloud& out) {
-  cv::Mat left, right;
-  if (!loadStereoPair(o, left, right, out)) return;
-  StereoCalibration calib;
-  calib.width = left.cols;
-  calib.height = left.rows;
-  Eigen::Isometry3d rectified_in_left = Eigen::Isometry3d::Identity();
-  if (params.hasStereoCalibration()) {
-    calib.fx_px = params.stereo_fx_px;
-    calib.fy_px = params.stereo_fy_px;
-    calib.cx_px = params.stereo_cx_px;
-    calib.cy_px = params.stereo_cy_px;
-    calib.baseline_m = params.stereo_baseline_m;
-  } else if (!calibrationFromObservation(o, left, right, calib, rectified_in_left, out)) {
-    return;
-  }
-  out.sensor_pose_on_robot = out.sensor_pose_on_robot * rectified_in_left;
-  const core::PointCloud in_camera =
-      stereoToCloud(left, right, calib, params.stereo, params.color_enabled);
-  out.cloud_in_robot = core::transformCloud(in_camera, out.sensor_pose_on_robot);
-}
-
 }  // namespace
 
 ObservationCloud toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params) {
@@ -569,7 +450,7 @@ void toCloud(const mrpt::obs::CObservation& obs, const SourceParams& params,
   } else if (const auto* rot = dynamic_cast<const mrpt::obs::CObservationRotatingScan*>(&obs)) {
     convertRotatingScan(*rot, params, out);
   } else if (const auto* st = dynamic_cast<const mrpt::obs::CObservationStereoImages*>(&obs)) {
-    convertStereo(*st, params, out);
+    detail::convertStereo(*st, params, out);
   } else if (dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) {
     out.skipped_reason = "CObservation2DRangeScan has no 3D points (a planar laser scan)";
   } else {
