@@ -63,13 +63,6 @@ void setPoint(core::PointCloud& c, std::size_t i, const Eigen::Vector3f& p) {
   c.z[i] = p.z();
 }
 
-// The cloud sized w x h, organized, without colour, for a pass that writes every point.
-void sizeOrganized(core::PointCloud& c, std::size_t w, std::size_t h) {
-  c.x.resize(w * h), c.y.resize(w * h), c.z.resize(w * h);
-  c.r.clear(), c.g.clear(), c.b.clear();
-  c.width = w, c.height = h;
-}
-
 // The points of one row of a range image in the robot frame: NaN where raw is 0 (no return),
 // else the pixel's unit ray (kx, ky, kz) times raw * units moved by robot_from_sensor. No
 // branch, so that the loop vectorizes.
@@ -194,7 +187,7 @@ void convertRangeScan(const mrpt::obs::CObservation3DRangeScan& o, const SourceP
     // MRPT's unit ray (or unit-depth ray when range_is_depth) of every pixel, in the sensor
     // frame, with the lens distortion undone: the same numbers unprojectInto() uses.
     const auto& lut = o.get_unproj_lut();
-    sizeOrganized(c, static_cast<std::size_t>(w), static_cast<std::size_t>(h));
+    c.resizeOrganizedUnfilled(static_cast<std::size_t>(w), static_cast<std::size_t>(h));
     const RangeScanColour colour(o, params.color_enabled, c);
     // Rows in parallel, in the static shares of the frame stages after (each pixel is its own):
     // every point written, NaN where there is no return (no fill of the cloud first).

@@ -66,13 +66,15 @@ struct PointCloud {
   }
   /// Makes the cloud an organized width x height image of NaN points (colour dropped).
   void resizeOrganized(std::size_t w, std::size_t h) {
+    resizeOrganizedUnfilled(w, h);
     const float nan = std::numeric_limits<float>::quiet_NaN();
     x.assign(w * h, nan);
     y.assign(w * h, nan);
     z.assign(w * h, nan);
-    r.clear();
-    g.clear();
-    b.clear();
+  }
+  /// The same without the NaN: the points' values are left to a pass that writes every one.
+  void resizeOrganizedUnfilled(std::size_t w, std::size_t h) {
+    resize(w * h, false);
     width = w;
     height = h;
   }
