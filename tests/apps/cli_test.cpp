@@ -91,6 +91,18 @@ TEST_F(Cli, VersionNamesTheReleaseAndWhatItWasBuiltWith) {
   EXPECT_EQ(line, "comment UPD-Nav " + v);
 }
 
+// MRPT's gui and hwdrivers (wxWidgets, GTK, FFmpeg, ...) are loaded with the viewer and the
+// sensor files (the modules), not at every start of the tool.
+TEST_F(Cli, TheToolLinksNeitherMrptGuiNorHwdrivers) {
+  const CmdResult r = test::runCommand(std::string("ldd ") + UPD_BINARY);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  if (r.output.find("libupd_core") == std::string::npos) {
+    GTEST_SKIP() << "a static build: no modules, the viewer and the sensors are linked in";
+  }
+  EXPECT_EQ(r.output.find("libmrpt-gui"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("libmrpt-hwdrivers"), std::string::npos) << r.output;
+}
+
 TEST_F(Cli, EveryGeneratedSceneIsAnalysed) {
   for (const char* scene : {"corner", "ramp", "step", "stairs", "ditch", "rocks"}) {
     SCOPED_TRACE(scene);

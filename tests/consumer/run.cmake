@@ -34,7 +34,7 @@ foreach(f bin/upd lib/cmake/upd_nav/upd_navConfig.cmake
           include/upd/core/pipeline.h include/upd/maps/traversability_grid.h
           share/upd-nav/README.md share/upd-nav/config/dune-kinect.ini
           share/upd-nav/config/dune-nav.ini share/upd-nav/config/ptg-dune.ini
-          share/upd-nav/samples/rocks.ply)
+          share/upd-nav/samples/rocks.ply lib/libupd_mrpt_sensors.so lib/libupd_nav_viewer.so)
   if(NOT EXISTS "${prefix}/${f}")
     message(FATAL_ERROR "not installed: ${prefix}/${f}")
   endif()
@@ -76,6 +76,11 @@ set(ENV{XDG_CACHE_HOME} "${work}/cache")
 run_checked("upd params" "${prefix}/bin/upd" params --ini)
 run_checked("upd analyze on the installed sample" "${prefix}/bin/upd" analyze
   "${prefix}/share/upd-nav/samples/rocks.ply" --stats-json "${work}/run/rocks.json")
+# The sensors module is found beside the installed libraries (MRPT then names the driver).
+file(WRITE "${work}/run/s.ini" "[CAM]\ndriver = CNoSuchSensor\n")
+set(ok_status 1)
+run_checked("upd live with a sensor file" "${prefix}/bin/upd" live --sensors "${work}/run/s.ini")
+expect_contains("${last_output}" "unknown driver class 'CNoSuchSensor'" "the installed sensors module")
 set(ok_status 3)  # 3: the goal is not reached in 2 s
 run_checked("upd navigate with the default configs" "${prefix}/bin/upd" navigate
   --scenario rocks --max-time-s 2 --output "${work}/run/nav")

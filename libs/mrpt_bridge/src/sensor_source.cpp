@@ -1,11 +1,11 @@
 #include "upd/mrpt_bridge/sensor_source.h"
 
 #include "mrpt_util.h"
+#include "sensor_driver.h"
+#include "upd/mrpt_bridge/module.h"
 #include "upd/mrpt_bridge/stereo.h"
 
 #include <mrpt/config/CConfigFile.h>
-#include <mrpt/hwdrivers/CGenericSensor.h>
-#include <mrpt/hwdrivers/COpenNI2Generic.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/obs/CObservationStereoImages.h>
 #include <mrpt/poses/CPose3DQuat.h>
@@ -19,6 +19,23 @@
 namespace fs = std::filesystem;
 
 namespace upd::mrpt_bridge {
+
+namespace detail {
+
+SensorDriver::~SensorDriver() = default;
+
+const SensorDrivers& sensorDrivers() {
+#ifdef UPD_SENSOR_MODULE
+  static const char here = 0;
+  static const auto* const drivers = static_cast<const SensorDrivers*>(
+      moduleSymbol(UPD_SENSOR_MODULE, "upd_mrpt_sensor_drivers", &here));
+  return *drivers;
+#else
+  return upd_mrpt_sensor_drivers;
+#endif
+}
+
+}  // namespace detail
 
 namespace {
 
@@ -67,9 +84,9 @@ SensorSection pickSection(const mrpt::config::CConfigFile& ini, const std::strin
   throw std::runtime_error(where(path, section) + ": no such section with a `driver` key");
 }
 
-mrpt::hwdrivers::CGenericSensor::Ptr createSensor(const std::string& path,
+std::unique_ptr<detail::SensorDriver> createSensor(const std::string& path,
                                                   const SensorSection& s) {
-  auto sensor = mrpt::hwdrivers::CGenericSensor::createSensorPtr(s.driver);
+  auto sensor = detail::sensorDrivers().create(s.driver);
   if (!sensor) {
     throw std::runtime_error(where(path, s.name) + ": unknown driver class '" + s.driver +
                              "' (not a sensor of MRPT's hwdrivers)");
@@ -77,7 +94,7 @@ mrpt::hwdrivers::CGenericSensor::Ptr createSensor(const std::string& path,
   return sensor;
 }
 
-void loadSensorConfig(mrpt::hwdrivers::CGenericSensor& sensor,
+void loadSensorConfig(detail::SensorDriver& sensor,
                       const mrpt::config::CConfigFile& ini, const std::string& path,
                       const std::string& section) {
   try {
@@ -88,15 +105,9 @@ void loadSensorConfig(mrpt::hwdrivers::CGenericSensor& sensor,
   }
 }
 
-// MRPT's COpenNI2Sensor aborts the process in doProcess() when no device is attached.
-// OpenNI2 stays initialized from the first probe until the process ends: MRPT's COpenNI2Generic
-// shuts it down when its last instance goes, which unloads the device drivers (and with them
-// what they allocated, then lost to every tool that would name it). The one probe is never
-// destroyed and stays reachable.
-int connectedOpenNI2Devices() {
-  static auto* const probe = new mrpt::hwdrivers::COpenNI2Generic();
-  return probe->getConnectedDevices();
-}
+// MRPT's COpenNI2Sensor aborts the process in doProcess() when no device is attached (the
+// probe: sensorDrivers().openni2Devices).
+int connectedOpenNI2Devices() { return detail::sensorDrivers().openni2Devices(); }
 
 void requireOpenNI2Device(const std::string& path, const std::string& section) {
   if (connectedOpenNI2Devices() <= 0) {
@@ -143,7 +154,7 @@ struct MrptSensorSource::Impl {
   std::string path;
   SensorSection section;
   std::unique_ptr<mrpt::config::CConfigFile> ini;
-  mrpt::hwdrivers::CGenericSensor::Ptr sensor;
+  std::unique_ptr<detail::SensorDriver> sensor;
   std::optional<StereoCalibration> stereo;
   bool recording = false;
 };
@@ -161,7 +172,7 @@ void checkSensorSection(const std::string& ini_path, const std::string& section)
   if (s.driver == "COpenNI2Sensor" && connectedOpenNI2Devices() <= 0) {
     // MRPT 2.5's ~COpenNI2Sensor throws (std::terminate) when no device was opened: such an
     // object, which never opened anything, is deliberately kept (reachable) and not destroyed.
-    static auto* const never_destroyed = new std::vector<mrpt::hwdrivers::CGenericSensor::Ptr>();
+    static auto* const never_destroyed = new std::vector<std::unique_ptr<detail::SensorDriver>>();
     static std::mutex guard;
     const std::lock_guard<std::mutex> lock(guard);
     never_destroyed->push_back(std::move(sensor));
@@ -195,22 +206,19 @@ MrptSensorSource::~MrptSensorSource() = default;
 
 bool MrptSensorSource::poll(std::vector<std::shared_ptr<mrpt::obs::CObservation>>& out) {
   Impl& m = *impl_;
-  mrpt::hwdrivers::CGenericSensor::TListObservations got;
+  std::vector<std::shared_ptr<mrpt::obs::CObservation>> got;
   try {
-    m.sensor->doProcess();
-    m.sensor->getObservations(got);
+    m.sensor->process(got);
   } catch (const std::exception& e) {
     if (m.recording) return false;  // "Reached end index.", the rawlog's end
     throw std::runtime_error(where(m.path, m.section.name) + ": " + m.section.driver +
                              " failed: " + detail::condenseMessage(e.what()));
   }
-  if (m.sensor->getState() == mrpt::hwdrivers::CGenericSensor::ssError) {
+  if (m.sensor->failed()) {
     throw std::runtime_error(where(m.path, m.section.name) + ": " + m.section.driver +
                              " reports an error state");
   }
-  for (auto& [t, obj] : got) {
-    auto obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj);
-    if (!obs) continue;
+  for (auto& obs : got) {
     if (m.stereo) {
       if (auto* st = dynamic_cast<mrpt::obs::CObservationStereoImages*>(obs.get())) {
         completeStereo(*st, *m.stereo);
