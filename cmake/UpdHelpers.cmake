@@ -22,6 +22,29 @@ function(upd_add_library name)
   upd_set_warnings(upd_${name})
 endfunction()
 
+# upd_add_module(name OF upd_<library> DEFINE VAR SOURCES a.cpp ... [LINKS ...]
+# [DEFINITIONS ...]): a part of the library loaded only when used (upd/mrpt_bridge/module.h),
+# for the heavy libraries it LINKS. In a shared build a MODULE beside the library (the build
+# tree and the installed lib/), whose file name the library gets as the string VAR; in a static
+# build the SOURCES are the library's own and VAR is not defined. DEFINITIONS are the SOURCES'
+# private compile definitions.
+function(upd_add_module name)
+  cmake_parse_arguments(M "" "OF;DEFINE" "SOURCES;LINKS;DEFINITIONS" ${ARGN})
+  if(BUILD_SHARED_LIBS)
+    add_library(${name} MODULE ${M_SOURCES})
+    target_link_libraries(${name} PRIVATE ${M_OF} ${M_LINKS})
+    target_compile_definitions(${name} PRIVATE ${M_DEFINITIONS})
+    set_target_properties(${name} PROPERTIES INSTALL_RPATH "$ORIGIN")
+    upd_set_warnings(${name})
+    target_compile_definitions(${M_OF} PRIVATE ${M_DEFINE}="$<TARGET_FILE_NAME:${name}>")
+    install(TARGETS ${name} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  else()
+    target_sources(${M_OF} PRIVATE ${M_SOURCES})
+    target_link_libraries(${M_OF} PRIVATE ${M_LINKS})
+    target_compile_definitions(${M_OF} PRIVATE ${M_DEFINITIONS})
+  endif()
+endfunction()
+
 # upd_add_test(NAME name SOURCES a.cpp b.cpp LIBS lib1 lib2 [LABEL label]): LABEL is the ctest
 # label of its test cases, the library it tests (`ctest -L '^maps$'`; scripts/sanitize.sh's scopes).
 function(upd_add_test)
