@@ -34,8 +34,14 @@ foreach(f bin/upd lib/cmake/upd_nav/upd_navConfig.cmake
           include/upd/core/pipeline.h include/upd/maps/traversability_grid.h
           share/upd-nav/README.md share/upd-nav/config/dune-kinect.ini
           share/upd-nav/config/dune-nav.ini share/upd-nav/config/ptg-dune.ini
-          share/upd-nav/samples/rocks.ply lib/libupd_mrpt_sensors.so lib/libupd_nav_viewer.so)
+          share/upd-nav/samples/rocks.ply)
   if(NOT EXISTS "${prefix}/${f}")
+    message(FATAL_ERROR "not installed: ${prefix}/${f}")
+  endif()
+endforeach()
+# A shared build's modules, beside the libraries (a static build has none).
+foreach(f lib/libupd_mrpt_sensors.so lib/libupd_nav_viewer.so)
+  if(EXISTS "${prefix}/lib/libupd_core.so" AND NOT EXISTS "${prefix}/${f}")
     message(FATAL_ERROR "not installed: ${prefix}/${f}")
   endif()
 endforeach()
