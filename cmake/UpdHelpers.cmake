@@ -27,7 +27,8 @@ endfunction()
 # for the heavy libraries it LINKS. In a shared build a MODULE beside the library (the build
 # tree and the installed lib/), whose file name the library gets as the string VAR; in a static
 # build the SOURCES are the library's own and VAR is not defined. DEFINITIONS are the SOURCES'
-# private compile definitions.
+# private compile definitions. The modules are listed in the global property UPD_MODULES (the
+# tool depends on them).
 function(upd_add_module name)
   cmake_parse_arguments(M "" "OF;DEFINE" "SOURCES;LINKS;DEFINITIONS" ${ARGN})
   if(BUILD_SHARED_LIBS)
@@ -38,6 +39,7 @@ function(upd_add_module name)
     upd_set_warnings(${name})
     target_compile_definitions(${M_OF} PRIVATE ${M_DEFINE}="$<TARGET_FILE_NAME:${name}>")
     install(TARGETS ${name} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+    set_property(GLOBAL APPEND PROPERTY UPD_MODULES ${name})  # (built with the tool)
   else()
     target_sources(${M_OF} PRIVATE ${M_SOURCES})
     target_link_libraries(${M_OF} PRIVATE ${M_LINKS})

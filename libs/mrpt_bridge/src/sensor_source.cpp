@@ -27,9 +27,7 @@ SensorDriver::~SensorDriver() = default;
 const SensorDrivers& sensorDrivers() {
 #ifdef UPD_SENSOR_MODULE
   static const char here = 0;
-  static const auto* const drivers = static_cast<const SensorDrivers*>(
-      moduleSymbol(UPD_SENSOR_MODULE, "upd_mrpt_sensor_drivers", &here));
-  return *drivers;
+  return moduleEntry<SensorDrivers>(UPD_SENSOR_MODULE, "upd_mrpt_sensor_drivers", &here);
 #else
   return upd_mrpt_sensor_drivers;
 #endif

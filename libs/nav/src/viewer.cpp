@@ -46,9 +46,8 @@ std::atomic<bool> g_viewer_shown{false};
 const detail::ViewerModule& viewerModule() {
 #ifdef UPD_VIEWER_MODULE
   static const char here = 0;
-  static const auto* const module = static_cast<const detail::ViewerModule*>(
-      mrpt_bridge::moduleSymbol(UPD_VIEWER_MODULE, "upd_nav_viewer_module", &here));
-  return *module;
+  return mrpt_bridge::moduleEntry<detail::ViewerModule>(UPD_VIEWER_MODULE,
+                                                        "upd_nav_viewer_module", &here);
 #else
   return upd_nav_viewer_module;
 #endif

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -68,9 +69,9 @@ struct PointCloud {
   void resizeOrganized(std::size_t w, std::size_t h) {
     resizeOrganizedUnfilled(w, h);
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    x.assign(w * h, nan);
-    y.assign(w * h, nan);
-    z.assign(w * h, nan);
+    std::fill(x.begin(), x.end(), nan);
+    std::fill(y.begin(), y.end(), nan);
+    std::fill(z.begin(), z.end(), nan);
   }
   /// The same without the NaN: the points' values are left to a pass that writes every one.
   void resizeOrganizedUnfilled(std::size_t w, std::size_t h) {

@@ -13,4 +13,12 @@ namespace upd::mrpt_bridge {
 /// be loaded or lacks the symbol.
 void* moduleSymbol(const char* file, const char* symbol, const void* beside);
 
+/// A module's entry point, an object of type Entry with C linkage, found by moduleSymbol on
+/// the first call and kept (one module per Entry type).
+template <class Entry>
+const Entry& moduleEntry(const char* file, const char* symbol, const void* beside) {
+  static const Entry* const entry = static_cast<const Entry*>(moduleSymbol(file, symbol, beside));
+  return *entry;
+}
+
 }  // namespace upd::mrpt_bridge
