@@ -7,11 +7,13 @@
 
 namespace upd::test {
 
-/// The what() of the std::exception f throws, or "" when it returns.
-inline std::string errorOf(const std::function<void()>& f) {
+/// The what() of the exception of type E (or derived) that f throws, or "" when it returns.
+/// Another type escapes, and fails the test: name E where the test holds the type too.
+template <class E = std::exception>
+std::string errorOf(const std::function<void()>& f) {
   try {
     f();
-  } catch (const std::exception& e) {
+  } catch (const E& e) {
     return e.what();
   }
   return "";

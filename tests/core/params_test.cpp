@@ -1,6 +1,7 @@
 // Bad parameters are rejected with a message naming the field and the value; degenerate inputs
 // (empty, fewer than 3 points, all NaN) give a well-defined result instead of a crash.
 #include "upd/core/pipeline.h"
+#include "error_of.h"
 
 #include <gtest/gtest.h>
 
@@ -11,12 +12,7 @@ namespace upd::core {
 namespace {
 
 std::string errorOf(const PipelineParams& p) {
-  try {
-    p.validate();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
+  return upd::test::errorOf<std::invalid_argument>([&] { p.validate(); });
 }
 
 TEST(Params, DefaultsAreValid) { EXPECT_EQ(errorOf(PipelineParams{}), ""); }

@@ -5,6 +5,7 @@
 
 #include "upd/io/cloud_io.h"
 #include "upd/io/kitti_bin.h"
+#include "error_of.h"
 
 #include <gtest/gtest.h>
 
@@ -24,12 +25,7 @@ void writeBytes(const std::string& path, const std::string& bytes) {
 }
 
 std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "";
+  return upd::test::errorOf<std::runtime_error>(f);
 }
 
 upd::core::PointCloud sampleCloud() {

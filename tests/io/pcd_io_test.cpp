@@ -3,6 +3,7 @@
 // trips (organized, NaN, colour, viewpoint).
 #include "io_test_util.h"
 #include "upd/io/cloud_io.h"
+#include "error_of.h"
 
 #include "test_data.h"
 
@@ -36,12 +37,7 @@ void writeBytes(const std::string& path, const std::string& bytes) {
 }
 
 std::string errorOf(const std::string& path) {
-  try {
-    upd::io::readCloud(path);
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "";
+  return upd::test::errorOf<std::runtime_error>([&] { upd::io::readCloud(path); });
 }
 
 bool anyColour(const core::PointCloud& c) {

@@ -2,6 +2,7 @@
 // and errors that name the file and line.
 #include "io_test_util.h"
 #include "upd/io/cloud_io.h"
+#include "error_of.h"
 
 #include <gtest/gtest.h>
 
@@ -28,12 +29,7 @@ void writeText(const std::string& path, const std::string& text) {
 }
 
 std::string errorOf(const std::string& path) {
-  try {
-    upd::io::readCloud(path);
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "";
+  return upd::test::errorOf<std::runtime_error>([&] { upd::io::readCloud(path); });
 }
 
 TEST(XyzIo, CommentsCommasBlankLinesAndHeader) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "temp_dir.h"
+#include "error_of.h"
 
 #include <cmath>
 #include <filesystem>
@@ -27,13 +28,8 @@ class IniFile : public ::testing::Test {
   }
   std::string errorOf(const std::string& text) {
     const std::string p = write(text);
-    try {
-      core::PipelineParams params;
-      loadPipelineParams(p, params);
-    } catch (const std::exception& e) {
-      return e.what();
-    }
-    return "";
+    core::PipelineParams params;
+    return test::errorOf([&] { loadPipelineParams(p, params); });
   }
   test::TempDir dir_;  // removed with its files after each test
   std::string path_;

@@ -1,6 +1,7 @@
 // The modules' loader (module.h): a module beside the library that loads it, and one line
 // naming the file when it cannot be loaded.
 #include "upd/mrpt_bridge/module.h"
+#include "error_of.h"
 
 #include <gtest/gtest.h>
 
@@ -23,12 +24,8 @@ std::string bridgeFolder() {
 }
 
 std::string errorOf(const char* file, const char* symbol) {
-  try {
-    upd::mrpt_bridge::moduleSymbol(file, symbol, bridgeAddress());
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "";
+  return upd::test::errorOf<std::runtime_error>(
+      [&] { upd::mrpt_bridge::moduleSymbol(file, symbol, bridgeAddress()); });
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "upd/mrpt_bridge/sensor_source.h"
 
 #include "mrpt_bridge/sensor_stereo_dir.h"
+#include "error_of.h"
 #include "temp_dir.h"
 #include "test_data.h"
 
@@ -31,12 +32,7 @@ std::string writeIni(const upd::test::TempDir& dir, const std::string& text) {
 }
 
 std::string errorOf(const std::string& ini, const std::string& section = "") {
-  try {
-    MrptSensorSource s(ini, section);
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  return "";
+  return upd::test::errorOf<std::runtime_error>([&] { MrptSensorSource s(ini, section); });
 }
 
 // Every observation the sensor delivers until the end of its recording.

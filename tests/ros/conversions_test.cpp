@@ -1,6 +1,7 @@
 // The ROS 1 message conversions: round trips, the occupancy scale, the scored cloud's fields,
 // and malformed messages rejected with one line naming the field.
 #include "upd/ros1/conversions.h"
+#include "error_of.h"
 
 #include <gtest/gtest.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
@@ -34,12 +35,7 @@ core::CameraIntrinsics smallCamera() {
 }
 
 std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const ros1::MessageError& e) {
-    return e.what();
-  }
-  return "";
+  return test::errorOf<ros1::MessageError>(f);
 }
 
 TEST(RosConversions, DepthRoundTripsThroughBothEncodings) {
