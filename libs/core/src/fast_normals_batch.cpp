@@ -83,11 +83,7 @@ UPD_LANES void store(double* p, V v) { _mm512_store_pd(p, v); }
 }  // namespace avx512
 #pragma GCC diagnostic pop
 
-bool haveAvx2() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
-}
-const bool kHaveAvx2 = haveAvx2();
+const bool kHaveAvx2 = cpuHasAvx2();
 const bool kHaveAvx512 = kHaveAvx2 && cpuHasAvx512();
 #else
 constexpr bool kHaveAvx2 = false, kHaveAvx512 = false;

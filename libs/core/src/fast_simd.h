@@ -22,6 +22,15 @@ struct KernelVersion {
 };
 
 #if defined(__GNUC__) && defined(__x86_64__)
+/// Whether the CPU runs the AVX2 kernels: AVX2 and the instructions their targets name beside it
+/// (FMA, POPCNT, BMI's TZCNT), which every x86-64 CPU with AVX2 has; one test for all of them,
+/// so that a CPU (or a hypervisor's mask) without one of the three takes the plain loops.
+inline bool cpuHasAvx2() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+         __builtin_cpu_supports("popcnt") && __builtin_cpu_supports("bmi");
+}
+
 /// Whether the CPU runs the AVX-512 kernels (foundation, vector-length and doubleword
 /// extensions: every AVX-512 CPU has the three).
 inline bool cpuHasAvx512() {
@@ -30,11 +39,12 @@ inline bool cpuHasAvx512() {
          __builtin_cpu_supports("avx512dq");
 }
 
-/// The versions of a kernel the running CPU can run: avx512 where it has AVX-512 and has_avx2,
-/// avx2 where has_avx2 (the CPU has the instructions the AVX2 version's target names), plain.
+/// The versions of a kernel the running CPU can run: avx512 where it has AVX-512 and AVX2, avx2
+/// where it has AVX2 (cpuHasAvx2), plain.
 template <class Fn>
-std::vector<KernelVersion<Fn>> kernelVersions(bool has_avx2, Fn avx512, Fn avx2, Fn plain) {
+std::vector<KernelVersion<Fn>> kernelVersions(Fn avx512, Fn avx2, Fn plain) {
   std::vector<KernelVersion<Fn>> v;
+  const bool has_avx2 = cpuHasAvx2();
   if (has_avx2 && cpuHasAvx512()) v.push_back({avx512, "AVX-512"});
   if (has_avx2) v.push_back({avx2, "AVX2"});
   v.push_back({plain, "plain"});

@@ -69,13 +69,6 @@ __attribute__((target("avx2,fma,popcnt"))) std::size_t gatherWithinAvx2(
   }
   return c;
 }
-
-// (The instructions gatherWithinAvx2's target names.)
-bool hasAvx2Gather() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-         __builtin_cpu_supports("popcnt");
-}
 #endif
 
 const GatherWithinFn pickedGatherWithin = gatherWithinVersions().front().fn;
@@ -288,13 +281,6 @@ __attribute__((target("avx512f,avx2,popcnt,bmi"))) double selectMeanAvx512(float
   return selectMeanAvx2(cand, c, want, kth);
 }
 
-bool hasAvx2Selection() {
-  __builtin_cpu_init();
-  // (The instructions its target names: AVX2, POPCNT and BMI's TZCNT.)
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt") &&
-         __builtin_cpu_supports("bmi");
-}
-
 #endif
 
 const SelectMeanFn pickedSelectMean = selectMeanVersions().front().fn;
@@ -375,8 +361,7 @@ using CellCoordsDenseFn = void (*)(const float*, const float*, const float*, std
                                    float, float, double, std::int32_t*, std::int32_t*,
                                    std::int32_t*);
 CellCoordsDenseFn pickCellCoordsDense() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") ? cellCoordsDenseAvx2 : cellCoordsDenseLoop;
+  return cpuHasAvx2() ? cellCoordsDenseAvx2 : cellCoordsDenseLoop;
 }
 #else
 using CellCoordsDenseFn = void (*)(const float*, const float*, const float*, std::size_t, float,
@@ -401,12 +386,12 @@ double selectMean(float* cand, std::size_t c, std::size_t want, float& kth) {
 
 #if defined(__GNUC__) && defined(__x86_64__)
 std::vector<KernelVersion<GatherWithinFn>> gatherWithinVersions() {
-  return kernelVersions<GatherWithinFn>(hasAvx2Gather(), gatherWithinAvx512, gatherWithinAvx2,
+  return kernelVersions<GatherWithinFn>(gatherWithinAvx512, gatherWithinAvx2,
                                         gatherWithinScalar);
 }
 
 std::vector<KernelVersion<SelectMeanFn>> selectMeanVersions() {
-  return kernelVersions<SelectMeanFn>(hasAvx2Selection(), selectMeanAvx512, selectMeanAvx2,
+  return kernelVersions<SelectMeanFn>(selectMeanAvx512, selectMeanAvx2,
                                       selectMeanScalar);
 }
 #else

@@ -394,21 +394,12 @@ const CropCopyFn pickedCropCopy = cropCopyVersions().front().fn;
 }  // namespace
 
 #if defined(__GNUC__) && defined(__x86_64__)
-namespace {
-// (The instructions the AVX2 versions' targets name.)
-bool hasAvx2Popcnt() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
-}
-}  // namespace
-
 std::vector<KernelVersion<VoxelKeysFn>> voxelKeysVersions() {
-  return kernelVersions<VoxelKeysFn>(hasAvx2Popcnt(), voxelKeysAvx512, voxelKeysAvx2,
-                                     voxelKeysLoop);
+  return kernelVersions<VoxelKeysFn>(voxelKeysAvx512, voxelKeysAvx2, voxelKeysLoop);
 }
 
 std::vector<KernelVersion<CropCopyFn>> cropCopyVersions() {
-  return kernelVersions<CropCopyFn>(hasAvx2Popcnt(), cropCopyAvx512, cropCopyAvx2, cropCopyLoop);
+  return kernelVersions<CropCopyFn>(cropCopyAvx512, cropCopyAvx2, cropCopyLoop);
 }
 #else
 std::vector<KernelVersion<VoxelKeysFn>> voxelKeysVersions() { return {{voxelKeysLoop, "plain"}}; }
