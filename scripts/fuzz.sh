@@ -2,8 +2,8 @@
 # Builds the libFuzzer targets of tests/fuzz with clang 14 under ASan and UBSan into
 # build-fuzz/, and runs each for SECONDS (default 30): the four cloud readers (pcd, ply, xyz,
 # kitti_bin), the robot config (ini), a rawlog object stream (rawlog), a depth PNG (depth_png)
-# and a depth camera's calibration YAML (calibration), a ROS 1 bag (bag: built when the ROS 1
-# packages are there), a classifier model (classifier: built with OpenCV's ml module) and the
+# and a depth camera's calibration YAML (calibration), a ROS 1 bag and a compressed depth image
+# (bag, compressed_depth: built when the ROS 1 packages are there), a classifier model (classifier: built with OpenCV's ml module) and the
 # core pipeline on arbitrary float clouds (pipeline).
 # docs/RELIABILITY.md, "Fuzzing".
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     e.g. scripts/fuzz.sh 600 pcd ply
@@ -23,7 +23,7 @@ UPD_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${UPD_FUZZ_BUILD:-$UPD_ROOT/build-fuzz}"
 SECS="${1:-30}"
 [ $# -gt 0 ] && shift
-ALL=(pcd ply xyz kitti_bin ini rawlog depth_png calibration classifier bag pipeline)
+ALL=(pcd ply xyz kitti_bin ini rawlog depth_png calibration classifier bag compressed_depth pipeline)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -gt 0 ] || TARGETS=("${ALL[@]}")
 SHARED="${UPD_SHARED_DATA_DIR:-$UPD_ROOT/../shared/data}"
@@ -37,10 +37,12 @@ cmake -S "$UPD_ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
       -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14 \
       -DUPD_FUZZ=ON -DUPD_SANITIZE=address,undefined -DUPD_BUILD_TESTS=OFF -DUPD_BUILD_BENCH=OFF \
       "${launcher[@]}" >/dev/null
-# fuzz_bag exists only with the ROS 1 packages (scripts/setup.sh installs them).
+# fuzz_bag and fuzz_compressed_depth exist only with the ROS 1 packages (scripts/setup.sh
+# installs them).
 # fuzz_classifier only with OpenCV's ml module (libopencv-ml-dev).
 built="$(cmake --build "$BUILD" --target help)"
-for optional in "bag:no ROS 1 packages" "classifier:no OpenCV ml module"; do
+for optional in "bag:no ROS 1 packages" "compressed_depth:no ROS 1 packages" \
+                "classifier:no OpenCV ml module"; do
   t="${optional%%:*}"
   if [[ " ${TARGETS[*]} " == *" $t "* ]] && ! grep -q "\bfuzz_$t\b" <<<"$built"; then
     echo "fuzz: $t: not built (${optional#*:}): left out"

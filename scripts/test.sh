@@ -19,7 +19,7 @@ step_done "the suite"
 if [ "${CI:-}" = true ] || [ "${UPD_RELIABILITY:-0}" = 1 ]; then
   # Repeatable: a fixed seed and 2,000 inputs per target (well within the time).
   UPD_FUZZ_SEED="${UPD_FUZZ_SEED:-1}" UPD_FUZZ_RUNS="${UPD_FUZZ_RUNS:-2000}" \
-    "$UPD_ROOT/scripts/fuzz.sh" "${UPD_FUZZ_SECONDS:-90}" pcd ply xyz kitti_bin pipeline ini rawlog depth_png bag
+    "$UPD_ROOT/scripts/fuzz.sh" "${UPD_FUZZ_SECONDS:-90}" pcd ply xyz kitti_bin pipeline ini rawlog depth_png bag compressed_depth
   step_done "fuzzing"
   # Every test program under ASan + UBSan + LeakSanitizer (apps/upd built instrumented), the
   # navigation scenarios shortened (NavScenarioStart.*) and nine long runs left out (a minute

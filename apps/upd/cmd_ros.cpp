@@ -57,7 +57,7 @@ int runRos(const std::vector<std::string>& argv) {
   ros::NodeHandle nh;
   const ros1::RosNodeParams params = ros1::loadRosNodeParams(ros::NodeHandle("~"));
   ros1::TraversabilityNode node(nh, params, config);
-  ROS_INFO("upd: listening on %s + %s and %s", params.depth_topic.c_str(),
+  ROS_INFO("upd: listening on %s + %s and %s", params.depthImageTopic().c_str(),
            params.camera_info_topic.c_str(), params.points_topic.c_str());
   const ros1::NodeEnd end = node.spin(args.flag("--exit-after-goal"));
   std::printf("upd ros: %d frames, %s\n", node.framesProcessed(),

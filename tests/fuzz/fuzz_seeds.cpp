@@ -361,6 +361,28 @@ int main(int argc, char** argv) {
     bag.compression = compression;
     upd::test::writeSmallBag((out / "bag" / name).string(), bag);
   }
+  // Compressed depth images alone (the format's index, then the data), and the same frames as
+  // compressed depth images in bags (image_transport's compressedDepth), each codec.
+  fs::create_directories(out / "compressed_depth");
+  upd::core::DepthImage depth;
+  depth.width = 16;
+  depth.height = 12;
+  for (int i = 0; i < 16 * 12; ++i) depth.depth_m.push_back(i % 11 == 0 ? 0.f : 0.5f + 0.01f * i);
+  const char* const codecs[] = {"png", "rvl"};
+  for (int f = 0; f < 4; ++f) {
+    const auto m =
+        upd::test::compressedDepthOf(depth, f < 2 ? "16UC1" : "32FC1", codecs[f % 2]);
+    std::ofstream seed(out / "compressed_depth" / ("seed" + std::to_string(f)), std::ios::binary);
+    seed.put(static_cast<char>(f));
+    seed.write(reinterpret_cast<const char*>(m.data.data()),
+               static_cast<std::streamsize>(m.data.size()));
+  }
+  bag.compression = rosbag::compression::Uncompressed;
+  for (const char* codec : {"png", "rvl"}) {
+    bag.depth_codec = codec;
+    const std::string name = std::string("compressed-depth-") + codec + ".bag";
+    upd::test::writeSmallBag((out / "bag" / name).string(), bag);
+  }
 #endif
 #ifdef UPD_FUZZ_HAVE_LEARN
   putModels(out / "classifier");

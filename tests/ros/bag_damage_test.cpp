@@ -183,7 +183,8 @@ TEST(BagMessages, LengthsThatRunPastTheDataAreFound) {
       {"sensor_msgs/Image", serialized(ros1::imageFromDepth(depth, "16UC1"))},
       {"sensor_msgs/CameraInfo", serialized(ros1::cameraInfoFromIntrinsics(k))},
       {"sensor_msgs/PointCloud2", serialized(ros1::pointCloud2FromCloud(cloud))},
-      {"tf2_msgs/TFMessage", serialized(tf)}};
+      {"tf2_msgs/TFMessage", serialized(tf)},
+      {"sensor_msgs/CompressedImage", serialized(test::compressedDepthOf(depth, "16UC1", "rvl"))}};
   for (const auto& [type, raw] : messages) {
     EXPECT_TRUE(ros1::detail::lengthsFit(type, raw.data(), raw.size())) << type;
     for (std::size_t cut = 0; cut < raw.size(); ++cut) {

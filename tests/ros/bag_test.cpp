@@ -1,6 +1,7 @@
 // ROS 1 bags: a bag written with the rosbag API from a real depth frame (Image + CameraInfo,
 // the camera on base_link in /tf_static, the robot moving in /tf) reads back frame by frame with
 // its poses, and `upd playback RUN.bag` turns it into a map as it does a rawlog.
+#include "compressed_depth.h"
 #include "real_frame.h"
 #include "small_bag.h"
 #include "temp_dir.h"
@@ -25,8 +26,9 @@ using namespace upd;
 using test::stamped;
 
 // Three copies of the frame at t = 1, 2, 3 s with the robot 0.1 m further along x each time,
-// and one malformed image between them.
-void writeBag(const std::string& path, const test::RealFrame& f) {
+// and one malformed image between them; with a codec ("png", "rvl"), as compressed depth images
+// on the topic image_transport's compressedDepth plugin publishes.
+void writeBag(const std::string& path, const test::RealFrame& f, const std::string& codec = "") {
   rosbag::Bag bag(path, rosbag::bagmode::Write);
   tf2_msgs::TFMessage statics;
   statics.transforms.push_back(stamped(f.pose_base_optical, "base_link", "camera_optical", 1.0));
@@ -43,6 +45,16 @@ void writeBag(const std::string& path, const test::RealFrame& f) {
     bag.write("/tf", ros::Time(t), tf);
     info.header.stamp = image.header.stamp = ros::Time(t);
     bag.write("/camera/depth/camera_info", ros::Time(t), info);
+    if (!codec.empty()) {
+      sensor_msgs::CompressedImage packed = test::compressedDepthOf(f.depth, "16UC1", codec);
+      packed.header = image.header;
+      bag.write("/camera/depth/image_raw/compressedDepth", ros::Time(t), packed);
+      if (i == 2) {
+        packed.format = "rgb8; compressedDepth " + codec;
+        bag.write("/camera/depth/image_raw/compressedDepth", ros::Time(t + 0.5), packed);
+      }
+      continue;
+    }
     bag.write("/camera/depth/image_raw", ros::Time(t), image);
     if (i == 2) {
       sensor_msgs::Image bad = image;
@@ -87,6 +99,44 @@ TEST_F(RosBag, ReadsEveryGoodFrameWithItsPosesAndCountsTheBadOne) {
     ASSERT_TRUE(f.pose_world_base.has_value());
     EXPECT_NEAR(f.pose_world_base->translation().x(), 0.1 * i, 1e-9);
   }
+}
+
+// A bag of compressed depth images (image_transport's compressedDepth: what a robot records to
+// save space) reads back as the same frames as the raw images, PNG or RVL, and plays back into
+// the same map.
+TEST_F(RosBag, CompressedDepthImagesReadAsTheRawOnes) {
+  std::vector<ros1::BagFrame> raw;
+  ros1::readBag(bag_path, {}, [&](const ros1::BagFrame& f) { raw.push_back(f); });
+  ASSERT_EQ(raw.size(), 3u);
+  for (const std::string codec : {"png", "rvl"}) {
+    const std::string packed_path = (dir.path() / ("packed-" + codec + ".bag")).string();
+    writeBag(packed_path, frame, codec);
+    std::vector<ros1::BagFrame> frames;
+    const ros1::BagReadStats stats =
+        ros1::readBag(packed_path, {}, [&](const ros1::BagFrame& f) { frames.push_back(f); });
+    ASSERT_EQ(frames.size(), 3u) << codec;
+    EXPECT_EQ(stats.messages, 4u);
+    ASSERT_EQ(stats.skipped.size(), 1u);
+    EXPECT_NE(stats.skipped.begin()->first.find("format 'rgb8; compressedDepth"),
+              std::string::npos) << stats.skipped.begin()->first;
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_DOUBLE_EQ(frames[i].stamp_s, raw[i].stamp_s);
+      EXPECT_EQ(frames[i].depth.depth_m, raw[i].depth.depth_m) << codec << " frame " << i;
+      ASSERT_TRUE(frames[i].pose_world_base.has_value());
+      EXPECT_TRUE(frames[i].pose_world_base->isApprox(*raw[i].pose_world_base, 1e-12));
+    }
+  }
+  const auto out = [&](const std::string& name) { return (dir.path() / name).string(); };
+  const std::string config = std::string(" --config ") + UPD_SOURCE_DIR + "/config/dune-kinect.ini";
+  const auto a = test::runUpd("playback " + bag_path + config + " --output " + out("a") + " --quiet");
+  const auto b = test::runUpd("playback " + out("packed-rvl.bag") + config + " --output " +
+                              out("b") + " --quiet");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  std::ifstream ja(dir.path() / "a" / "summary.json"), jb(dir.path() / "b" / "summary.json");
+  const nlohmann::json sa = nlohmann::json::parse(ja), sb = nlohmann::json::parse(jb);
+  EXPECT_EQ(sb["frames_processed"], 3);
+  EXPECT_EQ(sa["grid"], sb["grid"]);
 }
 
 TEST_F(RosBag, PlaysBackIntoAMapLikeARawlog) {

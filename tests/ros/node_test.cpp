@@ -3,6 +3,7 @@
 // stop the robot with one log line; in a generated world, a simulated base that integrates
 // /cmd_vel into /odom and tf, and a camera rendered at its pose, the node drives to a goal and
 // stops there, and it stops the robot when the frames stop coming.
+#include "compressed_depth.h"
 #include "real_frame.h"
 #include "ros_master.h"
 #include "test_data.h"
@@ -25,6 +26,8 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <atomic>
+#include <functional>
+#include <memory>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -102,6 +105,8 @@ class RosNode : public ::testing::Test {
                                                     ++out.cmds;
                                                   });
     depth_pub = nh->advertise<sensor_msgs::Image>("/camera/depth/image_raw", 2);
+    packed_pub = nh->advertise<sensor_msgs::CompressedImage>(
+        "/camera/depth/image_raw/compressedDepth", 2);
     info_pub = nh->advertise<sensor_msgs::CameraInfo>("/camera/depth/camera_info", 2);
     odom_pub = nh->advertise<nav_msgs::Odometry>("/odom", 5);
     goal_pub = nh->advertise<geometry_msgs::PoseStamped>("/move_base_simple/goal", 1, true);
@@ -114,6 +119,7 @@ class RosNode : public ::testing::Test {
     cloud_sub.shutdown();
     cmd_sub.shutdown();
     depth_pub.shutdown();
+    packed_pub.shutdown();
     info_pub.shutdown();
     odom_pub.shutdown();
     goal_pub.shutdown();
@@ -146,6 +152,17 @@ class RosNode : public ::testing::Test {
     o.twist.twist.angular.z = w;
     odom_pub.publish(o);
   }
+  // spinUntil's tick: every 0.3 s of wall time, the robot at rest on /odom, then publish(t).
+  std::function<void()> restingTick(std::function<void(const ros::Time&)> publish) {
+    auto next = std::make_shared<ros::WallTime>();
+    return [this, next, publish] {
+      if (ros::WallTime::now() < *next) return;
+      *next = ros::WallTime::now() + ros::WallDuration(0.3);
+      const ros::Time t = ros::Time::now();
+      publishOdom(Eigen::Isometry3d::Identity(), 0, 0, t);
+      publish(t);
+    };
+  }
   void sendStatic(const Eigen::Isometry3d& base_camera) {
     static_tf = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
     static_tf->sendTransform(stamped(base_camera, "base_link", "camera_optical", ros::Time::now()));
@@ -154,7 +171,7 @@ class RosNode : public ::testing::Test {
   static std::unique_ptr<test::RosMasterOnLoopback> master;
   std::unique_ptr<ros::NodeHandle> nh;
   ros::Subscriber grid_sub, cloud_sub, cmd_sub;
-  ros::Publisher depth_pub, info_pub, odom_pub, goal_pub;
+  ros::Publisher depth_pub, packed_pub, info_pub, odom_pub, goal_pub;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf;
   std::unique_ptr<tf2_ros::StaticTransformBroadcaster> static_tf;
   std::unique_ptr<test::Child> node;
@@ -177,14 +194,8 @@ TEST_F(RosNode, RealFramesGiveTheGridAndTheScoredCloudBadOnesOneLineEach) {
   sendStatic(f.pose_base_optical);
   node = startNode(*master, {"_odom_timeout_s:=2.0"});  // odometry here at 3 Hz only
   std::string frame = "camera_optical", encoding = "16UC1";
-  ros::WallTime next;
-  const auto tick = [&] {
-    if (ros::WallTime::now() < next) return;
-    next = ros::WallTime::now() + ros::WallDuration(0.3);
-    const ros::Time t = ros::Time::now();
-    publishOdom(Eigen::Isometry3d::Identity(), 0, 0, t);
-    publishFrame(f.depth, f.K, frame, t, encoding.c_str());
-  };
+  const auto tick = restingTick(
+      [&](const ros::Time& t) { publishFrame(f.depth, f.K, frame, t, encoding.c_str()); });
   ASSERT_TRUE(spinUntil([&] { return out.grid && knownCells(*out.grid) > 100 && out.cloud; }, 40,
                         tick))
       << node->log();
@@ -231,6 +242,36 @@ TEST_F(RosNode, RealFramesGiveTheGridAndTheScoredCloudBadOnesOneLineEach) {
   EXPECT_EQ(countLines(log, "encoding 'rgb8'"), 1u) << log;
   EXPECT_EQ(countLines(log, "no transform odom -> nowhere"), 1u) << log;
   EXPECT_GE(countLines(log, "robot stopped"), 2u) << log;
+}
+
+// With `_image_transport:=compressedDepth` the node reads the depth as image_transport's
+// compressed depth plugin publishes it (an RVL stream here), and maps as from raw images.
+TEST_F(RosNode, CompressedDepthFramesGiveTheGrid) {
+  UPD_REQUIRE_SHARED_FILE(png, "rtabmap/rgbd/depth/17.png");
+  UPD_REQUIRE_SHARED_FILE(yaml, "rtabmap/rgbd/calib/17.yaml");
+  const test::RealFrame f = test::loadRealFrame(png, yaml);
+  sendStatic(f.pose_base_optical);
+  node = startNode(*master, {"_odom_timeout_s:=2.0", "_image_transport:=compressedDepth"});
+  std::string format = "16UC1; compressedDepth rvl";
+  const auto tick = restingTick([&](const ros::Time& t) {
+    sensor_msgs::CameraInfo info = ros1::cameraInfoFromIntrinsics(f.K);
+    sensor_msgs::CompressedImage packed = test::compressedDepthOf(f.depth, "16UC1", "rvl");
+    packed.format = format;
+    info.header.frame_id = packed.header.frame_id = "camera_optical";
+    info.header.stamp = packed.header.stamp = t;
+    info_pub.publish(info);
+    packed_pub.publish(packed);
+  });
+  ASSERT_TRUE(spinUntil([&] { return out.grid && knownCells(*out.grid) > 100; }, 40, tick))
+      << node->log();
+  format = "16UC1; compressedDepth jpeg";
+  EXPECT_TRUE(spinUntil([&] { return countLines(node->log(), "compressedDepth jpeg") > 0; }, 30,
+                        tick))
+      << node->log();
+  node->stop();
+  EXPECT_NE(node->log().find("/camera/depth/image_raw/compressedDepth: compressed depth image"),
+            std::string::npos)
+      << node->log();
 }
 
 // A simulated differential-drive base in a generated world: integrates the last /cmd_vel

@@ -3,6 +3,7 @@
 // half a second after each), the camera on base_link in /tf_static, base_link in map on /tf.
 #pragma once
 
+#include "compressed_depth.h"
 #include "upd/ros1/conversions.h"
 
 #include <rosbag/bag.h>
@@ -29,6 +30,9 @@ struct SmallBag {
   std::uint32_t chunk_bytes = 4000;
   bool with_points = false;  ///< a PointCloud2 on /points after each frame
   rosbag::compression::CompressionType compression = rosbag::compression::Uncompressed;
+  /// "png" or "rvl": the depth frames as compressed depth images on the topic image_transport's
+  /// compressedDepth plugin publishes; "": raw images.
+  std::string depth_codec;
 };
 
 inline void writeSmallBag(const std::string& path, const SmallBag& b) {
@@ -61,7 +65,13 @@ inline void writeSmallBag(const std::string& path, const SmallBag& b) {
     bag.write("/tf", ros::Time(i), tf);
     info.header.stamp = image.header.stamp = points.header.stamp = ros::Time(i);
     bag.write("/camera/depth/camera_info", ros::Time(i), info);
-    bag.write("/camera/depth/image_raw", ros::Time(i), image);
+    if (b.depth_codec.empty()) {
+      bag.write("/camera/depth/image_raw", ros::Time(i), image);
+    } else {
+      sensor_msgs::CompressedImage packed = compressedDepthOf(depth, "16UC1", b.depth_codec);
+      packed.header = image.header;
+      bag.write("/camera/depth/image_raw/compressedDepth", ros::Time(i), packed);
+    }
     if (b.with_points) bag.write("/points", ros::Time(i + 0.5), points);
   }
 }

@@ -2,7 +2,7 @@
 
 #include "upd/io/atomic_file.h"
 #include "upd/io/whole_file.h"
-#include "png_gray16.h"
+#include "upd/io/png_gray16.h"
 #include "yaml_text.h"
 
 #include <opencv2/core.hpp>
@@ -142,9 +142,9 @@ core::DepthImage readDepthPng(const std::string& png_path, double metres_per_uni
   // lets libpng print them on stderr; and the header's size is checked before any allocation,
   // where OpenCV allocates up to 2^30 pixels.)
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  const detail::Gray16 img =
-      detail::decodeGray16(data, bytes.size(), kMaxDepthSide, kMaxDepthPixels);
-  using Png = detail::Gray16::Status;
+  const io::Gray16 img =
+      io::decodeGray16(data, bytes.size(), kMaxDepthSide, kMaxDepthPixels);
+  using Png = io::Gray16::Status;
   switch (img.status) {
     case Png::NotPng: throw bad("not a PNG image");
     case Png::TooLarge:

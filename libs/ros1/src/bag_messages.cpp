@@ -54,6 +54,10 @@ bool lengthsFit(const std::string& datatype, const std::uint8_t* data, std::size
     w.string();  // encoding
     w.skip(5);  // is_bigendian, step
     w.array(1);  // data
+  } else if (datatype == "sensor_msgs/CompressedImage") {
+    w.header();
+    w.string();  // format
+    w.array(1);  // data
   } else if (datatype == "sensor_msgs/CameraInfo") {
     w.header();
     w.skip(8);  // height, width

@@ -11,7 +11,8 @@ namespace upd::ros1::detail {
 
 /// Whether every string and array length in the serialized message stays inside its size bytes,
 /// walked by the layout of the types the bag reader instantiates: sensor_msgs/Image,
-/// sensor_msgs/CameraInfo, sensor_msgs/PointCloud2 and tf2_msgs/TFMessage. Other types: true.
+/// sensor_msgs/CompressedImage, sensor_msgs/CameraInfo, sensor_msgs/PointCloud2 and
+/// tf2_msgs/TFMessage. Other types: true.
 bool lengthsFit(const std::string& datatype, const std::uint8_t* data, std::size_t size);
 
 }  // namespace upd::ros1::detail

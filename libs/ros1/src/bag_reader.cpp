@@ -8,6 +8,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2/buffer_core.h>
@@ -98,6 +99,52 @@ bool framePoses(const tf2::BufferCore& tf, const BagTopics& topics, const ros::T
   return true;
 }
 
+// The depth images' topic: the one named, or the compressedDepth topic image_transport publishes
+// beside it (`<topic>/compressedDepth`) where the bag has no message on the one named.
+std::string depthTopicOf(const rosbag::Bag& bag, const std::string& depth_topic) {
+  const std::string compressed = depth_topic + "/compressedDepth";
+  if (rosbag::View(bag, rosbag::TopicQuery(depth_topic)).size() > 0) return depth_topic;
+  return rosbag::View(bag, rosbag::TopicQuery(compressed)).size() > 0 ? compressed : depth_topic;
+}
+
+// The frame of message m (a depth image, raw or compressed, with the CameraInfo info; or a
+// PointCloud2) into frame and header, without its poses: false (and the reason counted) where
+// the message is of another type, does not deserialize, or does not convert.
+bool frameOf(const rosbag::MessageInstance& m, const sensor_msgs::CameraInfo* info,
+             BagFrame& frame, std_msgs::Header& header, BagReadStats& stats) {
+  const auto image = instantiate<sensor_msgs::Image>(m, stats);
+  const auto packed = image ? nullptr : instantiate<sensor_msgs::CompressedImage>(m, stats);
+  const auto points =
+      image || packed ? nullptr : instantiate<sensor_msgs::PointCloud2>(m, stats);
+  if (!image && !packed && !points) {
+    const bool known = m.isType<sensor_msgs::Image>() ||
+                       m.isType<sensor_msgs::CompressedImage>() ||
+                       m.isType<sensor_msgs::PointCloud2>();
+    // (A known type that did not deserialize is counted already.)
+    if (!known) ++stats.skipped["unexpected type " + m.getDataType() + " on " + m.getTopic()];
+    return false;
+  }
+  header = image ? image->header : packed ? packed->header : points->header;
+  frame.stamp_s = header.stamp.toSec();
+  frame.sensor_frame = header.frame_id;
+  frame.from_depth = !points;
+  try {
+    if (points) {
+      frame.cloud = cloudFromPointCloud2(*points);
+      return true;
+    }
+    if (!info) throw MessageError("depth image before any CameraInfo");
+    frame.K = intrinsicsFromCameraInfo(*info);
+    frame.depth = image ? depthFromImage(*image) : depthFromCompressedDepth(*packed);
+    if (frame.depth.width != frame.K.width || frame.depth.height != frame.K.height)
+      throw MessageError("depth image and CameraInfo sizes differ");
+  } catch (const MessageError& e) {
+    ++stats.skipped[e.what()];
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool isBagPath(const std::string& path) {
@@ -133,7 +180,8 @@ BagReadStats readBag(const std::string& path, const BagTopics& topics,
       if ((info = instantiate<sensor_msgs::CameraInfo>(m, counted_below))) break;
     }
     rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{
-                               topics.depth_topic, topics.camera_info_topic, topics.points_topic}));
+                               depthTopicOf(bag, topics.depth_topic), topics.camera_info_topic,
+                               topics.points_topic}));
     BagFrame frame;
     for (const rosbag::MessageInstance& m : view) {
       if (m.isType<sensor_msgs::CameraInfo>()) {
@@ -141,32 +189,8 @@ BagReadStats readBag(const std::string& path, const BagTopics& topics,
         continue;
       }
       ++stats.messages;
-      const bool is_image = m.isType<sensor_msgs::Image>();
-      if (!is_image && !m.isType<sensor_msgs::PointCloud2>()) {
-        ++stats.skipped["unexpected type " + m.getDataType() + " on " + m.getTopic()];
-        continue;
-      }
-      const auto image = is_image ? instantiate<sensor_msgs::Image>(m, stats) : nullptr;
-      const auto points = is_image ? nullptr : instantiate<sensor_msgs::PointCloud2>(m, stats);
-      if (!image && !points) continue;  // counted: its data does not deserialize
-      const std_msgs::Header& header = image ? image->header : points->header;
-      frame.stamp_s = header.stamp.toSec();
-      frame.sensor_frame = header.frame_id;
-      frame.from_depth = image != nullptr;
-      try {
-        if (image) {
-          if (!info) throw MessageError("depth image before any CameraInfo");
-          frame.K = intrinsicsFromCameraInfo(*info);
-          frame.depth = depthFromImage(*image);
-          if (frame.depth.width != frame.K.width || frame.depth.height != frame.K.height)
-            throw MessageError("depth image and CameraInfo sizes differ");
-        } else {
-          frame.cloud = cloudFromPointCloud2(*points);
-        }
-      } catch (const MessageError& e) {
-        ++stats.skipped[e.what()];
-        continue;
-      }
+      std_msgs::Header header;
+      if (!frameOf(m, info.get(), frame, header, stats)) continue;
       if (!framePoses(tf, topics, header.stamp, frame, stats)) continue;
       on_frame(frame);
       ++stats.frames;

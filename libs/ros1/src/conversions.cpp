@@ -136,10 +136,14 @@ sensor_msgs::Image imageFromDepth(const core::DepthImage& depth, const std::stri
 
 core::PointCloud cloudFromDepthImage(const sensor_msgs::Image& image,
                                      const sensor_msgs::CameraInfo& info) {
+  return cloudFromDepthImage(depthFromImage(image), info);
+}
+
+core::PointCloud cloudFromDepthImage(const core::DepthImage& depth,
+                                     const sensor_msgs::CameraInfo& info) {
   const core::CameraIntrinsics K = intrinsicsFromCameraInfo(info);
-  const core::DepthImage depth = depthFromImage(image);
   if (depth.width != K.width || depth.height != K.height) {
-    throw MessageError("depth Image " + sizeText(image.width, image.height) +
+    throw MessageError("depth image " + sizeText(depth.width, depth.height) +
                        " but CameraInfo " + sizeText(info.width, info.height));
   }
   return core::depthToCloud(depth, K);

@@ -7,6 +7,7 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2/exceptions.h>
@@ -19,6 +20,9 @@ namespace upd::ros1 {
 
 void RosNodeParams::validate() const {
   base.validate();
+  core::requireParam(image_transport == "raw" || image_transport == "compressedDepth",
+                     "RosNodeParams", "image_transport", image_transport,
+                     "must be raw or compressedDepth");
   core::requireParam(sensor_timeout_s > 0, "RosNodeParams", "sensor_timeout_s", sensor_timeout_s,
                      "must be > 0");
   core::requireParam(tf_timeout_s >= 0, "RosNodeParams", "tf_timeout_s", tf_timeout_s,
@@ -46,7 +50,9 @@ struct TraversabilityNode::Impl {
     grid_pub = nh.advertise<nav_msgs::OccupancyGrid>(p.grid_topic, 1, /*latch=*/true);
     cloud_pub = nh.advertise<sensor_msgs::PointCloud2>(p.cloud_topic, 1);
     route_pub = nh.advertise<visualization_msgs::MarkerArray>(p.route_topic, 1, true);
-    depth_sub = nh.subscribe(p.depth_topic, 2, &Impl::onDepth, this);
+    depth_sub = p.image_transport == "raw"
+                    ? nh.subscribe(p.depthImageTopic(), 2, &Impl::onDepth, this)
+                    : nh.subscribe(p.depthImageTopic(), 2, &Impl::onPacked, this);
     info_sub = nh.subscribe(p.camera_info_topic, 2, &Impl::onInfo, this);
     points_sub = nh.subscribe(p.points_topic, 2, &Impl::onPoints, this);
     goal_sub = nh.subscribe(p.goal_topic, 1, &Impl::onGoal, this);
@@ -62,6 +68,7 @@ struct TraversabilityNode::Impl {
 
   sensor_msgs::CameraInfo::ConstPtr info;
   sensor_msgs::Image::ConstPtr pending_depth;
+  sensor_msgs::CompressedImage::ConstPtr pending_packed;  ///< (image_transport compressedDepth)
   sensor_msgs::PointCloud2::ConstPtr pending_points;
   std::string world_frame;  ///< resolved at the first frame
   std::optional<ros::Time> last_frame;
@@ -72,6 +79,7 @@ struct TraversabilityNode::Impl {
   std::string last_problem;  ///< the last problem logged, so that a repeated one is logged once
 
   void onDepth(const sensor_msgs::Image::ConstPtr& m) { pending_depth = m; }
+  void onPacked(const sensor_msgs::CompressedImage::ConstPtr& m) { pending_packed = m; }
   void onInfo(const sensor_msgs::CameraInfo::ConstPtr& m) { info = m; }
   void onPoints(const sensor_msgs::PointCloud2::ConstPtr& m) { pending_points = m; }
   void onGoal(const geometry_msgs::PoseStamped::ConstPtr& m);
@@ -138,18 +146,23 @@ bool TraversabilityNode::Impl::basePoseKnown() {
 }
 
 void TraversabilityNode::Impl::processPending() {
-  if (pending_depth) {
+  if (pending_depth || pending_packed) {
     const auto image = pending_depth;
+    const auto packed = pending_packed;
     pending_depth.reset();
+    pending_packed.reset();
+    const std::string topic = params.depthImageTopic();
     if (!info) {
-      problem("depth image on " + params.depth_topic + " but no CameraInfo on " +
-              params.camera_info_topic + " yet");
+      problem("depth image on " + topic + " but no CameraInfo on " + params.camera_info_topic +
+              " yet");
       return;
     }
     try {
-      processCloud(cloudFromDepthImage(*image, *info), image->header);
+      const core::DepthImage depth =
+          image ? depthFromImage(*image) : depthFromCompressedDepth(*packed);
+      processCloud(cloudFromDepthImage(depth, *info), image ? image->header : packed->header);
     } catch (const MessageError& e) {
-      problem(params.depth_topic + ": " + e.what());
+      problem(topic + ": " + e.what());
     }
   }
   if (pending_points) {

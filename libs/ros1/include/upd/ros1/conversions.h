@@ -1,8 +1,9 @@
 // ROS 1 messages <-> the project's types. Pure functions: no node, no master, no clock.
 //
 // In: sensor_msgs/Image (depth, 16UC1 in millimetres or 32FC1 in metres, camera-optical frame
-// as REP 103 states for *_optical_frame) with its sensor_msgs/CameraInfo becomes a depth image
-// and intrinsics, then an organized core::PointCloud; sensor_msgs/PointCloud2 with float32
+// as REP 103 states for *_optical_frame), or its sensor_msgs/CompressedImage by image_transport's
+// compressedDepth plugin, with its sensor_msgs/CameraInfo becomes a depth image and intrinsics,
+// then an organized core::PointCloud; sensor_msgs/PointCloud2 with float32
 // x, y, z becomes a core::PointCloud (organized when height > 1). geometry_msgs transforms
 // become Eigen isometries.
 // Out: the traversability grid as nav_msgs/OccupancyGrid (0 traversable ... 100
@@ -23,6 +24,7 @@
 #include <geometry_msgs/Transform.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -49,12 +51,25 @@ sensor_msgs::CameraInfo cameraInfoFromIntrinsics(const core::CameraIntrinsics& K
 /// Throws MessageError for another encoding, a step or data size that does not match
 /// width x height, or a big-endian image.
 core::DepthImage depthFromImage(const sensor_msgs::Image& image);
+/// The depth image [m] of a compressed depth image, as image_transport's compressedDepth plugin
+/// writes it: format "<encoding>; compressedDepth png" or "...; compressedDepth rvl" (the older
+/// "<encoding>; compressedDepth" is PNG), data a 12-byte header (the format code, then the two
+/// float parameters of a 32FC1 image's inverse-depth quantization) and the PNG or RVL stream of
+/// 16-bit codes. 16UC1: the codes are millimetres; 32FC1: depth = p0 / (code - p1), code 0 no
+/// return. Invalid pixels are 0. Throws MessageError for another format or encoding, a header or
+/// stream that is short or damaged, or a size beyond kMaxCompressedDepthPixels.
+core::DepthImage depthFromCompressedDepth(const sensor_msgs::CompressedImage& image);
+/// The most pixels depthFromCompressedDepth decodes (a side at most 2^15).
+constexpr std::uint64_t kMaxCompressedDepthPixels = std::uint64_t{1} << 25;
 /// The image of a depth image: "16UC1" (rounded to millimetres, 0 = invalid) or "32FC1".
 sensor_msgs::Image imageFromDepth(const core::DepthImage& depth, const std::string& encoding);
 
 /// The organized cloud of a depth image in its camera-optical frame (sensor origin 0). Throws
 /// MessageError when the image and the camera info disagree on the size.
 core::PointCloud cloudFromDepthImage(const sensor_msgs::Image& image,
+                                     const sensor_msgs::CameraInfo& info);
+/// The same for a depth image already decoded (depthFromImage, depthFromCompressedDepth).
+core::PointCloud cloudFromDepthImage(const core::DepthImage& depth,
                                      const sensor_msgs::CameraInfo& info);
 
 /// The points of a PointCloud2 with float32 fields x, y, z (other fields ignored; organized

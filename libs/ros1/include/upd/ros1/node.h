@@ -27,6 +27,10 @@ namespace upd::ros1 {
 /// (`~depth_topic`, ...) with these defaults.
 struct RosNodeParams {
   std::string depth_topic = "/camera/depth/image_raw";
+  /// "raw": sensor_msgs/Image on depth_topic; "compressedDepth": sensor_msgs/CompressedImage on
+  /// depth_topic/compressedDepth (image_transport's compressed depth plugin), as image_transport
+  /// subscribers choose by their `~image_transport` parameter.
+  std::string image_transport = "raw";
   std::string camera_info_topic = "/camera/depth/camera_info";
   std::string points_topic = "/points";
   std::string goal_topic = "/move_base_simple/goal";
@@ -42,9 +46,15 @@ struct RosNodeParams {
 
   /// Throws std::invalid_argument naming the field and value.
   void validate() const;
+  /// The topic the depth arrives on: depth_topic, or depth_topic/compressedDepth.
+  std::string depthImageTopic() const {
+    return image_transport == "raw" ? depth_topic : depth_topic + "/compressedDepth";
+  }
   template <class V>
   void visit(V& v) {
     v("depth_topic", depth_topic, "depth image in (sensor_msgs/Image, 16UC1 mm or 32FC1 m)");
+    v("image_transport", image_transport,
+      "raw, or compressedDepth: its CompressedImage on depth_topic/compressedDepth");
     v("camera_info_topic", camera_info_topic, "its camera info in");
     v("points_topic", points_topic, "point cloud in (sensor_msgs/PointCloud2)");
     v("goal_topic", goal_topic, "goals in (geometry_msgs/PoseStamped)");

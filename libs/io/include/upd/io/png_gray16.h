@@ -1,5 +1,7 @@
-// Private to libs/mrpt_bridge: a 16-bit single-channel PNG decoded by libpng from memory, its
-// errors returned as text (libpng's own handler would print them on stderr).
+// A 16-bit single-channel PNG decoded by libpng from memory, its errors returned as text
+// (libpng's own handler would print them on stderr; OpenCV's decoder lets it), the header's size
+// checked before anything is allocated: the depth PNG files (mrpt_bridge's readDepthPng) and the
+// compressed depth images of ROS (ros1's depthFromCompressedDepth).
 #pragma once
 
 #include <cstddef>
@@ -7,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace upd::mrpt_bridge::detail {
+namespace upd::io {
 
 /// What decodeGray16 found.
 struct Gray16 {
@@ -30,4 +32,4 @@ struct Gray16 {
 Gray16 decodeGray16(const unsigned char* bytes, std::size_t n, std::uint32_t max_side,
                     std::uint64_t max_pixels);
 
-}  // namespace upd::mrpt_bridge::detail
+}  // namespace upd::io

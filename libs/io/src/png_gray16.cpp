@@ -1,10 +1,10 @@
-#include "png_gray16.h"
+#include "upd/io/png_gray16.h"
 
 #include <png.h>
 
 #include <cstring>
 
-namespace upd::mrpt_bridge::detail {
+namespace upd::io {
 
 namespace {
 
@@ -116,4 +116,4 @@ Gray16 decodeGray16(const unsigned char* bytes, std::size_t n, std::uint32_t max
   return out;
 }
 
-}  // namespace upd::mrpt_bridge::detail
+}  // namespace upd::io
