@@ -143,7 +143,9 @@ TEST(CompressedDepth, DamagedOrForeignMessagesGiveOneLine) {
   cv::imencode(".png", cv::Mat(4, 4, CV_8UC1, cv::Scalar(7)), png8);
   eight.data.resize(12);
   eight.data.insert(eight.data.end(), png8.begin(), png8.end());
-  EXPECT_NE(errorOf(eight).find("8-bit PNG of 1 channel(s)"), std::string::npos) << errorOf(eight);
+  EXPECT_NE(errorOf(eight).find("8-bit, 1 channel(s); a depth image is 16-bit single channel"),
+            std::string::npos)
+      << errorOf(eight);
 }
 
 }  // namespace

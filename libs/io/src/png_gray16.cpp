@@ -116,4 +116,20 @@ Gray16 decodeGray16(const unsigned char* bytes, std::size_t n, std::uint32_t max
   return out;
 }
 
+std::string whyNotGray16(const Gray16& g, std::uint32_t max_side, std::uint64_t max_pixels) {
+  switch (g.status) {
+    case Gray16::Status::NotPng: return "not a PNG image";
+    case Gray16::Status::TooLarge:
+      return std::to_string(g.width) + " x " + std::to_string(g.height) +
+             " pixels by its header: a depth image has 1 to " + std::to_string(max_side) +
+             " a side and at most " + std::to_string(max_pixels) + " in all";
+    case Gray16::Status::Damaged: return "damaged PNG (" + g.error + ")";
+    case Gray16::Status::NotGray16:
+      return std::to_string(g.bit_depth) + "-bit, " + std::to_string(g.channels) +
+             " channel(s); a depth image is 16-bit single channel";
+    case Gray16::Status::Gray16: break;
+  }
+  return "";
+}
+
 }  // namespace upd::io

@@ -144,19 +144,8 @@ core::DepthImage readDepthPng(const std::string& png_path, double metres_per_uni
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   const io::Gray16 img =
       io::decodeGray16(data, bytes.size(), kMaxDepthSide, kMaxDepthPixels);
-  using Png = io::Gray16::Status;
-  switch (img.status) {
-    case Png::NotPng: throw bad("not a PNG image");
-    case Png::TooLarge:
-      throw bad(std::to_string(img.width) + " x " + std::to_string(img.height) +
-                " pixels by its header: a depth image has 1 to " + std::to_string(kMaxDepthSide) +
-                " a side and at most " + std::to_string(kMaxDepthPixels) + " in all");
-    case Png::Damaged: throw bad("damaged PNG (" + img.error + ")");
-    case Png::NotGray16:
-      throw bad(std::to_string(img.bit_depth) + "-bit, " + std::to_string(img.channels) +
-                " channel(s); a depth image is 16-bit single channel");
-    case Png::Gray16: break;
-  }
+  const std::string why = io::whyNotGray16(img, kMaxDepthSide, kMaxDepthPixels);
+  if (!why.empty()) throw bad(why);
   core::DepthImage d;
   d.width = static_cast<int>(img.width);
   d.height = static_cast<int>(img.height);

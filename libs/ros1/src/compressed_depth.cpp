@@ -105,19 +105,8 @@ void decodeRvl(const sensor_msgs::CompressedImage& m, const std::uint8_t* data, 
 void decodePng(const sensor_msgs::CompressedImage& m, const std::uint8_t* data, std::size_t size,
                std::uint32_t& width, std::uint32_t& height, std::vector<std::uint16_t>& codes) {
   io::Gray16 png = io::decodeGray16(data, size, kMaxSide, kMaxCompressedDepthPixels);
-  using Png = io::Gray16::Status;
-  switch (png.status) {
-    case Png::NotPng: fail(m, "its data after the 12-byte header is not a PNG image");
-    case Png::TooLarge:
-      fail(m, "PNG of " + std::to_string(png.width) + " x " + std::to_string(png.height) +
-                  " pixels by its header: a depth image has 1 to " + std::to_string(kMaxSide) +
-                  " pixels a side");
-    case Png::Damaged: fail(m, "damaged PNG (" + png.error + ")");
-    case Png::NotGray16:
-      fail(m, "a " + std::to_string(png.bit_depth) + "-bit PNG of " +
-                  std::to_string(png.channels) + " channel(s); the codes are 16-bit single channel");
-    case Png::Gray16: break;
-  }
+  const std::string why = io::whyNotGray16(png, kMaxSide, kMaxCompressedDepthPixels);
+  if (!why.empty()) fail(m, "the data after its 12-byte header: " + why);
   width = png.width;
   height = png.height;
   codes = std::move(png.pixels);

@@ -32,4 +32,8 @@ struct Gray16 {
 Gray16 decodeGray16(const unsigned char* bytes, std::size_t n, std::uint32_t max_side,
                     std::uint64_t max_pixels);
 
+/// Why g (decodeGray16's answer with those limits) is no depth image, as the end of a one-line
+/// error ("not a PNG image", "damaged PNG (...)", ...); "" where it decoded.
+std::string whyNotGray16(const Gray16& g, std::uint32_t max_side, std::uint64_t max_pixels);
+
 }  // namespace upd::io

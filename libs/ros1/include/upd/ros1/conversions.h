@@ -29,6 +29,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
