@@ -4,9 +4,9 @@
 // 32FC1, PNG or RVL), the rest is the message's data. Any input must give a depth image or a
 // MessageError, never a crash, a hang, a sanitizer report or an allocation beyond the fuzzer's
 // limit.
+#include "fuzz_depth_check.h"
 #include "upd/ros1/conversions.h"
 
-#include <cmath>
 #include <cstdint>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -18,12 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   m.format = kFormats[data[0] % 4];
   m.data.assign(data + 1, data + size);
   try {
-    const upd::core::DepthImage d = upd::ros1::depthFromCompressedDepth(m);
-    if (d.width <= 0 || d.height <= 0) __builtin_trap();
-    if (d.depth_m.size() != static_cast<std::size_t>(d.width) * d.height) __builtin_trap();
-    for (const float z : d.depth_m) {
-      if (!(z >= 0.f) || !std::isfinite(z)) __builtin_trap();
-    }
+    upd::fuzz::requireSoundDepth(upd::ros1::depthFromCompressedDepth(m));
   } catch (const upd::ros1::MessageError&) {
     // a refused message: what the decoder must do with a bad one
   }

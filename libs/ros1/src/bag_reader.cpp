@@ -102,7 +102,7 @@ bool framePoses(const tf2::BufferCore& tf, const BagTopics& topics, const ros::T
 // The depth images' topic: the one named, or the compressedDepth topic image_transport publishes
 // beside it (`<topic>/compressedDepth`) where the bag has no message on the one named.
 std::string depthTopicOf(const rosbag::Bag& bag, const std::string& depth_topic) {
-  const std::string compressed = depth_topic + "/compressedDepth";
+  const std::string compressed = compressedDepthTopic(depth_topic);
   if (rosbag::View(bag, rosbag::TopicQuery(depth_topic)).size() > 0) return depth_topic;
   return rosbag::View(bag, rosbag::TopicQuery(compressed)).size() > 0 ? compressed : depth_topic;
 }
@@ -112,18 +112,20 @@ std::string depthTopicOf(const rosbag::Bag& bag, const std::string& depth_topic)
 // the message is of another type, does not deserialize, or does not convert.
 bool frameOf(const rosbag::MessageInstance& m, const sensor_msgs::CameraInfo* info,
              BagFrame& frame, std_msgs::Header& header, BagReadStats& stats) {
-  const auto image = instantiate<sensor_msgs::Image>(m, stats);
-  const auto packed = image ? nullptr : instantiate<sensor_msgs::CompressedImage>(m, stats);
-  const auto points =
-      image || packed ? nullptr : instantiate<sensor_msgs::PointCloud2>(m, stats);
-  if (!image && !packed && !points) {
-    const bool known = m.isType<sensor_msgs::Image>() ||
-                       m.isType<sensor_msgs::CompressedImage>() ||
-                       m.isType<sensor_msgs::PointCloud2>();
-    // (A known type that did not deserialize is counted already.)
-    if (!known) ++stats.skipped["unexpected type " + m.getDataType() + " on " + m.getTopic()];
+  sensor_msgs::Image::ConstPtr image;
+  sensor_msgs::CompressedImage::ConstPtr packed;
+  sensor_msgs::PointCloud2::ConstPtr points;
+  if (m.isType<sensor_msgs::Image>()) {
+    image = instantiate<sensor_msgs::Image>(m, stats);
+  } else if (m.isType<sensor_msgs::CompressedImage>()) {
+    packed = instantiate<sensor_msgs::CompressedImage>(m, stats);
+  } else if (m.isType<sensor_msgs::PointCloud2>()) {
+    points = instantiate<sensor_msgs::PointCloud2>(m, stats);
+  } else {
+    ++stats.skipped["unexpected type " + m.getDataType() + " on " + m.getTopic()];
     return false;
   }
+  if (!image && !packed && !points) return false;  // counted: its data does not deserialize
   header = image ? image->header : packed ? packed->header : points->header;
   frame.stamp_s = header.stamp.toSec();
   frame.sensor_frame = header.frame_id;
@@ -134,10 +136,8 @@ bool frameOf(const rosbag::MessageInstance& m, const sensor_msgs::CameraInfo* in
       return true;
     }
     if (!info) throw MessageError("depth image before any CameraInfo");
-    frame.K = intrinsicsFromCameraInfo(*info);
     frame.depth = image ? depthFromImage(*image) : depthFromCompressedDepth(*packed);
-    if (frame.depth.width != frame.K.width || frame.depth.height != frame.K.height)
-      throw MessageError("depth image and CameraInfo sizes differ");
+    frame.K = intrinsicsForDepth(frame.depth, *info);
   } catch (const MessageError& e) {
     ++stats.skipped[e.what()];
     return false;

@@ -141,12 +141,17 @@ core::PointCloud cloudFromDepthImage(const sensor_msgs::Image& image,
 
 core::PointCloud cloudFromDepthImage(const core::DepthImage& depth,
                                      const sensor_msgs::CameraInfo& info) {
+  return core::depthToCloud(depth, intrinsicsForDepth(depth, info));
+}
+
+core::CameraIntrinsics intrinsicsForDepth(const core::DepthImage& depth,
+                                          const sensor_msgs::CameraInfo& info) {
   const core::CameraIntrinsics K = intrinsicsFromCameraInfo(info);
   if (depth.width != K.width || depth.height != K.height) {
     throw MessageError("depth image " + sizeText(depth.width, depth.height) +
                        " but CameraInfo " + sizeText(info.width, info.height));
   }
-  return core::depthToCloud(depth, K);
+  return K;
 }
 
 core::PointCloud cloudFromPointCloud2(const sensor_msgs::PointCloud2& msg) {

@@ -33,6 +33,10 @@ void RosNodeParams::validate() const {
                      "must be >= 0");
 }
 
+std::string RosNodeParams::depthImageTopic() const {
+  return image_transport == "raw" ? depth_topic : compressedDepthTopic(depth_topic);
+}
+
 RosNodeParams loadRosNodeParams(const ros::NodeHandle& pnh, RosNodeParams p) {
   // Every field is the private parameter of its name; nh.param keeps the default when unset.
   const auto read = [&pnh](const char* name, auto& value, const char*) {

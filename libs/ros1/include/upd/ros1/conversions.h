@@ -62,6 +62,10 @@ core::DepthImage depthFromImage(const sensor_msgs::Image& image);
 core::DepthImage depthFromCompressedDepth(const sensor_msgs::CompressedImage& image);
 /// The most pixels depthFromCompressedDepth decodes (a side at most 2^15).
 constexpr std::uint64_t kMaxCompressedDepthPixels = std::uint64_t{1} << 25;
+/// The topic image_transport's compressedDepth plugin publishes beside a raw depth topic.
+inline std::string compressedDepthTopic(const std::string& depth_topic) {
+  return depth_topic + "/compressedDepth";
+}
 /// The image of a depth image: "16UC1" (rounded to millimetres, 0 = invalid) or "32FC1".
 sensor_msgs::Image imageFromDepth(const core::DepthImage& depth, const std::string& encoding);
 
@@ -72,6 +76,10 @@ core::PointCloud cloudFromDepthImage(const sensor_msgs::Image& image,
 /// The same for a depth image already decoded (depthFromImage, depthFromCompressedDepth).
 core::PointCloud cloudFromDepthImage(const core::DepthImage& depth,
                                      const sensor_msgs::CameraInfo& info);
+/// The intrinsics of info for the depth image depth: intrinsicsFromCameraInfo, and MessageError
+/// when the two disagree on the size.
+core::CameraIntrinsics intrinsicsForDepth(const core::DepthImage& depth,
+                                          const sensor_msgs::CameraInfo& info);
 
 /// The points of a PointCloud2 with float32 fields x, y, z (other fields ignored; organized
 /// when height > 1, NaN points kept). Throws MessageError for a missing or non-float32 x, y or

@@ -47,9 +47,7 @@ struct RosNodeParams {
   /// Throws std::invalid_argument naming the field and value.
   void validate() const;
   /// The topic the depth arrives on: depth_topic, or depth_topic/compressedDepth.
-  std::string depthImageTopic() const {
-    return image_transport == "raw" ? depth_topic : depth_topic + "/compressedDepth";
-  }
+  std::string depthImageTopic() const;
   template <class V>
   void visit(V& v) {
     v("depth_topic", depth_topic, "depth image in (sensor_msgs/Image, 16UC1 mm or 32FC1 m)");
