@@ -35,17 +35,28 @@ struct SmallBag {
   std::string depth_codec;
 };
 
+/// A camera of w x h px with a 79 degree field of view, centred.
+inline core::CameraIntrinsics camera(int w, int h) {
+  core::CameraIntrinsics k;
+  k.width = w;
+  k.height = h;
+  k.fx = k.fy = 0.78125 * w;
+  k.cx = w / 2.0;
+  k.cy = h / 2.0;
+  return k;
+}
+
+/// The name of a compression, for a test's parameter: None, Bz2, Lz4.
+inline std::string compressionName(rosbag::compression::CompressionType c) {
+  return c == rosbag::compression::Uncompressed ? "None" : c == rosbag::compression::BZ2 ? "Bz2" : "Lz4";
+}
+
 inline void writeSmallBag(const std::string& path, const SmallBag& b) {
   core::DepthImage depth;
   depth.width = b.width;
   depth.height = b.height;
   depth.depth_m.assign(static_cast<std::size_t>(b.width) * b.height, 1.5f);
-  core::CameraIntrinsics k;
-  k.width = b.width;
-  k.height = b.height;
-  k.fx = k.fy = 0.78125 * b.width;  // a 79 degree field of view
-  k.cx = b.width / 2.0;
-  k.cy = b.height / 2.0;
+  const core::CameraIntrinsics k = camera(b.width, b.height);
   core::PointCloud cloud;
   for (int i = 0; i < 8; ++i) cloud.push_back(1.f + 0.1f * i, 0.f, -0.5f);
   rosbag::Bag bag(path, rosbag::bagmode::Write);

@@ -172,25 +172,20 @@ struct ChunkInfo {
   std::size_t connections = 0;  // index records after the chunk
 };
 
-// A compressed chunk's data, decompressed as rosbag decompresses it (BZ2 or LZ4).
-std::vector<char> decompressed(const Bytes& file, const Record& chunk, const std::string& compression,
-                               std::uint32_t size, std::uint64_t chunk_pos) {
-  std::vector<char> in(chunk.data_len);
-  file.read(chunk.data_pos, in.size(), in.data());
-  std::vector<char> out(size);
+// A compressed chunk's data, decompressed as rosbag decompresses it (BZ2 or LZ4) into out (its
+// size bytes): false where it does not decompress to exactly that. Safe on several threads at
+// once (libbz2 and roslz4 keep no state between calls).
+bool decompress(const std::vector<char>& in, const std::string& compression, std::uint32_t size,
+                std::vector<char>& out) {
+  out.resize(size);
   unsigned int out_len = size;
   const bool ok =
       compression == "bz2"
-          ? BZ2_bzBuffToBuffDecompress(out.data(), &out_len, in.data(),
+          ? BZ2_bzBuffToBuffDecompress(out.data(), &out_len, const_cast<char*>(in.data()),
                                        static_cast<unsigned int>(in.size()), 0, 0) == BZ_OK
-          : roslz4_buffToBuffDecompress(in.data(), static_cast<unsigned int>(in.size()),
+          : roslz4_buffToBuffDecompress(const_cast<char*>(in.data()), static_cast<unsigned int>(in.size()),
                                         out.data(), &out_len) == ROSLZ4_OK;
-  if (!ok || out_len != size) {
-    damage("the chunk (" + compression + ") does not decompress to its " + std::to_string(size) +
-               " bytes",
-           chunk_pos);
-  }
-  return out;
+  return ok && out_len == size;
 }
 
 // The records of a chunk's data, which must fill it: the op at each record's start.
@@ -208,18 +203,30 @@ std::map<std::uint64_t, std::uint8_t> chunkRecords(const Bytes& data, std::uint6
   return ops;
 }
 
+// A connection the index declares: its topic, and the MD5 sum of its messages' type.
+struct Connection {
+  std::string topic, md5sum;
+};
+using Connections = std::map<std::uint32_t, Connection>;
+
+std::string valueOr(const Fields& f, const char* name) {
+  const auto it = f.find(name);
+  return it == f.end() ? std::string() : it->second;
+}
+
 // The index at pos: a record per connection (a header, then the connection's own header), then
 // a chunk info per chunk. Each takes at least 8 bytes: a damaged count runs into the end.
 std::vector<ChunkInfo> readIndex(const Bytes& file, std::uint64_t pos, std::uint32_t connections,
-                                 std::uint32_t chunks, std::set<std::uint32_t>& declared) {
+                                 std::uint32_t chunks, Connections& declared) {
   for (std::uint32_t i = 0; i < connections; ++i) {
     std::uint64_t next = 0;
     const Fields f = headerAt(file, pos, next, "a connection record");
     if (field<std::uint8_t>(f, "op", "a connection record", pos) != kOpConnection) {
       damage("a connection record of another op", pos);
     }
-    declared.insert(field<std::uint32_t>(f, "conn", "a connection record", pos));
-    headerAt(file, next, pos, "a connection's header");
+    const auto id = field<std::uint32_t>(f, "conn", "a connection record", pos);
+    const Fields own = headerAt(file, next, pos, "a connection's header");
+    declared[id] = {valueOr(f, "topic"), valueOr(own, "md5sum")};
   }
   std::vector<ChunkInfo> infos;
   for (std::uint32_t i = 0; i < chunks; ++i) {
@@ -240,10 +247,17 @@ std::vector<ChunkInfo> readIndex(const Bytes& file, std::uint64_t pos, std::uint
   return infos;
 }
 
-// The index records after a chunk: the offset of each message in the chunk's data.
-std::vector<std::uint32_t> messageOffsets(const Bytes& file, std::uint64_t p, std::size_t records,
-                                          const std::set<std::uint32_t>& declared) {
-  std::vector<std::uint32_t> offsets;
+// A message as the index after its chunk lists it.
+struct IndexEntry {
+  std::uint64_t time_ns = 0;
+  std::uint32_t offset = 0;  // of its record in the chunk's data
+  std::uint32_t conn = 0;
+};
+
+// The index records after a chunk: each message's time and offset in the chunk's data.
+std::vector<IndexEntry> messageIndex(const Bytes& file, std::uint64_t p, std::size_t records,
+                                     const Connections& declared) {
+  std::vector<IndexEntry> entries;
   for (std::size_t k = 0; k < records; ++k) {
     const std::string what = "an index record";
     const Record r = recordAt(file, p, kOpIndexData, what);
@@ -252,46 +266,84 @@ std::vector<std::uint32_t> messageOffsets(const Bytes& file, std::uint64_t p, st
     if (!declared.count(id)) damage(what + ": connection " + std::to_string(id) + " is not declared", p);
     const auto count = field<std::uint32_t>(r.fields, "count", what, p);
     if (r.data_len != 12ull * count) damage(what + ": its data is not 12 bytes a message", p);
-    for (std::uint32_t m = 0; m < count; ++m) offsets.push_back(u32At(file, r.data_pos + 12ull * m + 8, what));
+    for (std::uint32_t m = 0; m < count; ++m) {
+      const std::uint64_t at = r.data_pos + 12ull * m;
+      const std::uint64_t ns = u32At(file, at, what) * 1'000'000'000ull + u32At(file, at + 4, what);
+      entries.push_back({ns, u32At(file, at + 8, what), id});
+    }
     p = r.end();
   }
-  return offsets;
+  return entries;
 }
 
-// One chunk and its index records: every record in its data (read in place when it is not
-// compressed), and every message offset of the index on a message.
-void checkChunk(std::ifstream& in, const Bytes& file, const ChunkInfo& info,
-                const std::set<std::uint32_t>& declared) {
-  const Record chunk = recordAt(file, info.pos, kOpChunk, "a chunk");
-  const auto compression = chunk.fields.find("compression");
-  if (compression == chunk.fields.end() ||
+// The messages of a checked chunk on the topics asked for, to on_message in order of time.
+void handMessages(const Bytes& data, std::vector<IndexEntry> entries, const Connections& declared,
+                  const std::set<std::string>& topics,
+                  const std::function<void(const BagMessage&)>& on_message) {
+  const auto unasked = [&](const IndexEntry& e) { return !topics.count(declared.at(e.conn).topic); };
+  entries.erase(std::remove_if(entries.begin(), entries.end(), unasked), entries.end());
+  std::sort(entries.begin(), entries.end(), [](const IndexEntry& a, const IndexEntry& b) {
+    return a.time_ns != b.time_ns ? a.time_ns < b.time_ns : a.offset < b.offset;
+  });
+  std::vector<std::uint8_t> bytes;
+  for (const IndexEntry& e : entries) {
+    const Record r = recordAt(data, e.offset, kOpMessageData, "a message");
+    bytes.resize(r.data_len);
+    data.read(r.data_pos, bytes.size(), reinterpret_cast<char*>(bytes.data()));
+    const Connection& c = declared.at(e.conn);
+    on_message({c.topic, c.md5sum, e.time_ns, bytes.data(), bytes.size()});
+  }
+}
+
+// A chunk as its header and the index records after it give it.
+struct Chunk {
+  std::uint64_t pos = 0;
+  Record record;
+  std::string compression;
+  std::uint32_t size = 0;  // of its data, decompressed
+  std::vector<IndexEntry> entries;
+};
+
+// A chunk's header and its index records.
+Chunk chunkAt(const Bytes& file, const ChunkInfo& info, const Connections& declared) {
+  Chunk c{info.pos, recordAt(file, info.pos, kOpChunk, "a chunk"), {}, 0, {}};
+  const auto compression = c.record.fields.find("compression");
+  if (compression == c.record.fields.end() ||
       (compression->second != "none" && compression->second != "bz2" && compression->second != "lz4")) {
     damage("a chunk without a known compression (none, bz2, lz4)", info.pos);
   }
-  const std::vector<std::uint32_t> offsets = messageOffsets(file, chunk.end(), info.connections, declared);
-  const auto size = field<std::uint32_t>(chunk.fields, "size", "a chunk", info.pos);
-  if (size > kMaxChunkBytes) damage("a chunk of " + std::to_string(size) + " bytes (more than 2^30)", info.pos);
-  std::map<std::uint64_t, std::uint8_t> ops;
-  if (compression->second == "none") {
-    if (chunk.data_len != size) {
-      damage("an uncompressed chunk of " + std::to_string(chunk.data_len) + " bytes whose size says " +
-                 std::to_string(size),
-             info.pos);
-    }
-    ops = chunkRecords(FileBytes(in, chunk.data_pos, chunk.data_len), info.pos);
-  } else {
-    const std::vector<char> data = decompressed(file, chunk, compression->second, size, info.pos);
-    ops = chunkRecords(BufferBytes(data, info.pos), info.pos);
+  c.compression = compression->second;
+  c.entries = messageIndex(file, c.record.end(), info.connections, declared);
+  c.size = field<std::uint32_t>(c.record.fields, "size", "a chunk", info.pos);
+  if (c.size > kMaxChunkBytes) damage("a chunk of " + std::to_string(c.size) + " bytes (more than 2^30)", info.pos);
+  if (c.compression == "none" && c.record.data_len != c.size) {
+    damage("an uncompressed chunk of " + std::to_string(c.record.data_len) + " bytes whose size says " +
+               std::to_string(c.size),
+           info.pos);
   }
+  return c;
+}
+
+// A chunk's data (data: decompressed; empty and read in place when it is not compressed): every
+// record in it, and every message offset of the index on a message; then its messages on topics
+// to on_message.
+void checkChunkData(std::ifstream& in, const Chunk& c, const std::vector<char>& data_if_packed,
+                    const Connections& declared, const std::set<std::string>& topics,
+                    const std::function<void(const BagMessage&)>& on_message) {
+  const FileBytes in_place(in, c.record.data_pos, c.record.data_len);
+  const BufferBytes in_buffer(data_if_packed, c.pos);
+  const Bytes& data = c.compression == "none" ? static_cast<const Bytes&>(in_place) : in_buffer;
+  const std::map<std::uint64_t, std::uint8_t> ops = chunkRecords(data, c.pos);
   // rosbag writes each offset at its message record. (Where one lands on a connection record,
   // rosbag reads on from inside that record's second header: a record to refuse too.)
-  for (const std::uint32_t offset : offsets) {
-    const auto it = ops.find(offset);
+  for (const IndexEntry& e : c.entries) {
+    const auto it = ops.find(e.offset);
     if (it == ops.end() || it->second != kOpMessageData) {
-      damage("the index points at byte " + std::to_string(offset) + " of the chunk, not at a message",
-             info.pos);
+      damage("the index points at byte " + std::to_string(e.offset) + " of the chunk, not at a message",
+             c.pos);
     }
   }
+  if (on_message) handMessages(data, c.entries, declared, topics, on_message);
 }
 
 // sscanf's %d at p, read as strtoll reads it (white space, a sign, digits: the same grammar,
@@ -354,8 +406,16 @@ VersionLine bagVersion(std::ifstream& in, std::uint64_t& after) {
 
 }  // namespace
 
-void checkBag(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+struct BagWalk::Impl {
+  std::ifstream in;
+  std::uint64_t file_size = 0;
+  Connections declared;
+  std::vector<Chunk> chunks;
+};
+
+BagWalk::BagWalk(const std::string& path) : impl_(std::make_unique<Impl>()) {
+  std::ifstream& in = impl_->in;
+  in.open(path, std::ios::binary);
   if (!in) return;  // rosbag says why
   in.seekg(0, std::ios::end);
   const std::uint64_t file_size = static_cast<std::uint64_t>(in.tellg());
@@ -381,15 +441,59 @@ void checkBag(const std::string& path) {
                " lies outside the file's records",
            header_pos);
   }
-  std::set<std::uint32_t> declared;
-  const std::vector<ChunkInfo> infos =
-      readIndex(file, index_pos, field<std::uint32_t>(header.fields, "conn_count", "the file header", header_pos),
-                field<std::uint32_t>(header.fields, "chunk_count", "the file header", header_pos), declared);
+  const std::vector<ChunkInfo> infos = readIndex(
+      file, index_pos, field<std::uint32_t>(header.fields, "conn_count", "the file header", header_pos),
+      field<std::uint32_t>(header.fields, "chunk_count", "the file header", header_pos), impl_->declared);
   for (const ChunkInfo& info : infos) {
     if (info.pos < header.end() || info.pos >= index_pos) {
       damage("a chunk position " + std::to_string(info.pos) + " outside the chunks", index_pos);
     }
-    checkChunk(in, file, info, declared);
+    impl_->chunks.push_back(chunkAt(file, info, impl_->declared));
+    for (const IndexEntry& e : impl_->chunks.back().entries) {
+      begin_ns_ = std::min(begin_ns_, e.time_ns);
+      end_ns_ = std::max(end_ns_, e.time_ns);
+    }
+  }
+  impl_->file_size = file_size;
+}
+
+BagWalk::~BagWalk() = default;
+
+void BagWalk::checkChunks(const std::set<std::string>& topics,
+                          const std::function<void(const BagMessage&)>& on_message) {
+  const FileBytes file(impl_->in, 0, impl_->file_size);
+  const std::vector<Chunk>& chunks = impl_->chunks;
+  // The compressed chunks of a batch (up to 64 MB decompressed) are decompressed on the team,
+  // then the batch's chunks checked in order: the first damage of the file is the one reported.
+  constexpr std::uint64_t kBatchBytes = 64u << 20;
+  for (std::size_t first = 0; first < chunks.size();) {
+    std::size_t end = first + 1;
+    for (std::uint64_t bytes = chunks[first].size;
+         end < chunks.size() && bytes + chunks[end].size <= kBatchBytes; ++end) {
+      bytes += chunks[end].size;
+    }
+    std::vector<std::vector<char>> packed(end - first), data(end - first);
+    for (std::size_t i = first; i < end; ++i) {
+      if (chunks[i].compression == "none") continue;
+      packed[i - first].resize(chunks[i].record.data_len);
+      file.read(chunks[i].record.data_pos, chunks[i].record.data_len, packed[i - first].data());
+    }
+    std::vector<char> sound(end - first, 1);
+#pragma omp parallel for schedule(dynamic) if (end - first > 1)
+    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(end - first); ++k) {
+      const Chunk& c = chunks[first + static_cast<std::size_t>(k)];
+      if (c.compression != "none") sound[k] = decompress(packed[k], c.compression, c.size, data[k]);
+    }
+    for (std::size_t i = first; i < end; ++i) {
+      const Chunk& c = chunks[i];
+      if (!sound[i - first]) {
+        damage("the chunk (" + c.compression + ") does not decompress to its " + std::to_string(c.size) +
+                   " bytes",
+               c.pos);
+      }
+      checkChunkData(impl_->in, c, data[i - first], impl_->declared, topics, on_message);
+    }
+    first = end;
   }
 }
 

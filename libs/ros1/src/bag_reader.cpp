@@ -19,53 +19,104 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <new>
+#include <optional>
+#include <set>
+#include <utility>
 #include <vector>
 
 namespace upd::ros1 {
 
 namespace {
 
-// The message as type M (null when it is another type). A message of type M whose data does not
-// deserialize is null too, and counted under its reason: a string or array length that runs past
-// its data (checked first: roscpp would allocate what it says), or what roscpp throws.
-template <class M>
-boost::shared_ptr<M> instantiate(const rosbag::MessageInstance& m, BagReadStats& stats) {
-  if (!m.isType<M>()) return nullptr;
+// Runs f, counting why it failed for a message on topic: what roscpp throws (a length it read
+// past the data, or a read of the bag), or an allocation beyond memory.
+template <class F>
+bool counted(const std::string& topic, BagReadStats& stats, F f) {
   const auto count = [&](const std::string& why) {
-    ++stats.skipped["a message on " + m.getTopic() + " that does not deserialize (" + why + ")"];
+    ++stats.skipped["a message on " + topic + " that does not deserialize (" + why + ")"];
   };
   try {
-    std::vector<std::uint8_t> raw(m.size());
-    ros::serialization::OStream stream(raw.data(), static_cast<std::uint32_t>(raw.size()));
-    m.write(stream);
-    if (!detail::lengthsFit(m.getDataType(), raw.data(), raw.size())) {
-      count("a length runs past its data");
-      return nullptr;
-    }
-    // From the data just read and walked, not read from the bag again.
-    auto msg = boost::make_shared<M>();
-    ros::serialization::IStream in(raw.data(), static_cast<std::uint32_t>(raw.size()));
-    ros::serialization::deserialize(in, *msg);
-    return msg;
+    f();
+    return true;
   } catch (const ros::Exception& e) {
     count(e.what());
   } catch (const std::bad_alloc&) {
     count("a length beyond memory");
   }
-  return nullptr;
+  return false;
 }
 
-// Every transform of the bag in a buffer that keeps them all.
-void loadTf(rosbag::Bag& bag, tf2::BufferCore& tf, BagReadStats& stats) {
-  rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf", "/tf_static"}));
-  for (const rosbag::MessageInstance& m : view) {
-    const auto msg = instantiate<tf2_msgs::TFMessage>(m, stats);
-    if (!msg) continue;
-    const bool is_static = m.getTopic() == "/tf_static";
-    for (const auto& t : msg->transforms) tf.setTransform(t, "bag", is_static);
+// Message M from its serialized data: null where its data does not deserialize, counted under
+// its reason: a string or array length that runs past its data (checked first, by M's layout
+// whatever type the bag names: roscpp would allocate what a length says), or what roscpp throws.
+template <class M>
+boost::shared_ptr<M> decoded(const std::string& topic, const std::uint8_t* data, std::size_t size,
+                             BagReadStats& stats) {
+  if (!detail::lengthsFit(ros::message_traits::datatype<M>(), data, size)) {
+    ++stats.skipped["a message on " + topic + " that does not deserialize (a length runs past its data)"];
+    return nullptr;
   }
+  auto msg = boost::make_shared<M>();
+  const bool ok = counted(topic, stats, [&] {
+    ros::serialization::IStream in(const_cast<std::uint8_t*>(data), static_cast<std::uint32_t>(size));
+    ros::serialization::deserialize(in, *msg);
+  });
+  return ok ? msg : nullptr;
 }
+
+// Whether a connection's messages are of type M, as rosbag's MessageInstance::isType asks.
+template <class M>
+bool isType(const std::string& md5sum) {
+  const std::string m = ros::message_traits::MD5Sum<M>::value();
+  return m == "*" || m == md5sum;
+}
+
+// The message as type M (null when it is another type, or counted where it does not
+// deserialize).
+template <class M>
+boost::shared_ptr<M> instantiate(const rosbag::MessageInstance& m, BagReadStats& stats) {
+  if (!isType<M>(m.getMD5Sum())) return nullptr;
+  std::vector<std::uint8_t> raw;
+  const bool read = counted(m.getTopic(), stats, [&] {
+    raw.resize(m.size());
+    ros::serialization::OStream stream(raw.data(), static_cast<std::uint32_t>(raw.size()));
+    m.write(stream);
+  });
+  return read ? decoded<M>(m.getTopic(), raw.data(), raw.size(), stats) : nullptr;
+}
+
+// The bag's transforms, from the walk of its chunks (which decompresses them once): /tf as
+// met, /tf_static kept until the walk ends and then set in the order of their times, for a
+// later static transform of a frame replaces an earlier one.
+class TfFromWalk {
+ public:
+  TfFromWalk(tf2::BufferCore& tf, BagReadStats& stats) : tf_(tf), stats_(stats) {}
+  static std::set<std::string> topics() { return {"/tf", "/tf_static"}; }
+  void operator()(const detail::BagMessage& m) {
+    if (!isType<tf2_msgs::TFMessage>(m.md5sum)) return;
+    const auto msg = decoded<tf2_msgs::TFMessage>(m.topic, m.data, m.size, stats_);
+    if (!msg) return;
+    if (m.topic == "/tf_static") {
+      statics_.emplace_back(m.time_ns, msg);
+      return;
+    }
+    for (const auto& t : msg->transforms) tf_.setTransform(t, "bag", false);
+  }
+  void setStatics() {
+    std::stable_sort(statics_.begin(), statics_.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [time, msg] : statics_) {
+      for (const auto& t : msg->transforms) tf_.setTransform(t, "bag", true);
+    }
+  }
+
+ private:
+  tf2::BufferCore& tf_;
+  BagReadStats& stats_;
+  std::vector<std::pair<std::uint64_t, tf2_msgs::TFMessage::ConstPtr>> statics_;
+};
 
 std::optional<Eigen::Isometry3d> lookup(const tf2::BufferCore& tf, const std::string& target,
                                         const std::string& source, const ros::Time& stamp) {
@@ -153,8 +204,18 @@ bool isBagPath(const std::string& path) {
 
 BagReadStats readBag(const std::string& path, const BagTopics& topics,
                      const std::function<void(const BagFrame&)>& on_frame) {
+  BagReadStats stats;
+  // The walk before rosbag trusts the bag's lengths and offsets, the transforms read in it.
+  std::optional<tf2::BufferCore> tf;
   try {
-    detail::checkBag(path);  // before rosbag trusts its lengths and offsets
+    detail::BagWalk walk(path);
+    // In seconds: a span beyond ros::Duration's 2^31 s (a damaged stamp) would throw.
+    const double span_s =
+        walk.beginNs() > walk.endNs() ? 0.0 : (walk.endNs() - walk.beginNs()) * 1e-9;
+    tf.emplace(ros::Duration(std::clamp(span_s + 60.0, 60.0, 2e9)));
+    TfFromWalk transforms(*tf, stats);
+    walk.checkChunks(TfFromWalk::topics(), std::ref(transforms));
+    transforms.setStatics();
   } catch (const detail::BagDamage& e) {
     throw std::runtime_error(path + ": damaged bag: " + e.what());
   }
@@ -164,13 +225,7 @@ BagReadStats readBag(const std::string& path, const BagTopics& topics,
   } catch (const rosbag::BagException& e) {
     throw std::runtime_error(path + ": cannot open as a ROS 1 bag: " + e.what());
   }
-  BagReadStats stats;
   try {
-    rosbag::View all(bag);
-    // In seconds first: a span beyond ros::Duration's 2^31 s (a damaged stamp) would throw.
-    const double span_s = all.getEndTime().toSec() - all.getBeginTime().toSec();
-    tf2::BufferCore tf(ros::Duration(std::clamp(span_s + 60.0, 60.0, 2e9)));
-    loadTf(bag, tf, stats);
     // The first CameraInfo serves the images before it: a bag orders messages of the same
     // stamp by connection, so an image may come just before its info.
     sensor_msgs::CameraInfo::ConstPtr info;
@@ -191,7 +246,7 @@ BagReadStats readBag(const std::string& path, const BagTopics& topics,
       ++stats.messages;
       std_msgs::Header header;
       if (!frameOf(m, info.get(), frame, header, stats)) continue;
-      if (!framePoses(tf, topics, header.stamp, frame, stats)) continue;
+      if (!framePoses(*tf, topics, header.stamp, frame, stats)) continue;
       on_frame(frame);
       ++stats.frames;
     }

@@ -1,0 +1,111 @@
+// The transforms of a bag are read in the walk that checks its chunks (one decompression of
+// each chunk for the walk and the transforms together). They must be the transforms rosbag's
+// view of /tf and /tf_static gives, in its order of time: a bag whose transforms span many
+// chunks, a static transform of the camera written twice, in chunks far apart, the later in time
+// written first (it replaces the earlier one), and a robot pose written twice at one stamp by
+// two publishers, the earlier in time written second (tf2 keeps the first it is given).
+#include "small_bag.h"
+#include "temp_dir.h"
+
+#include "upd/ros1/bag_reader.h"
+#include "upd/ros1/conversions.h"
+
+#include <gtest/gtest.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <tf2/buffer_core.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <boost/make_shared.hpp>
+
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace upd;
+
+Eigen::Isometry3d along(double x, double z = 0.0) {
+  Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
+  p.translation() = Eigen::Vector3d(x, 0.0, z);
+  return p;
+}
+
+tf2_msgs::TFMessage one(const Eigen::Isometry3d& pose, const std::string& parent,
+                        const std::string& child, double stamp) {
+  tf2_msgs::TFMessage m;
+  m.transforms.push_back(test::stamped(pose, parent, child, stamp));
+  return m;
+}
+
+// Ten small depth frames at t = 1..10 s in chunks of about 1 kB, the robot 0.1 m further along x
+// at each; the camera's mount at bag time 2 s (z 0.5, written first) and 1 s (z 0.3, written
+// after the 6th frame); at 4 s a second publisher's robot pose (x 7) with an earlier bag time than
+// the first's (x 0.3), written after it.
+void writeBag(const std::string& path, rosbag::compression::CompressionType compression) {
+  rosbag::Bag bag(path, rosbag::bagmode::Write);
+  bag.setCompression(compression);
+  bag.setChunkThreshold(1000);
+  bag.write("/tf_static", ros::Time(2.0), one(along(0.0, 0.5), "base_link", "camera", 2.0));
+  core::DepthImage depth;
+  depth.width = 16;
+  depth.height = 12;
+  depth.depth_m.assign(16 * 12, 1.5f);
+  sensor_msgs::CameraInfo info = ros1::cameraInfoFromIntrinsics(test::camera(16, 12));
+  sensor_msgs::Image image = ros1::imageFromDepth(depth, "16UC1");
+  info.header.frame_id = image.header.frame_id = "camera";
+  const auto other = boost::make_shared<ros::M_string>(ros::M_string{
+      {"callerid", "/other_localizer"},
+      {"type", ros::message_traits::datatype<tf2_msgs::TFMessage>()},
+      {"md5sum", ros::message_traits::md5sum<tf2_msgs::TFMessage>()},
+      {"message_definition", ros::message_traits::definition<tf2_msgs::TFMessage>()}});
+  for (int i = 1; i <= 10; ++i) {
+    bag.write("/tf", ros::Time(i + 0.02), one(along(0.1 * (i - 1)), "map", "base_link", i));
+    if (i == 4) bag.write("/tf", ros::Time(i + 0.01), one(along(7.0), "map", "base_link", i), other);
+    if (i == 6) bag.write("/tf_static", ros::Time(1.0), one(along(0.0, 0.3), "base_link", "camera", 1.0));
+    info.header.stamp = image.header.stamp = ros::Time(i);
+    bag.write("/camera/depth/camera_info", ros::Time(i + 0.02), info);
+    bag.write("/camera/depth/image_raw", ros::Time(i + 0.02), image);
+  }
+}
+
+// The transforms as rosbag's view of the transform topics gives them, one after the other.
+void loadByView(const std::string& path, tf2::BufferCore& tf) {
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  for (const rosbag::MessageInstance& m :
+       rosbag::View(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf", "/tf_static"}))) {
+    const auto msg = m.instantiate<tf2_msgs::TFMessage>();
+    for (const auto& t : msg->transforms) tf.setTransform(t, "bag", m.getTopic() == "/tf_static");
+  }
+}
+
+class BagTransforms : public ::testing::TestWithParam<rosbag::compression::CompressionType> {};
+
+TEST_P(BagTransforms, AreRosbagsViewOfThem) {
+  test::TempDir dir("bag_tf");
+  const std::string path = dir.file("run.bag");
+  writeBag(path, GetParam());
+  tf2::BufferCore tf(ros::Duration(100.0));
+  loadByView(path, tf);
+  std::vector<ros1::BagFrame> frames;
+  ros1::readBag(path, {}, [&](const ros1::BagFrame& f) { frames.push_back(f); });
+  ASSERT_EQ(frames.size(), 10u);
+  for (const ros1::BagFrame& f : frames) {
+    const ros::Time stamp(f.stamp_s);
+    const auto mount = ros1::isometryFromTransform(tf.lookupTransform("base_link", "camera", stamp).transform);
+    const auto robot = ros1::isometryFromTransform(tf.lookupTransform("map", "base_link", stamp).transform);
+    EXPECT_TRUE(f.pose_base_sensor.isApprox(mount, 1e-12)) << "frame at " << f.stamp_s;
+    ASSERT_TRUE(f.pose_world_base.has_value());
+    EXPECT_TRUE(f.pose_world_base->isApprox(robot, 1e-12)) << "frame at " << f.stamp_s;
+  }
+  EXPECT_DOUBLE_EQ(frames[0].pose_base_sensor.translation().z(), 0.5) << "the mount of the later time";
+  EXPECT_DOUBLE_EQ(frames[3].pose_world_base->translation().x(), 7.0) << "the pose of the earlier time";
+  EXPECT_DOUBLE_EQ(frames[4].pose_world_base->translation().x(), 0.4);
+}
+
+INSTANTIATE_TEST_SUITE_P(Compressions, BagTransforms,
+                         ::testing::Values(rosbag::compression::Uncompressed,
+                                           rosbag::compression::BZ2, rosbag::compression::LZ4),
+                         [](const auto& p) { return test::compressionName(p.param); });
+
+}  // namespace
