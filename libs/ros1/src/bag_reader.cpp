@@ -2,11 +2,9 @@
 
 #include "upd/ros1/conversions.h"
 
-#include "bag_check.h"
+#include "bag_walk.h"
 #include "bag_messages.h"
 
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
@@ -22,6 +20,7 @@
 #include <functional>
 #include <new>
 #include <optional>
+#include <string>
 #include <set>
 #include <utility>
 #include <vector>
@@ -30,8 +29,8 @@ namespace upd::ros1 {
 
 namespace {
 
-// Runs f, counting why it failed for a message on topic: what roscpp throws (a length it read
-// past the data, or a read of the bag), or an allocation beyond memory.
+// Runs f (roscpp deserializing a message on topic), counting why it failed: what roscpp throws,
+// or an allocation beyond memory.
 template <class F>
 bool counted(const std::string& topic, BagReadStats& stats, F f) {
   const auto count = [&](const std::string& why) {
@@ -73,18 +72,11 @@ bool isType(const std::string& md5sum) {
   return m == "*" || m == md5sum;
 }
 
-// The message as type M (null when it is another type, or counted where it does not
-// deserialize).
+// The message as type M: null when it is another type, or (counted) where it does not
+// deserialize.
 template <class M>
-boost::shared_ptr<M> instantiate(const rosbag::MessageInstance& m, BagReadStats& stats) {
-  if (!isType<M>(m.getMD5Sum())) return nullptr;
-  std::vector<std::uint8_t> raw;
-  const bool read = counted(m.getTopic(), stats, [&] {
-    raw.resize(m.size());
-    ros::serialization::OStream stream(raw.data(), static_cast<std::uint32_t>(raw.size()));
-    m.write(stream);
-  });
-  return read ? decoded<M>(m.getTopic(), raw.data(), raw.size(), stats) : nullptr;
+boost::shared_ptr<M> instantiate(const detail::BagMessage& m, BagReadStats& stats) {
+  return isType<M>(m.md5sum) ? decoded<M>(m.topic, m.data, m.size, stats) : nullptr;
 }
 
 // The bag's transforms, from the walk of its chunks (which decompresses them once): /tf as
@@ -95,8 +87,7 @@ class TfFromWalk {
   TfFromWalk(tf2::BufferCore& tf, BagReadStats& stats) : tf_(tf), stats_(stats) {}
   static std::set<std::string> topics() { return {"/tf", "/tf_static"}; }
   void operator()(const detail::BagMessage& m) {
-    if (!isType<tf2_msgs::TFMessage>(m.md5sum)) return;
-    const auto msg = decoded<tf2_msgs::TFMessage>(m.topic, m.data, m.size, stats_);
+    const auto msg = instantiate<tf2_msgs::TFMessage>(m, stats_);
     if (!msg) return;
     if (m.topic == "/tf_static") {
       statics_.emplace_back(m.time_ns, msg);
@@ -152,28 +143,27 @@ bool framePoses(const tf2::BufferCore& tf, const BagTopics& topics, const ros::T
 
 // The depth images' topic: the one named, or the compressedDepth topic image_transport publishes
 // beside it (`<topic>/compressedDepth`) where the bag has no message on the one named.
-std::string depthTopicOf(const rosbag::Bag& bag, const std::string& depth_topic) {
+std::string depthTopicOf(const detail::BagWalk& bag, const std::string& depth_topic) {
   const std::string compressed = compressedDepthTopic(depth_topic);
-  if (rosbag::View(bag, rosbag::TopicQuery(depth_topic)).size() > 0) return depth_topic;
-  return rosbag::View(bag, rosbag::TopicQuery(compressed)).size() > 0 ? compressed : depth_topic;
+  return !bag.hasMessages(depth_topic) && bag.hasMessages(compressed) ? compressed : depth_topic;
 }
 
 // The frame of message m (a depth image, raw or compressed, with the CameraInfo info; or a
 // PointCloud2) into frame and header, without its poses: false (and the reason counted) where
 // the message is of another type, does not deserialize, or does not convert.
-bool frameOf(const rosbag::MessageInstance& m, const sensor_msgs::CameraInfo* info,
-             BagFrame& frame, std_msgs::Header& header, BagReadStats& stats) {
+bool frameOf(const detail::BagMessage& m, const sensor_msgs::CameraInfo* info, BagFrame& frame,
+             std_msgs::Header& header, BagReadStats& stats) {
   sensor_msgs::Image::ConstPtr image;
   sensor_msgs::CompressedImage::ConstPtr packed;
   sensor_msgs::PointCloud2::ConstPtr points;
-  if (m.isType<sensor_msgs::Image>()) {
+  if (isType<sensor_msgs::Image>(m.md5sum)) {
     image = instantiate<sensor_msgs::Image>(m, stats);
-  } else if (m.isType<sensor_msgs::CompressedImage>()) {
+  } else if (isType<sensor_msgs::CompressedImage>(m.md5sum)) {
     packed = instantiate<sensor_msgs::CompressedImage>(m, stats);
-  } else if (m.isType<sensor_msgs::PointCloud2>()) {
+  } else if (isType<sensor_msgs::PointCloud2>(m.md5sum)) {
     points = instantiate<sensor_msgs::PointCloud2>(m, stats);
   } else {
-    ++stats.skipped["unexpected type " + m.getDataType() + " on " + m.getTopic()];
+    ++stats.skipped["unexpected type " + m.datatype + " on " + m.topic];
     return false;
   }
   if (!image && !packed && !points) return false;  // counted: its data does not deserialize
@@ -205,53 +195,45 @@ bool isBagPath(const std::string& path) {
 BagReadStats readBag(const std::string& path, const BagTopics& topics,
                      const std::function<void(const BagFrame&)>& on_frame) {
   BagReadStats stats;
-  // The walk before rosbag trusts the bag's lengths and offsets, the transforms read in it.
-  std::optional<tf2::BufferCore> tf;
   try {
-    detail::BagWalk walk(path);
+    detail::BagWalk bag(path);
     // In seconds: a span beyond ros::Duration's 2^31 s (a damaged stamp) would throw.
-    const double span_s =
-        walk.beginNs() > walk.endNs() ? 0.0 : (walk.endNs() - walk.beginNs()) * 1e-9;
-    tf.emplace(ros::Duration(std::clamp(span_s + 60.0, 60.0, 2e9)));
-    TfFromWalk transforms(*tf, stats);
-    walk.checkChunks(TfFromWalk::topics(), std::ref(transforms));
+    const double span_s = bag.beginNs() > bag.endNs() ? 0.0 : (bag.endNs() - bag.beginNs()) * 1e-9;
+    tf2::BufferCore tf(ros::Duration(std::clamp(span_s + 60.0, 60.0, 2e9)));
+    TfFromWalk transforms(tf, stats);
+    bag.checkChunks(TfFromWalk::topics(), std::ref(transforms));
     transforms.setStatics();
-  } catch (const detail::BagDamage& e) {
-    throw std::runtime_error(path + ": damaged bag: " + e.what());
-  }
-  rosbag::Bag bag;
-  try {
-    bag.open(path, rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
-    throw std::runtime_error(path + ": cannot open as a ROS 1 bag: " + e.what());
-  }
-  try {
     // The first CameraInfo serves the images before it: a bag orders messages of the same
     // stamp by connection, so an image may come just before its info.
     sensor_msgs::CameraInfo::ConstPtr info;
-    for (const rosbag::MessageInstance& m :
-         rosbag::View(bag, rosbag::TopicQuery(topics.camera_info_topic))) {
-      BagReadStats counted_below;  // the loop below meets this message again
-      if ((info = instantiate<sensor_msgs::CameraInfo>(m, counted_below))) break;
-    }
-    rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{
-                               depthTopicOf(bag, topics.depth_topic), topics.camera_info_topic,
-                               topics.points_topic}));
+    bag.readMessages(
+        {topics.camera_info_topic},
+        [&](const detail::BagMessage& m) {
+          BagReadStats counted_below;  // the loop below meets this message again
+          info = instantiate<sensor_msgs::CameraInfo>(m, counted_below);
+          return !info;
+        },
+        0);
     BagFrame frame;
-    for (const rosbag::MessageInstance& m : view) {
-      if (m.isType<sensor_msgs::CameraInfo>()) {
-        if (auto i = instantiate<sensor_msgs::CameraInfo>(m, stats)) info = i;
-        continue;
-      }
-      ++stats.messages;
-      std_msgs::Header header;
-      if (!frameOf(m, info.get(), frame, header, stats)) continue;
-      if (!framePoses(*tf, topics, header.stamp, frame, stats)) continue;
-      on_frame(frame);
-      ++stats.frames;
-    }
-  } catch (const rosbag::BagException& e) {
-    throw std::runtime_error(path + ": " + e.what());
+    bag.readMessages(
+        {depthTopicOf(bag, topics.depth_topic), topics.camera_info_topic, topics.points_topic},
+        [&](const detail::BagMessage& m) {
+          if (isType<sensor_msgs::CameraInfo>(m.md5sum)) {
+            if (auto i = instantiate<sensor_msgs::CameraInfo>(m, stats)) info = i;
+            return true;
+          }
+          ++stats.messages;
+          std_msgs::Header header;
+          if (!frameOf(m, info.get(), frame, header, stats)) return true;
+          if (!framePoses(tf, topics, header.stamp, frame, stats)) return true;
+          on_frame(frame);
+          ++stats.frames;
+          return true;
+        });
+  } catch (const detail::NotABag& e) {
+    throw std::runtime_error(path + ": cannot open as a ROS 1 bag: " + e.what());
+  } catch (const detail::BagDamage& e) {
+    throw std::runtime_error(path + ": damaged bag: " + e.what());
   }
   return stats;
 }

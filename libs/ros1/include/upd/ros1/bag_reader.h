@@ -1,7 +1,9 @@
-// Reading ROS 1 bags with the rosbag storage API (no master, no node): the depth frames (an
-// Image with the latest CameraInfo before it) or PointCloud2 frames of a bag, each with the
-// sensor's pose on the robot and the robot's pose in the world from the bag's tf (/tf and
-// /tf_static, read in full first, so a transform stamped a little after a frame still counts).
+// Reading ROS 1 bags (format 2.0; no master, no node): the depth frames (an Image, or a
+// compressedDepth CompressedImage, with the latest CameraInfo before it) or PointCloud2 frames of
+// a bag in the order of their times, each with the sensor's pose on the robot and the robot's pose
+// in the world from the bag's tf (/tf and /tf_static, read in full first, so a transform stamped a
+// little after a frame still counts). The bag is read by a reader of the format that checks every
+// length and offset first; the messages are deserialized by roscpp.
 #pragma once
 
 #include "upd/core/camera.h"
@@ -49,8 +51,8 @@ struct BagReadStats {
 /// Calls on_frame for every frame in time order. A message that does not convert, or whose
 /// sensor has no transform to base_frame, is skipped and counted under its reason. Throws
 /// std::runtime_error naming the file when the bag cannot be opened or read, and before any
-/// frame when it is damaged ("F: damaged bag: <what> (byte N)": the whole bag is walked first,
-/// since rosbag trusts its lengths and offsets) or has no index.
+/// frame when it is damaged ("F: damaged bag: <what> (byte N)": the whole bag is walked first)
+/// or has no index.
 BagReadStats readBag(const std::string& path, const BagTopics& topics,
                      const std::function<void(const BagFrame&)>& on_frame);
 

@@ -1,21 +1,19 @@
-#include "bag_check.h"
+#include "bag_walk.h"
+
+#include "bag_version.h"
 
 #include <bzlib.h>
 #include <roslz4/lz4s.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <limits>
 #include <map>
-#include <optional>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace upd::ros1::detail {
@@ -203,9 +201,9 @@ std::map<std::uint64_t, std::uint8_t> chunkRecords(const Bytes& data, std::uint6
   return ops;
 }
 
-// A connection the index declares: its topic, and the MD5 sum of its messages' type.
+// A connection the index declares: its topic, and the type and MD5 sum of its messages.
 struct Connection {
-  std::string topic, md5sum;
+  std::string topic, datatype, md5sum;
 };
 using Connections = std::map<std::uint32_t, Connection>;
 
@@ -226,7 +224,7 @@ std::vector<ChunkInfo> readIndex(const Bytes& file, std::uint64_t pos, std::uint
     }
     const auto id = field<std::uint32_t>(f, "conn", "a connection record", pos);
     const Fields own = headerAt(file, next, pos, "a connection's header");
-    declared[id] = {valueOr(f, "topic"), valueOr(own, "md5sum")};
+    declared[id] = {valueOr(f, "topic"), valueOr(own, "type"), valueOr(own, "md5sum")};
   }
   std::vector<ChunkInfo> infos;
   for (std::uint32_t i = 0; i < chunks; ++i) {
@@ -291,7 +289,7 @@ void handMessages(const Bytes& data, std::vector<IndexEntry> entries, const Conn
     bytes.resize(r.data_len);
     data.read(r.data_pos, bytes.size(), reinterpret_cast<char*>(bytes.data()));
     const Connection& c = declared.at(e.conn);
-    on_message({c.topic, c.md5sum, e.time_ns, bytes.data(), bytes.size()});
+    on_message({c.topic, c.datatype, c.md5sum, e.time_ns, bytes.data(), bytes.size()});
   }
 }
 
@@ -346,64 +344,6 @@ void checkChunkData(std::ifstream& in, const Chunk& c, const std::vector<char>& 
   if (on_message) handMessages(data, c.entries, declared, topics, on_message);
 }
 
-// sscanf's %d at p, read as strtoll reads it (white space, a sign, digits: the same grammar,
-// but defined past an int's range, where %d is not): its text without the white space, and its
-// value where that fits an int (rosbag's version arithmetic overflows beyond). p moves past it;
-// false, p left, without a digit.
-bool readIntField(const char*& p, std::string& text, std::optional<long long>& value) {
-  while (std::isspace(static_cast<unsigned char>(*p))) ++p;
-  char* end = nullptr;
-  errno = 0;
-  const long long v = std::strtoll(p, &end, 10);
-  if (end == p) return false;
-  const bool fits = errno != ERANGE && v >= std::numeric_limits<int>::min() &&
-                    v <= std::numeric_limits<int>::max();
-  text.assign(p, static_cast<std::size_t>(end - p));
-  value = fits ? std::optional<long long>(v) : std::nullopt;
-  p = end;
-  return true;
-}
-
-// The bag's first line as rosbag reads it (fgets of at most 1,023 bytes, then sscanf
-// "#ROS%s V%d.%d" into a 100-byte word, the version major * 100 + minor), and the byte after
-// that line. found false: it is not a bag's version line, and rosbag says so.
-struct VersionLine {
-  bool found = false;
-  bool is_2_0 = false;  // the version rosbag reads is 200
-  std::string text;     // "MAJOR.MINOR" as written
-};
-
-VersionLine bagVersion(std::ifstream& in, std::uint64_t& after) {
-  std::string line(1023, '\0');
-  in.seekg(0);
-  in.read(line.data(), static_cast<std::streamsize>(line.size()));
-  line.resize(static_cast<std::size_t>(in.gcount()));
-  in.clear();
-  const auto newline = line.find('\n');
-  after = newline == std::string::npos ? line.size() : newline + 1;
-  line.resize(std::min<std::size_t>(after, line.find('\0')));  // as sscanf sees it
-  VersionLine v;
-  if (line.rfind("#ROS", 0) != 0) return v;
-  // rosbag's unbounded %s writes a longer word past its 100-byte buffer.
-  const auto word_end = line.find_first_of(" \t\n\v\f\r", 4);
-  if ((word_end == std::string::npos ? line.size() : word_end) - 4 >= 100) {
-    throw BagDamage("the version line's word after '#ROS' has 100 or more characters");
-  }
-  char word[100];
-  int end_of_word = 0;
-  if (std::sscanf(line.c_str(), "#ROS%99s%n", word, &end_of_word) != 1) return v;
-  const char* p = line.c_str() + end_of_word;
-  while (std::isspace(static_cast<unsigned char>(*p))) ++p;  // the format's " V"
-  if (*p++ != 'V') return v;
-  std::string major, minor;
-  std::optional<long long> ma, mi;
-  if (!readIntField(p, major, ma) || *p++ != '.' || !readIntField(p, minor, mi)) return v;
-  v.found = true;
-  v.text = major + "." + minor;
-  v.is_2_0 = ma && mi && *ma * 100 + *mi == 200;
-  return v;
-}
-
 }  // namespace
 
 struct BagWalk::Impl {
@@ -411,17 +351,46 @@ struct BagWalk::Impl {
   std::uint64_t file_size = 0;
   Connections declared;
   std::vector<Chunk> chunks;
+
+  // The data of chunks ids (in[k] of ids[k]; empty where not compressed), the compressed ones
+  // decompressed on the team; damage at the first (in the order of ids) that does not
+  // decompress to its size.
+  std::vector<std::vector<char>> unpack(const std::vector<std::size_t>& ids) {
+    const FileBytes file(in, 0, file_size);
+    std::vector<std::vector<char>> packed(ids.size()), data(ids.size());
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      const Record& r = chunks[ids[k]].record;
+      if (chunks[ids[k]].compression == "none") continue;
+      packed[k].resize(r.data_len);
+      file.read(r.data_pos, r.data_len, packed[k].data());
+    }
+    std::vector<char> sound(ids.size(), 1);
+#pragma omp parallel for schedule(dynamic) if (ids.size() > 1)
+    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(ids.size()); ++k) {
+      const Chunk& c = chunks[ids[static_cast<std::size_t>(k)]];
+      if (c.compression != "none") sound[k] = decompress(packed[k], c.compression, c.size, data[k]);
+    }
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      const Chunk& c = chunks[ids[k]];
+      if (!sound[k]) {
+        damage("the chunk (" + c.compression + ") does not decompress to its " + std::to_string(c.size) +
+                   " bytes",
+               c.pos);
+      }
+    }
+    return data;
+  }
 };
 
 BagWalk::BagWalk(const std::string& path) : impl_(std::make_unique<Impl>()) {
   std::ifstream& in = impl_->in;
   in.open(path, std::ios::binary);
-  if (!in) return;  // rosbag says why
+  if (!in) throw NotABag(std::string("cannot read it: ") + std::strerror(errno));
   in.seekg(0, std::ios::end);
   const std::uint64_t file_size = static_cast<std::uint64_t>(in.tellg());
   std::uint64_t header_pos = 0;
   const VersionLine version = bagVersion(in, header_pos);
-  if (!version.found) return;  // not a bag: rosbag says so
+  if (!version.found) throw NotABag("its first line is not a bag's version line (#ROSBAG V2.0)");
   if (!version.is_2_0) {
     throw BagDamage("bag format " + version.text + ": only format 2.0 (ROS since 2010) is read");
   }
@@ -459,41 +428,81 @@ BagWalk::BagWalk(const std::string& path) : impl_(std::make_unique<Impl>()) {
 
 BagWalk::~BagWalk() = default;
 
+bool BagWalk::hasMessages(const std::string& topic) const {
+  for (const Chunk& c : impl_->chunks) {
+    for (const IndexEntry& e : c.entries) {
+      if (impl_->declared.at(e.conn).topic == topic) return true;
+    }
+  }
+  return false;
+}
+
 void BagWalk::checkChunks(const std::set<std::string>& topics,
                           const std::function<void(const BagMessage&)>& on_message) {
-  const FileBytes file(impl_->in, 0, impl_->file_size);
   const std::vector<Chunk>& chunks = impl_->chunks;
-  // The compressed chunks of a batch (up to 64 MB decompressed) are decompressed on the team,
-  // then the batch's chunks checked in order: the first damage of the file is the one reported.
-  constexpr std::uint64_t kBatchBytes = 64u << 20;
+  // A batch's chunks are checked in order: the first damage of the file is the one reported.
   for (std::size_t first = 0; first < chunks.size();) {
-    std::size_t end = first + 1;
+    std::vector<std::size_t> ids{first};
     for (std::uint64_t bytes = chunks[first].size;
-         end < chunks.size() && bytes + chunks[end].size <= kBatchBytes; ++end) {
-      bytes += chunks[end].size;
+         ids.back() + 1 < chunks.size() && bytes + chunks[ids.back() + 1].size <= kBatchBytes;) {
+      ids.push_back(ids.back() + 1);
+      bytes += chunks[ids.back()].size;
     }
-    std::vector<std::vector<char>> packed(end - first), data(end - first);
-    for (std::size_t i = first; i < end; ++i) {
-      if (chunks[i].compression == "none") continue;
-      packed[i - first].resize(chunks[i].record.data_len);
-      file.read(chunks[i].record.data_pos, chunks[i].record.data_len, packed[i - first].data());
+    const std::vector<std::vector<char>> data = impl_->unpack(ids);
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      checkChunkData(impl_->in, chunks[ids[k]], data[k], impl_->declared, topics, on_message);
     }
-    std::vector<char> sound(end - first, 1);
-#pragma omp parallel for schedule(dynamic) if (end - first > 1)
-    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(end - first); ++k) {
-      const Chunk& c = chunks[first + static_cast<std::size_t>(k)];
-      if (c.compression != "none") sound[k] = decompress(packed[k], c.compression, c.size, data[k]);
+    first = ids.back() + 1;
+  }
+}
+
+void BagWalk::readMessages(const std::set<std::string>& topics,
+                           const std::function<bool(const BagMessage&)>& on_message,
+                           std::uint64_t batch_bytes) {
+  const std::vector<Chunk>& chunks = impl_->chunks;
+  struct At {
+    std::uint64_t time_ns;
+    std::size_t chunk;
+    std::uint32_t offset, conn;
+  };
+  std::vector<At> order;
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
+    for (const IndexEntry& e : chunks[i].entries) {
+      if (topics.count(impl_->declared.at(e.conn).topic)) order.push_back({e.time_ns, i, e.offset, e.conn});
     }
-    for (std::size_t i = first; i < end; ++i) {
-      const Chunk& c = chunks[i];
-      if (!sound[i - first]) {
-        damage("the chunk (" + c.compression + ") does not decompress to its " + std::to_string(c.size) +
-                   " bytes",
-               c.pos);
+  }
+  std::sort(order.begin(), order.end(), [](const At& a, const At& b) {
+    return std::tie(a.time_ns, a.chunk, a.offset) < std::tie(b.time_ns, b.chunk, b.offset);
+  });
+  std::map<std::size_t, std::vector<char>> held;  // the decompressed chunks of the batch
+  std::vector<std::uint8_t> bytes;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const Chunk& c = chunks[order[k].chunk];
+    if (c.compression != "none" && !held.count(order[k].chunk)) {
+      // The next compressed chunks the messages need, up to batch_bytes (one at least).
+      std::vector<std::size_t> ids;
+      std::set<std::size_t> picked;
+      std::uint64_t total = 0;
+      for (std::size_t j = k; j < order.size(); ++j) {
+        const std::size_t id = order[j].chunk;
+        if (chunks[id].compression == "none" || picked.count(id)) continue;
+        if (!ids.empty() && total + chunks[id].size > batch_bytes) break;
+        ids.push_back(id);
+        picked.insert(id);
+        total += chunks[id].size;
       }
-      checkChunkData(impl_->in, c, data[i - first], impl_->declared, topics, on_message);
+      std::vector<std::vector<char>> data = impl_->unpack(ids);
+      held.clear();
+      for (std::size_t i = 0; i < ids.size(); ++i) held[ids[i]] = std::move(data[i]);
     }
-    first = end;
+    const FileBytes in_place(impl_->in, c.record.data_pos, c.record.data_len);
+    const BufferBytes in_buffer(held[order[k].chunk], c.pos);
+    const Bytes& data = c.compression == "none" ? static_cast<const Bytes&>(in_place) : in_buffer;
+    const Record r = recordAt(data, order[k].offset, kOpMessageData, "a message");
+    bytes.resize(r.data_len);
+    data.read(r.data_pos, bytes.size(), reinterpret_cast<char*>(bytes.data()));
+    const Connection& conn = impl_->declared.at(order[k].conn);
+    if (!on_message({conn.topic, conn.datatype, conn.md5sum, order[k].time_ns, bytes.data(), bytes.size()})) return;
   }
 }
 

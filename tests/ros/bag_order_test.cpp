@@ -1,6 +1,8 @@
-// The transforms of a bag are read in the walk that checks its chunks (one decompression of
-// each chunk for the walk and the transforms together). They must be the transforms rosbag's
-// view of /tf and /tf_static gives, in its order of time: a bag whose transforms span many
+// A bag's messages are read from its checked chunks in the order rosbag's views give them: by
+// their times in the bag, whatever the order they were written in, a batch of chunks at a time.
+// The transforms are read in the walk that checks the chunks (one decompression of each chunk
+// for the walk and the transforms together). They must be the transforms rosbag's view of /tf
+// and /tf_static gives, in its order of time: a bag whose transforms span many
 // chunks, a static transform of the camera written twice, in chunks far apart, the later in time
 // written first (it replaces the earlier one), and a robot pose written twice at one stamp by
 // two publishers, the earlier in time written second (tf2 keeps the first it is given).
@@ -10,6 +12,8 @@
 #include "upd/ros1/bag_reader.h"
 #include "upd/ros1/conversions.h"
 
+#include "../../libs/ros1/src/bag_walk.h"
+
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -18,6 +22,9 @@
 
 #include <boost/make_shared.hpp>
 
+#include <algorithm>
+#include <cstdint>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -38,11 +45,12 @@ tf2_msgs::TFMessage one(const Eigen::Isometry3d& pose, const std::string& parent
   return m;
 }
 
-// Ten small depth frames at t = 1..10 s in chunks of about 1 kB, the robot 0.1 m further along x
-// at each; the camera's mount at bag time 2 s (z 0.5, written first) and 1 s (z 0.3, written
+// Ten small depth frames at t = 1..10 s in chunks of about 1 kB (then, for a second recording,
+// five at t = 0.1..0.5 s), the robot 0.1 m further along x at each; the camera's mount at bag time 2 s (z 0.5, written first) and 1 s (z 0.3, written
 // after the 6th frame); at 4 s a second publisher's robot pose (x 7) with an earlier bag time than
 // the first's (x 0.3), written after it.
-void writeBag(const std::string& path, rosbag::compression::CompressionType compression) {
+void writeBag(const std::string& path, rosbag::compression::CompressionType compression,
+              bool second_recording = false) {
   rosbag::Bag bag(path, rosbag::bagmode::Write);
   bag.setCompression(compression);
   bag.setChunkThreshold(1000);
@@ -64,8 +72,14 @@ void writeBag(const std::string& path, rosbag::compression::CompressionType comp
     if (i == 4) bag.write("/tf", ros::Time(i + 0.01), one(along(7.0), "map", "base_link", i), other);
     if (i == 6) bag.write("/tf_static", ros::Time(1.0), one(along(0.0, 0.3), "base_link", "camera", 1.0));
     info.header.stamp = image.header.stamp = ros::Time(i);
-    bag.write("/camera/depth/camera_info", ros::Time(i + 0.02), info);
-    bag.write("/camera/depth/image_raw", ros::Time(i + 0.02), image);
+    bag.write("/camera/depth/camera_info", ros::Time(i + 0.03), info);
+    bag.write("/camera/depth/image_raw", ros::Time(i + 0.04), image);
+  }
+  for (int j = 1; second_recording && j <= 5; ++j) {  // at 0.1 to 0.5 s, after the first
+    bag.write("/tf", ros::Time(0.1 * j + 0.002), one(along(-0.1 * j), "map", "base_link", 0.1 * j));
+    info.header.stamp = image.header.stamp = ros::Time(0.1 * j);
+    bag.write("/camera/depth/camera_info", ros::Time(0.1 * j + 0.003), info);
+    bag.write("/camera/depth/image_raw", ros::Time(0.1 * j + 0.004), image);
   }
 }
 
@@ -79,9 +93,9 @@ void loadByView(const std::string& path, tf2::BufferCore& tf) {
   }
 }
 
-class BagTransforms : public ::testing::TestWithParam<rosbag::compression::CompressionType> {};
+class BagOrder : public ::testing::TestWithParam<rosbag::compression::CompressionType> {};
 
-TEST_P(BagTransforms, AreRosbagsViewOfThem) {
+TEST_P(BagOrder, TransformsAreRosbagsViewOfThem) {
   test::TempDir dir("bag_tf");
   const std::string path = dir.file("run.bag");
   writeBag(path, GetParam());
@@ -103,7 +117,57 @@ TEST_P(BagTransforms, AreRosbagsViewOfThem) {
   EXPECT_DOUBLE_EQ(frames[4].pose_world_base->translation().x(), 0.4);
 }
 
-INSTANTIATE_TEST_SUITE_P(Compressions, BagTransforms,
+// A message as read: its topic, time and data.
+struct Read {
+  std::string topic;
+  std::uint64_t time_ns;
+  std::vector<std::uint8_t> data;
+  bool operator==(const Read& o) const {
+    return topic == o.topic && time_ns == o.time_ns && data == o.data;
+  }
+};
+
+// Every message of the bag as rosbag's view of all its topics gives them.
+std::vector<Read> readByView(const std::string& path) {
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  std::vector<Read> all;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+    std::vector<std::uint8_t> data(m.size());
+    ros::serialization::OStream stream(data.data(), static_cast<std::uint32_t>(data.size()));
+    m.write(stream);
+    all.push_back({m.getTopic(), m.getTime().toNSec(), data});
+  }
+  return all;
+}
+
+// The bag above, and the frames of a second recording written after it with earlier bag
+// times (a bag merged from two: its chunks do not follow each other in time), read a chunk at
+// a time, two chunks' bytes at a time and all at once: the messages of rosbag's view.
+TEST_P(BagOrder, MessagesComeAsRosbagsView) {
+  test::TempDir dir("bag_order");
+  const std::string path = dir.file("run.bag");
+  writeBag(path, GetParam(), /*second_recording=*/true);
+  const std::vector<Read> expected = readByView(path);
+  ASSERT_GT(expected.size(), 40u);
+  ros1::detail::BagWalk walk(path);
+  walk.checkChunks();
+  const std::set<std::string> topics{"/tf", "/tf_static", "/camera/depth/camera_info",
+                                     "/camera/depth/image_raw"};
+  for (const std::uint64_t batch : {std::uint64_t{0}, std::uint64_t{2000}, ros1::detail::BagWalk::kBatchBytes}) {
+    std::vector<Read> read;
+    walk.readMessages(topics, [&](const ros1::detail::BagMessage& m) {
+      read.push_back({m.topic, m.time_ns, std::vector<std::uint8_t>(m.data, m.data + m.size)});
+      return true;
+    }, batch);
+    EXPECT_TRUE(read == expected) << "batches of " << batch << " bytes: " << read.size() << " messages";
+  }
+  std::vector<double> stamps;
+  ros1::readBag(path, {}, [&](const ros1::BagFrame& f) { stamps.push_back(f.stamp_s); });
+  EXPECT_TRUE(std::is_sorted(stamps.begin(), stamps.end()));
+  EXPECT_EQ(stamps.size(), 15u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Compressions, BagOrder,
                          ::testing::Values(rosbag::compression::Uncompressed,
                                            rosbag::compression::BZ2, rosbag::compression::LZ4),
                          [](const auto& p) { return test::compressionName(p.param); });
