@@ -29,10 +29,10 @@
 #include "upd/maps/evaluation.h"
 #include "upd/maps/grid_export.h"
 #include "upd/maps/grid_fusion.h"
+#include "upd/mrpt_bridge/gz_output_stream.h"
 #include "upd/mrpt_bridge/rawlog_reader.h"
 #include "upd/mrpt_bridge/simulated_run.h"
 
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
@@ -204,12 +204,9 @@ json truthJson(const maps::TraversabilityGrid& grid, const Truth& truth, double 
 class AnnotatedRawlog {
  public:
   explicit AnnotatedRawlog(const std::string& path)
-      : path_(path), tmp_(path + ".tmp-" + std::to_string(::getpid())) {
-    if (!out_.open(tmp_, 1)) throw std::runtime_error("cannot write " + path_);
-  }
+      : path_(path), tmp_(path + ".tmp-" + std::to_string(::getpid())), out_(tmp_) {}
   ~AnnotatedRawlog() {
     if (committed_) return;
-    out_.close();
     std::error_code ec;
     fs::remove(tmp_, ec);
   }
@@ -228,7 +225,7 @@ class AnnotatedRawlog {
 
  private:
   std::string path_, tmp_;
-  mrpt::io::CFileGZOutputStream out_;
+  mrpt_bridge::GzOutputStream out_;
   bool committed_ = false;
 };
 

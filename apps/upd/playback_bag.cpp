@@ -2,11 +2,11 @@
 
 #ifdef UPD_HAVE_ROS1
 
+#include "upd/mrpt_bridge/gz_output_stream.h"
 #include "upd/io/atomic_file.h"
 #include "upd/ros1/bag_reader.h"
 #include "upd/sim/robot.h"
 
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationPointCloud.h>
@@ -89,7 +89,7 @@ std::optional<BagInput> convertBagInput(const std::string& path,
   ros1::BagReadStats stats;
   io::writeFileAtomicallyVia(in.rawlog, [&](const std::string& tmp) {
     {
-      mrpt::io::CFileGZOutputStream file(tmp);
+      mrpt_bridge::GzOutputStream file(tmp);
       auto archive = mrpt::serialization::archiveFrom(file);
       stats = ros1::readBag(path, ros1::BagTopics{}, [&](const ros1::BagFrame& f) {
         mrpt::obs::CObservation::Ptr obs = f.from_depth ? rangeScanOf(f) : pointCloudOf(f);
@@ -100,6 +100,7 @@ std::optional<BagInput> convertBagInput(const std::string& path,
           last_pose_t = f.stamp_s;
         }
       });
+      file.close();
     }
     if (stats.frames == 0) {
       std::string why;

@@ -4,12 +4,12 @@
 #include "commands.h"
 #include "depth_input.h"
 
+#include "upd/mrpt_bridge/gz_output_stream.h"
 #include "upd/io/atomic_file.h"
 #include "upd/mrpt_bridge/depth_files.h"
 #include "upd/mrpt_bridge/pose_source.h"
 #include "upd/sim/robot.h"
 
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -150,12 +150,12 @@ mrpt::obs::CObservation3DRangeScan::Ptr tumScan(const core::DepthImage& depth, c
 // The folder as a rawlog (observations only), written atomically.
 void writeSequence(const std::vector<TumFrame>& frames, const TumOptions& o, const fs::path& rawlog) {
   io::writeFileAtomicallyVia(rawlog.string(), [&](const std::string& tmp) {
-    mrpt::io::CFileGZOutputStream out;
-    if (!out.open(tmp, 1)) throw std::runtime_error("cannot write " + rawlog.string());
+    mrpt_bridge::GzOutputStream out(tmp);
     auto arch = mrpt::serialization::archiveFrom(out);
     for (const TumFrame& f : frames) {
       arch << *tumScan(depthImageOf(f.png, o.calib, o.metres_per_unit), o, f.t_s);
     }
+    out.close();
   });
 }
 

@@ -1,3 +1,4 @@
+#include "upd/mrpt_bridge/gz_output_stream.h"
 #include "upd/mrpt_bridge/simulated_run.h"
 
 #include "upd/io/atomic_file.h"
@@ -7,7 +8,6 @@
 #include "upd/sim/terrain.h"
 #include "upd/sim/truth_raster.h"
 
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -220,8 +220,7 @@ void writeRawlog(const std::vector<RoutePose>& route, const sim::WorldSpec& worl
   std::mt19937 rng(static_cast<std::uint32_t>(p.seed));
   std::normal_distribution<double> gauss(0.0, 1.0);
   io::writeFileAtomicallyVia(rawlog_path, [&](const std::string& tmp) {
-    mrpt::io::CFileGZOutputStream out;
-    if (!out.open(tmp, 1)) throw std::runtime_error("cannot write " + tmp);
+    GzOutputStream out(tmp);
     auto arch = mrpt::serialization::archiveFrom(out);
     for (std::size_t k = 0; k < route.size(); ++k) {
       const RoutePose& rp = route[k];
@@ -243,6 +242,7 @@ void writeRawlog(const std::vector<RoutePose>& route, const sim::WorldSpec& worl
       sf.insert(obs);
       arch << sf;
     }
+    out.close();
   });
 }
 

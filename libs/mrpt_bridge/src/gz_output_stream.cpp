@@ -1,0 +1,86 @@
+#include "upd/mrpt_bridge/gz_output_stream.h"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace upd::mrpt_bridge {
+
+namespace {
+
+// data as one gzip member deflated at level; false where zlib fails.
+bool gzipMember(const char* data, std::size_t size, int level, std::vector<unsigned char>& out) {
+  z_stream s{};
+  if (deflateInit2(&s, level, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) return false;
+  out.resize(deflateBound(&s, static_cast<uLong>(size)));
+  s.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data));
+  s.avail_in = static_cast<uInt>(size);
+  s.next_out = out.data();
+  s.avail_out = static_cast<uInt>(out.size());
+  const bool done = deflate(&s, Z_FINISH) == Z_STREAM_END;
+  out.resize(s.total_out);
+  deflateEnd(&s);
+  return done;
+}
+
+}  // namespace
+
+GzOutputStream::GzOutputStream(const std::string& path, int level, std::size_t member_bytes)
+    : path_(path), out_(path, std::ios::binary | std::ios::trunc), level_(level),
+      member_bytes_(std::max<std::size_t>(member_bytes, 1)) {
+  if (!out_) throw std::runtime_error("cannot write " + path);
+  int threads = 1;
+#ifdef _OPENMP
+  threads = omp_get_max_threads();
+#endif
+  batch_members_ = 2 * static_cast<std::size_t>(threads);
+}
+
+size_t GzOutputStream::Write(const void* buffer, size_t count) {
+  const char* p = static_cast<const char*>(buffer);
+  pending_.insert(pending_.end(), p, p + count);
+  written_ += count;
+  if (pending_.size() >= batch_members_ * member_bytes_) flushMembers();
+  return count;
+}
+
+void GzOutputStream::flushMembers() {
+  // (An empty stream is one empty member: a gzip file as gzip and CFileGZOutputStream write it.)
+  const std::size_t members = std::max<std::size_t>(1, (pending_.size() + member_bytes_ - 1) / member_bytes_);
+  std::vector<std::vector<unsigned char>> packed(members);
+  std::vector<char> sound(members, 1);
+#pragma omp parallel for schedule(dynamic) if (members > 1)
+  for (std::ptrdiff_t m = 0; m < static_cast<std::ptrdiff_t>(members); ++m) {
+    const std::size_t from = static_cast<std::size_t>(m) * member_bytes_;
+    const std::size_t n = std::min(member_bytes_, pending_.size() - from);
+    sound[m] = gzipMember(pending_.data() + from, n, level_, packed[m]);
+  }
+  for (std::size_t m = 0; m < members; ++m) {
+    if (!sound[m]) throw std::runtime_error("cannot compress the data of " + path_);
+    out_.write(reinterpret_cast<const char*>(packed[m].data()), static_cast<std::streamsize>(packed[m].size()));
+  }
+  if (!out_) throw std::runtime_error("cannot write " + path_);
+  pending_.clear();
+}
+
+void GzOutputStream::close() {
+  if (!out_.is_open()) return;
+  if (!pending_.empty() || written_ == 0) flushMembers();
+  out_.close();
+  if (!out_) throw std::runtime_error("cannot write " + path_);
+}
+
+size_t GzOutputStream::Read(void*, size_t) {
+  throw std::logic_error("GzOutputStream " + path_ + ": an output stream cannot be read");
+}
+
+uint64_t GzOutputStream::Seek(int64_t, mrpt::io::CStream::TSeekOrigin) {
+  throw std::logic_error("GzOutputStream " + path_ + ": an output stream cannot seek");
+}
+
+}  // namespace upd::mrpt_bridge
