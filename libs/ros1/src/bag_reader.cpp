@@ -29,22 +29,9 @@ namespace upd::ros1 {
 
 namespace {
 
-// Runs f (roscpp deserializing a message on topic), counting why it failed: what roscpp throws,
-// or an allocation beyond memory.
-template <class F>
-bool counted(const std::string& topic, BagReadStats& stats, F f) {
-  const auto count = [&](const std::string& why) {
-    ++stats.skipped["a message on " + topic + " that does not deserialize (" + why + ")"];
-  };
-  try {
-    f();
-    return true;
-  } catch (const ros::Exception& e) {
-    count(e.what());
-  } catch (const std::bad_alloc&) {
-    count("a length beyond memory");
-  }
-  return false;
+// Counts a message on topic that does not deserialize, and why.
+void countUndeserialized(BagReadStats& stats, const std::string& topic, const std::string& why) {
+  ++stats.skipped["a message on " + topic + " that does not deserialize (" + why + ")"];
 }
 
 // Message M from its serialized data: null where its data does not deserialize, counted under
@@ -54,15 +41,20 @@ template <class M>
 boost::shared_ptr<M> decoded(const std::string& topic, const std::uint8_t* data, std::size_t size,
                              BagReadStats& stats) {
   if (!detail::lengthsFit(ros::message_traits::datatype<M>(), data, size)) {
-    ++stats.skipped["a message on " + topic + " that does not deserialize (a length runs past its data)"];
+    countUndeserialized(stats, topic, "a length runs past its data");
     return nullptr;
   }
-  auto msg = boost::make_shared<M>();
-  const bool ok = counted(topic, stats, [&] {
+  try {
+    auto msg = boost::make_shared<M>();
     ros::serialization::IStream in(const_cast<std::uint8_t*>(data), static_cast<std::uint32_t>(size));
     ros::serialization::deserialize(in, *msg);
-  });
-  return ok ? msg : nullptr;
+    return msg;
+  } catch (const ros::Exception& e) {
+    countUndeserialized(stats, topic, e.what());
+  } catch (const std::bad_alloc&) {
+    countUndeserialized(stats, topic, "a length beyond memory");
+  }
+  return nullptr;
 }
 
 // Whether a connection's messages are of type M, as rosbag's MessageInstance::isType asks.
@@ -203,8 +195,8 @@ BagReadStats readBag(const std::string& path, const BagTopics& topics,
     TfFromWalk transforms(tf, stats);
     bag.checkChunks(TfFromWalk::topics(), std::ref(transforms));
     transforms.setStatics();
-    // The first CameraInfo serves the images before it: a bag orders messages of the same
-    // stamp by connection, so an image may come just before its info.
+    // The first CameraInfo serves the images before it (an image received, and recorded, just
+    // before its info).
     sensor_msgs::CameraInfo::ConstPtr info;
     bag.readMessages(
         {topics.camera_info_topic},

@@ -274,6 +274,15 @@ std::vector<IndexEntry> messageIndex(const Bytes& file, std::uint64_t p, std::si
   return entries;
 }
 
+// The message e of a checked chunk's data, its bytes read into bytes.
+BagMessage messageAt(const Bytes& data, const IndexEntry& e, const Connection& c,
+                     std::vector<std::uint8_t>& bytes) {
+  const Record r = recordAt(data, e.offset, kOpMessageData, "a message");
+  bytes.resize(r.data_len);
+  data.read(r.data_pos, bytes.size(), reinterpret_cast<char*>(bytes.data()));
+  return {c.topic, c.datatype, c.md5sum, e.time_ns, bytes.data(), bytes.size()};
+}
+
 // The messages of a checked chunk on the topics asked for, to on_message in order of time.
 void handMessages(const Bytes& data, std::vector<IndexEntry> entries, const Connections& declared,
                   const std::set<std::string>& topics,
@@ -284,13 +293,7 @@ void handMessages(const Bytes& data, std::vector<IndexEntry> entries, const Conn
     return a.time_ns != b.time_ns ? a.time_ns < b.time_ns : a.offset < b.offset;
   });
   std::vector<std::uint8_t> bytes;
-  for (const IndexEntry& e : entries) {
-    const Record r = recordAt(data, e.offset, kOpMessageData, "a message");
-    bytes.resize(r.data_len);
-    data.read(r.data_pos, bytes.size(), reinterpret_cast<char*>(bytes.data()));
-    const Connection& c = declared.at(e.conn);
-    on_message({c.topic, c.datatype, c.md5sum, e.time_ns, bytes.data(), bytes.size()});
-  }
+  for (const IndexEntry& e : entries) on_message(messageAt(data, e, declared.at(e.conn), bytes));
 }
 
 // A chunk as its header and the index records after it give it.
@@ -322,15 +325,27 @@ Chunk chunkAt(const Bytes& file, const ChunkInfo& info, const Connections& decla
   return c;
 }
 
-// A chunk's data (data: decompressed; empty and read in place when it is not compressed): every
-// record in it, and every message offset of the index on a message; then its messages on topics
-// to on_message.
-void checkChunkData(std::ifstream& in, const Chunk& c, const std::vector<char>& data_if_packed,
+// A chunk's data: in place in the file when it is not compressed, else its decompressed bytes.
+class ChunkData {
+ public:
+  ChunkData(std::ifstream& in, const Chunk& c, const std::vector<char>& unpacked)
+      : in_place_(in, c.record.data_pos, c.record.data_len), in_buffer_(unpacked, c.pos),
+        packed_(c.compression != "none") {}
+  const Bytes& bytes() const { return packed_ ? static_cast<const Bytes&>(in_buffer_) : in_place_; }
+
+ private:
+  FileBytes in_place_;
+  BufferBytes in_buffer_;
+  bool packed_;
+};
+
+// A chunk's data (unpacked: decompressed; empty when it is not compressed): every record in it,
+// and every message offset of the index on a message; then its messages on topics to on_message.
+void checkChunkData(std::ifstream& in, const Chunk& c, const std::vector<char>& unpacked,
                     const Connections& declared, const std::set<std::string>& topics,
                     const std::function<void(const BagMessage&)>& on_message) {
-  const FileBytes in_place(in, c.record.data_pos, c.record.data_len);
-  const BufferBytes in_buffer(data_if_packed, c.pos);
-  const Bytes& data = c.compression == "none" ? static_cast<const Bytes&>(in_place) : in_buffer;
+  const ChunkData chunk(in, c, unpacked);
+  const Bytes& data = chunk.bytes();
   const std::map<std::uint64_t, std::uint8_t> ops = chunkRecords(data, c.pos);
   // rosbag writes each offset at its message record. (Where one lands on a connection record,
   // rosbag reads on from inside that record's second header: a record to refuse too.)
@@ -352,7 +367,7 @@ struct BagWalk::Impl {
   Connections declared;
   std::vector<Chunk> chunks;
 
-  // The data of chunks ids (in[k] of ids[k]; empty where not compressed), the compressed ones
+  // The data of chunks ids (the k-th of ids[k]; empty where not compressed), the compressed ones
   // decompressed on the team; damage at the first (in the order of ids) that does not
   // decompress to its size.
   std::vector<std::vector<char>> unpack(const std::vector<std::size_t>& ids) {
@@ -495,14 +510,10 @@ void BagWalk::readMessages(const std::set<std::string>& topics,
       held.clear();
       for (std::size_t i = 0; i < ids.size(); ++i) held[ids[i]] = std::move(data[i]);
     }
-    const FileBytes in_place(impl_->in, c.record.data_pos, c.record.data_len);
-    const BufferBytes in_buffer(held[order[k].chunk], c.pos);
-    const Bytes& data = c.compression == "none" ? static_cast<const Bytes&>(in_place) : in_buffer;
-    const Record r = recordAt(data, order[k].offset, kOpMessageData, "a message");
-    bytes.resize(r.data_len);
-    data.read(r.data_pos, bytes.size(), reinterpret_cast<char*>(bytes.data()));
-    const Connection& conn = impl_->declared.at(order[k].conn);
-    if (!on_message({conn.topic, conn.datatype, conn.md5sum, order[k].time_ns, bytes.data(), bytes.size()})) return;
+    static const std::vector<char> in_file;
+    const ChunkData data(impl_->in, c, c.compression == "none" ? in_file : held.at(order[k].chunk));
+    const IndexEntry e{order[k].time_ns, order[k].offset, order[k].conn};
+    if (!on_message(messageAt(data.bytes(), e, impl_->declared.at(e.conn), bytes))) return;
   }
 }
 
