@@ -4,6 +4,7 @@
 // its index, and has bytes flipped at random; every read ends in its frames or in one
 // std::runtime_error that names the file, and never ends the process.
 #include "small_bag.h"
+#include "sanitizer.h"
 #include "temp_dir.h"
 
 #include "upd/ros1/bag_reader.h"
@@ -13,6 +14,8 @@
 
 #include <boost/make_shared.hpp>
 #include <gtest/gtest.h>
+
+#include <sys/resource.h>
 
 #include <cstdint>
 #include <cstring>
@@ -201,6 +204,32 @@ TEST(BagMessages, LengthsThatRunPastTheDataAreFound) {
   std::memset(many.data(), 0xff, 4);
   EXPECT_FALSE(ros1::detail::lengthsFit("tf2_msgs/TFMessage", many.data(), many.size()));
   EXPECT_TRUE(ros1::detail::lengthsFit("std_msgs/String", nullptr, 0));  // not walked
+}
+
+// A BZ2 chunk whose header claims 10^9 bytes of data: damage naming them, found with the pages the
+// decompressor wrote, not a gigabyte of zeroes first (the peak resident memory of this test's
+// process; not measured under ASan, whose allocator differs).
+TEST(BagDamageMemory, ChunkClaimingAGigabyteCostsWhatItHolds) {
+  const test::TempDir dir("bag_claim");
+  std::string bytes = writeBag(dir.file("good.bag"), rosbag::compression::BZ2);
+  const std::size_t chunk = bytes.find("compression=bz2");
+  ASSERT_NE(chunk, std::string::npos);
+  const std::size_t size_field = bytes.find("size=", chunk);
+  ASSERT_NE(size_field, std::string::npos);
+  const std::uint32_t claim = 1'000'000'000;
+  std::memcpy(&bytes[size_field + 5], &claim, 4);
+  const std::string bad = dir.file("bad.bag");
+  write(bad, bytes);
+  rusage before{};
+  getrusage(RUSAGE_SELF, &before);
+  std::string error;
+  ASSERT_EQ(framesOf(bad, error), -1);
+  EXPECT_NE(error.find("does not decompress to its 1000000000 bytes"), std::string::npos) << error;
+#ifndef UPD_TEST_UNDER_ASAN
+  rusage after{};
+  getrusage(RUSAGE_SELF, &after);
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 256 * 1024) << "kB more at the peak";
+#endif
 }
 
 // A connection whose type names another message than its MD5 sum does (found by fuzz_bag: the

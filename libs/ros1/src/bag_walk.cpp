@@ -11,9 +11,12 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <tuple>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace upd::ros1::detail {
@@ -32,6 +35,28 @@ constexpr std::uint8_t kOpConnection = 0x07;
 constexpr std::uint32_t kMaxHeaderBytes = 1u << 24;
 // rosbag closes a chunk at 768 kB by default; a chunk holds at least one whole message.
 constexpr std::uint32_t kMaxChunkBytes = 1u << 30;
+
+// A chunk's decompressed data, left uninitialized until the decompressor writes it: a damaged
+// chunk that claims up to 1 GB costs the pages written before the damage is found, not 1 GB.
+template <class T>
+struct Uninitialized : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = Uninitialized<U>;
+  };
+  Uninitialized() = default;
+  template <class U>
+  Uninitialized(const Uninitialized<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... A>
+  void construct(U* p, A&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<A>(args)...);
+  }
+};
+using ChunkBuffer = std::vector<char, Uninitialized<char>>;
 
 [[noreturn]] void damage(const std::string& what, std::uint64_t byte) {
   throw BagDamage(what + " (byte " + std::to_string(byte) + ")");
@@ -68,7 +93,7 @@ class FileBytes : public Bytes {
 
 class BufferBytes : public Bytes {
  public:
-  BufferBytes(const std::vector<char>& data, std::uint64_t chunk_byte)
+  BufferBytes(const ChunkBuffer& data, std::uint64_t chunk_byte)
       : data_(data), chunk_byte_(chunk_byte) {}
   std::uint64_t size() const override { return data_.size(); }
   bool read(std::uint64_t pos, std::size_t n, char* out) const override {
@@ -79,7 +104,7 @@ class BufferBytes : public Bytes {
   std::uint64_t fileByte(std::uint64_t) const override { return chunk_byte_; }
 
  private:
-  const std::vector<char>& data_;
+  const ChunkBuffer& data_;
   std::uint64_t chunk_byte_;
 };
 
@@ -174,7 +199,7 @@ struct ChunkInfo {
 // size bytes): false where it does not decompress to exactly that. Safe on several threads at
 // once (libbz2 and roslz4 keep no state between calls).
 bool decompress(const std::vector<char>& in, const std::string& compression, std::uint32_t size,
-                std::vector<char>& out) {
+                ChunkBuffer& out) {
   out.resize(size);
   unsigned int out_len = size;
   const bool ok =
@@ -328,7 +353,7 @@ Chunk chunkAt(const Bytes& file, const ChunkInfo& info, const Connections& decla
 // A chunk's data: in place in the file when it is not compressed, else its decompressed bytes.
 class ChunkData {
  public:
-  ChunkData(std::ifstream& in, const Chunk& c, const std::vector<char>& unpacked)
+  ChunkData(std::ifstream& in, const Chunk& c, const ChunkBuffer& unpacked)
       : in_place_(in, c.record.data_pos, c.record.data_len), in_buffer_(unpacked, c.pos),
         packed_(c.compression != "none") {}
   const Bytes& bytes() const { return packed_ ? static_cast<const Bytes&>(in_buffer_) : in_place_; }
@@ -341,7 +366,7 @@ class ChunkData {
 
 // A chunk's data (unpacked: decompressed; empty when it is not compressed): every record in it,
 // and every message offset of the index on a message; then its messages on topics to on_message.
-void checkChunkData(std::ifstream& in, const Chunk& c, const std::vector<char>& unpacked,
+void checkChunkData(std::ifstream& in, const Chunk& c, const ChunkBuffer& unpacked,
                     const Connections& declared, const std::set<std::string>& topics,
                     const std::function<void(const BagMessage&)>& on_message) {
   const ChunkData chunk(in, c, unpacked);
@@ -370,9 +395,10 @@ struct BagWalk::Impl {
   // The data of chunks ids (the k-th of ids[k]; empty where not compressed), the compressed ones
   // decompressed on the team; damage at the first (in the order of ids) that does not
   // decompress to its size.
-  std::vector<std::vector<char>> unpack(const std::vector<std::size_t>& ids) {
+  std::vector<ChunkBuffer> unpack(const std::vector<std::size_t>& ids) {
     const FileBytes file(in, 0, file_size);
-    std::vector<std::vector<char>> packed(ids.size()), data(ids.size());
+    std::vector<std::vector<char>> packed(ids.size());
+    std::vector<ChunkBuffer> data(ids.size());
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const Record& r = chunks[ids[k]].record;
       if (chunks[ids[k]].compression == "none") continue;
@@ -463,7 +489,7 @@ void BagWalk::checkChunks(const std::set<std::string>& topics,
       ids.push_back(ids.back() + 1);
       bytes += chunks[ids.back()].size;
     }
-    const std::vector<std::vector<char>> data = impl_->unpack(ids);
+    const std::vector<ChunkBuffer> data = impl_->unpack(ids);
     for (std::size_t k = 0; k < ids.size(); ++k) {
       checkChunkData(impl_->in, chunks[ids[k]], data[k], impl_->declared, topics, on_message);
     }
@@ -489,7 +515,7 @@ void BagWalk::readMessages(const std::set<std::string>& topics,
   std::sort(order.begin(), order.end(), [](const At& a, const At& b) {
     return std::tie(a.time_ns, a.chunk, a.offset) < std::tie(b.time_ns, b.chunk, b.offset);
   });
-  std::map<std::size_t, std::vector<char>> held;  // the decompressed chunks of the batch
+  std::map<std::size_t, ChunkBuffer> held;  // the decompressed chunks of the batch
   std::vector<std::uint8_t> bytes;
   for (std::size_t k = 0; k < order.size(); ++k) {
     const Chunk& c = chunks[order[k].chunk];
@@ -506,11 +532,11 @@ void BagWalk::readMessages(const std::set<std::string>& topics,
         picked.insert(id);
         total += chunks[id].size;
       }
-      std::vector<std::vector<char>> data = impl_->unpack(ids);
+      std::vector<ChunkBuffer> data = impl_->unpack(ids);
       held.clear();
       for (std::size_t i = 0; i < ids.size(); ++i) held[ids[i]] = std::move(data[i]);
     }
-    static const std::vector<char> in_file;
+    static const ChunkBuffer in_file;
     const ChunkData data(impl_->in, c, c.compression == "none" ? in_file : held.at(order[k].chunk));
     const IndexEntry e{order[k].time_ns, order[k].offset, order[k].conn};
     if (!on_message(messageAt(data.bytes(), e, impl_->declared.at(e.conn), bytes))) return;
