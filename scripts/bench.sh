@@ -8,7 +8,8 @@
 # timings are then run again with OMP_WAIT_POLICY=passive (threads sleep at once: the setting
 # for a machine shared with other jobs) into out/bench-passive.json, since the second core's
 # gain depends on it. Last, `upd playback` of the demo run with the paper's config against the
-# realtime one (scripts/bench-playback.sh, out/bench-playback.json).
+# realtime one (scripts/bench-playback.sh, out/bench-playback.json); with ROS 1, the read of a
+# bag against rosbag's own reader (bench/upd_bag_bench, out/bench-bag.json).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 mkdir -p "$UPD_ROOT/out"
@@ -21,3 +22,8 @@ OMP_WAIT_POLICY=passive "$UPD_BUILD/bench/upd_bench" --data "$UPD_ROOT/../shared
 echo
 echo "upd playback of the demo run, config/dune-kinect.ini against config/dune-kinect-realtime.ini:"
 "$UPD_ROOT/scripts/bench-playback.sh"
+if [ -x "$UPD_BUILD/bench/upd_bag_bench" ]; then
+  echo
+  echo "Reading a ROS 1 bag as upd playback RUN.bag does, against rosbag's own reader:"
+  "$UPD_BUILD/bench/upd_bag_bench" --json "$UPD_ROOT/out/bench-bag.json"
+fi

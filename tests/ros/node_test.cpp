@@ -39,16 +39,6 @@ using namespace upd;
 
 const std::string kConfigDir = std::string(UPD_SOURCE_DIR) + "/config";
 
-geometry_msgs::TransformStamped stamped(const Eigen::Isometry3d& p, const std::string& parent,
-                                        const std::string& child, const ros::Time& t) {
-  geometry_msgs::TransformStamped s;
-  s.header.frame_id = parent;
-  s.header.stamp = t;
-  s.child_frame_id = child;
-  s.transform = ros1::transformFromIsometry(p);
-  return s;
-}
-
 // `upd ros` as a child process, with private parameters as remappings.
 std::unique_ptr<test::Child> startNode(const test::RosMasterOnLoopback& master,
                                        std::vector<std::string> extra) {
@@ -138,7 +128,7 @@ class RosNode : public ::testing::Test {
   }
   void publishOdom(const Eigen::Isometry3d& pose, double v, double w, const ros::Time& t) {
     if (!tf) tf = std::make_unique<tf2_ros::TransformBroadcaster>();
-    tf->sendTransform(stamped(pose, "odom", "base_link", t));
+    tf->sendTransform(ros1::stampedTransform(pose, "odom", "base_link", t));
     nav_msgs::Odometry o;
     o.header.frame_id = "odom";
     o.header.stamp = t;
@@ -165,7 +155,8 @@ class RosNode : public ::testing::Test {
   }
   void sendStatic(const Eigen::Isometry3d& base_camera) {
     static_tf = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
-    static_tf->sendTransform(stamped(base_camera, "base_link", "camera_optical", ros::Time::now()));
+    static_tf->sendTransform(
+        ros1::stampedTransform(base_camera, "base_link", "camera_optical", ros::Time::now()));
   }
 
   static std::unique_ptr<test::RosMasterOnLoopback> master;

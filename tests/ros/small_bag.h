@@ -16,12 +16,7 @@ namespace upd::test {
 
 inline geometry_msgs::TransformStamped stamped(const Eigen::Isometry3d& pose, const std::string& parent,
                                                const std::string& child, double t) {
-  geometry_msgs::TransformStamped s;
-  s.header.frame_id = parent;
-  s.header.stamp = ros::Time(t);
-  s.child_frame_id = child;
-  s.transform = ros1::transformFromIsometry(pose);
-  return s;
+  return ros1::stampedTransform(pose, parent, child, ros::Time(t));
 }
 
 struct SmallBag {

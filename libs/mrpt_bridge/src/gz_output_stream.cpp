@@ -13,17 +13,19 @@ namespace upd::mrpt_bridge {
 
 namespace {
 
-// data as one gzip member deflated at level; false where zlib fails.
-bool gzipMember(const char* data, std::size_t size, int level, std::vector<unsigned char>& out) {
+// data as one gzip member deflated at level into out (its size set to the member's; grown, and
+// left uninitialized, where it is short); false where zlib fails.
+bool gzipMember(const char* data, std::size_t size, int level, GzOutputStream::Member& out) {
   z_stream s{};
   if (deflateInit2(&s, level, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) return false;
-  out.resize(deflateBound(&s, static_cast<uLong>(size)));
+  const std::size_t bound = deflateBound(&s, static_cast<uLong>(size));
+  if (out.capacity < bound) out.bytes.reset(new unsigned char[out.capacity = bound]);
   s.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data));
   s.avail_in = static_cast<uInt>(size);
-  s.next_out = out.data();
-  s.avail_out = static_cast<uInt>(out.size());
+  s.next_out = out.bytes.get();
+  s.avail_out = static_cast<uInt>(bound);
   const bool done = deflate(&s, Z_FINISH) == Z_STREAM_END;
-  out.resize(s.total_out);
+  out.size = s.total_out;
   deflateEnd(&s);
   return done;
 }
@@ -52,17 +54,18 @@ size_t GzOutputStream::Write(const void* buffer, size_t count) {
 void GzOutputStream::flushMembers() {
   // (An empty stream is one empty member: a gzip file as gzip and CFileGZOutputStream write it.)
   const std::size_t members = std::max<std::size_t>(1, (pending_.size() + member_bytes_ - 1) / member_bytes_);
-  std::vector<std::vector<unsigned char>> packed(members);
+  if (packed_.size() < members) packed_.resize(members);
   std::vector<char> sound(members, 1);
 #pragma omp parallel for schedule(dynamic) if (members > 1)
   for (std::ptrdiff_t m = 0; m < static_cast<std::ptrdiff_t>(members); ++m) {
     const std::size_t from = static_cast<std::size_t>(m) * member_bytes_;
     const std::size_t n = std::min(member_bytes_, pending_.size() - from);
-    sound[m] = gzipMember(pending_.data() + from, n, level_, packed[m]);
+    sound[m] = gzipMember(pending_.data() + from, n, level_, packed_[m]);
   }
   for (std::size_t m = 0; m < members; ++m) {
     if (!sound[m]) throw std::runtime_error("cannot compress the data of " + path_);
-    out_.write(reinterpret_cast<const char*>(packed[m].data()), static_cast<std::streamsize>(packed[m].size()));
+    out_.write(reinterpret_cast<const char*>(packed_[m].bytes.get()),
+               static_cast<std::streamsize>(packed_[m].size));
   }
   if (!out_) throw std::runtime_error("cannot write " + path_);
   pending_.clear();

@@ -71,6 +71,8 @@ class Bytes {
   virtual bool read(std::uint64_t pos, std::size_t n, char* out) const = 0;
   /// The byte of the file a position stands for (for the messages).
   virtual std::uint64_t fileByte(std::uint64_t pos) const = 0;
+  /// The n bytes at pos where they are in memory (null where they are to be read), all there.
+  virtual const char* view(std::uint64_t, std::size_t) const { return nullptr; }
 };
 
 class FileBytes : public Bytes {
@@ -102,6 +104,9 @@ class BufferBytes : public Bytes {
     return true;
   }
   std::uint64_t fileByte(std::uint64_t) const override { return chunk_byte_; }
+  const char* view(std::uint64_t pos, std::size_t n) const override {
+    return pos <= data_.size() && n <= data_.size() - pos ? data_.data() + pos : nullptr;
+  }
 
  private:
   const ChunkBuffer& data_;
@@ -198,7 +203,7 @@ struct ChunkInfo {
 // A compressed chunk's data, decompressed as rosbag decompresses it (BZ2 or LZ4) into out (its
 // size bytes): false where it does not decompress to exactly that. Safe on several threads at
 // once (libbz2 and roslz4 keep no state between calls).
-bool decompress(const std::vector<char>& in, const std::string& compression, std::uint32_t size,
+bool decompress(const ChunkBuffer& in, const std::string& compression, std::uint32_t size,
                 ChunkBuffer& out) {
   out.resize(size);
   unsigned int out_len = size;
@@ -299,13 +304,17 @@ std::vector<IndexEntry> messageIndex(const Bytes& file, std::uint64_t p, std::si
   return entries;
 }
 
-// The message e of a checked chunk's data, its bytes read into bytes.
-BagMessage messageAt(const Bytes& data, const IndexEntry& e, const Connection& c,
-                     std::vector<std::uint8_t>& bytes) {
+// The message e of a checked chunk's data: its bytes where they are in memory, else read into
+// bytes.
+BagMessage messageAt(const Bytes& data, const IndexEntry& e, const Connection& c, ChunkBuffer& bytes) {
   const Record r = recordAt(data, e.offset, kOpMessageData, "a message");
-  bytes.resize(r.data_len);
-  data.read(r.data_pos, bytes.size(), reinterpret_cast<char*>(bytes.data()));
-  return {c.topic, c.datatype, c.md5sum, e.time_ns, bytes.data(), bytes.size()};
+  const char* at = data.view(r.data_pos, r.data_len);  // in a decompressed chunk: no copy
+  if (!at) {
+    bytes.resize(r.data_len);
+    data.read(r.data_pos, bytes.size(), bytes.data());
+    at = bytes.data();
+  }
+  return {c.topic, c.datatype, c.md5sum, e.time_ns, reinterpret_cast<const std::uint8_t*>(at), r.data_len};
 }
 
 // The messages of a checked chunk on the topics asked for, to on_message in order of time.
@@ -317,7 +326,7 @@ void handMessages(const Bytes& data, std::vector<IndexEntry> entries, const Conn
   std::sort(entries.begin(), entries.end(), [](const IndexEntry& a, const IndexEntry& b) {
     return a.time_ns != b.time_ns ? a.time_ns < b.time_ns : a.offset < b.offset;
   });
-  std::vector<std::uint8_t> bytes;
+  ChunkBuffer bytes;
   for (const IndexEntry& e : entries) on_message(messageAt(data, e, declared.at(e.conn), bytes));
 }
 
@@ -392,15 +401,19 @@ struct BagWalk::Impl {
   Connections declared;
   std::vector<Chunk> chunks;
 
-  // The data of chunks ids (the k-th of ids[k]; empty where not compressed), the compressed ones
-  // decompressed on the team; damage at the first (in the order of ids) that does not
-  // decompress to its size.
-  std::vector<ChunkBuffer> unpack(const std::vector<std::size_t>& ids) {
+  // The buffers of a batch, kept from batch to batch: a buffer that is written again is not
+  // mapped and cleared by the kernel again.
+  std::vector<ChunkBuffer> packed, unpacked;
+
+  // The data of chunks ids in unpacked (the k-th of ids[k]; empty where not compressed), the
+  // compressed ones decompressed on the team; damage at the first (in the order of ids) that
+  // does not decompress to its size.
+  void unpack(const std::vector<std::size_t>& ids) {
     const FileBytes file(in, 0, file_size);
-    std::vector<std::vector<char>> packed(ids.size());
-    std::vector<ChunkBuffer> data(ids.size());
+    if (packed.size() < ids.size()) packed.resize(ids.size()), unpacked.resize(ids.size());
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const Record& r = chunks[ids[k]].record;
+      unpacked[k].clear();
       if (chunks[ids[k]].compression == "none") continue;
       packed[k].resize(r.data_len);
       file.read(r.data_pos, r.data_len, packed[k].data());
@@ -409,7 +422,7 @@ struct BagWalk::Impl {
 #pragma omp parallel for schedule(dynamic) if (ids.size() > 1)
     for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(ids.size()); ++k) {
       const Chunk& c = chunks[ids[static_cast<std::size_t>(k)]];
-      if (c.compression != "none") sound[k] = decompress(packed[k], c.compression, c.size, data[k]);
+      if (c.compression != "none") sound[k] = decompress(packed[k], c.compression, c.size, unpacked[k]);
     }
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const Chunk& c = chunks[ids[k]];
@@ -419,7 +432,6 @@ struct BagWalk::Impl {
                c.pos);
       }
     }
-    return data;
   }
 };
 
@@ -489,9 +501,9 @@ void BagWalk::checkChunks(const std::set<std::string>& topics,
       ids.push_back(ids.back() + 1);
       bytes += chunks[ids.back()].size;
     }
-    const std::vector<ChunkBuffer> data = impl_->unpack(ids);
+    impl_->unpack(ids);
     for (std::size_t k = 0; k < ids.size(); ++k) {
-      checkChunkData(impl_->in, chunks[ids[k]], data[k], impl_->declared, topics, on_message);
+      checkChunkData(impl_->in, chunks[ids[k]], impl_->unpacked[k], impl_->declared, topics, on_message);
     }
     first = ids.back() + 1;
   }
@@ -515,29 +527,28 @@ void BagWalk::readMessages(const std::set<std::string>& topics,
   std::sort(order.begin(), order.end(), [](const At& a, const At& b) {
     return std::tie(a.time_ns, a.chunk, a.offset) < std::tie(b.time_ns, b.chunk, b.offset);
   });
-  std::map<std::size_t, ChunkBuffer> held;  // the decompressed chunks of the batch
-  std::vector<std::uint8_t> bytes;
+  std::map<std::size_t, std::size_t> held;  // a chunk of the batch -> its buffer in unpacked
+  ChunkBuffer bytes;
   for (std::size_t k = 0; k < order.size(); ++k) {
     const Chunk& c = chunks[order[k].chunk];
     if (c.compression != "none" && !held.count(order[k].chunk)) {
       // The next compressed chunks the messages need, up to batch_bytes (one at least).
       std::vector<std::size_t> ids;
-      std::set<std::size_t> picked;
       std::uint64_t total = 0;
+      held.clear();
       for (std::size_t j = k; j < order.size(); ++j) {
         const std::size_t id = order[j].chunk;
-        if (chunks[id].compression == "none" || picked.count(id)) continue;
+        if (chunks[id].compression == "none" || held.count(id)) continue;
         if (!ids.empty() && total + chunks[id].size > batch_bytes) break;
+        held[id] = ids.size();
         ids.push_back(id);
-        picked.insert(id);
         total += chunks[id].size;
       }
-      std::vector<ChunkBuffer> data = impl_->unpack(ids);
-      held.clear();
-      for (std::size_t i = 0; i < ids.size(); ++i) held[ids[i]] = std::move(data[i]);
+      impl_->unpack(ids);
     }
     static const ChunkBuffer in_file;
-    const ChunkData data(impl_->in, c, c.compression == "none" ? in_file : held.at(order[k].chunk));
+    const ChunkData data(impl_->in, c,
+                         c.compression == "none" ? in_file : impl_->unpacked[held.at(order[k].chunk)]);
     const IndexEntry e{order[k].time_ns, order[k].offset, order[k].conn};
     if (!on_message(messageAt(data.bytes(), e, impl_->declared.at(e.conn), bytes))) return;
   }

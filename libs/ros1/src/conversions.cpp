@@ -293,6 +293,17 @@ Eigen::Isometry3d isometryFromTransform(const geometry_msgs::Transform& t) {
   return pose;
 }
 
+geometry_msgs::TransformStamped stampedTransform(const Eigen::Isometry3d& pose,
+                                                 const std::string& parent_frame,
+                                                 const std::string& child_frame, const ros::Time& stamp) {
+  geometry_msgs::TransformStamped s;
+  s.header.frame_id = parent_frame;
+  s.header.stamp = stamp;
+  s.child_frame_id = child_frame;
+  s.transform = transformFromIsometry(pose);
+  return s;
+}
+
 geometry_msgs::Transform transformFromIsometry(const Eigen::Isometry3d& pose) {
   geometry_msgs::Transform t;
   const Eigen::Quaterniond q(pose.linear());

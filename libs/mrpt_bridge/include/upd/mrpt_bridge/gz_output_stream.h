@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,12 @@ class GzOutputStream : public mrpt::io::CStream {
   uint64_t getTotalBytesCount() const override { return written_; }
   uint64_t getPosition() const override { return written_; }
 
+  /// A deflated member's bytes, kept from batch to batch (not cleared again by the kernel).
+  struct Member {
+    std::unique_ptr<unsigned char[]> bytes;
+    std::size_t capacity = 0, size = 0;
+  };
+
  private:
   /// Deflates the members buffered (on every core) and writes them in order.
   void flushMembers();
@@ -44,6 +51,7 @@ class GzOutputStream : public mrpt::io::CStream {
   std::size_t member_bytes_;
   std::size_t batch_members_;
   std::vector<char> pending_;  ///< data not yet deflated
+  std::vector<Member> packed_;
   std::uint64_t written_ = 0;  ///< bytes of data taken
 };
 

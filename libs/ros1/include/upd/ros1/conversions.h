@@ -22,6 +22,7 @@
 
 #include <Eigen/Geometry>
 #include <geometry_msgs/Transform.h>
+#include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/CompressedImage.h>
@@ -105,5 +106,9 @@ visualization_msgs::MarkerArray routeMarkers(const std::vector<Eigen::Vector2d>&
 
 Eigen::Isometry3d isometryFromTransform(const geometry_msgs::Transform& t);
 geometry_msgs::Transform transformFromIsometry(const Eigen::Isometry3d& pose);
+/// pose (child_frame in parent_frame) as the transform tf publishes, stamped at stamp.
+geometry_msgs::TransformStamped stampedTransform(const Eigen::Isometry3d& pose,
+                                                 const std::string& parent_frame,
+                                                 const std::string& child_frame, const ros::Time& stamp);
 
 }  // namespace upd::ros1
