@@ -12,17 +12,10 @@
 // Medians over the runs, ours and the peer in turn. Printed, and written as JSON with --json.
 //
 // Usage: upd_bag_bench [--frames N (100)] [--repeats N (7)] [--json OUT.json]
-#include "upd/mrpt_bridge/gz_output_stream.h"
-#include "upd/ros1/bag_reader.h"
-#include "upd/ros1/conversions.h"
-#include "upd/sim/render.h"
-#include "upd/sim/world_generator.h"
-
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/serialization/CArchive.h>
-#include <nlohmann/json.hpp>
 #include <omp.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -36,8 +29,15 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include "upd/mrpt_bridge/gz_output_stream.h"
+#include "upd/ros1/bag_reader.h"
+#include "upd/ros1/conversions.h"
+#include "upd/sim/render.h"
+#include "upd/sim/world_generator.h"
 
 namespace {
 
@@ -138,7 +138,8 @@ std::vector<double> medians(const std::vector<std::function<void()>>& candidates
 
 // The frames as `upd playback` converts them: CObservation3DRangeScan in millimetres, each
 // serialized.
-std::vector<std::vector<std::uint8_t>> serializedScans(const std::vector<core::DepthImage>& frames) {
+std::vector<std::vector<std::uint8_t>> serializedScans(
+    const std::vector<core::DepthImage>& frames) {
   std::vector<std::vector<std::uint8_t>> all;
   for (const core::DepthImage& d : frames) {
     mrpt::obs::CObservation3DRangeScan obs;
@@ -148,7 +149,8 @@ std::vector<std::vector<std::uint8_t>> serializedScans(const std::vector<core::D
     for (int v = 0; v < d.height; ++v) {
       for (int u = 0; u < d.width; ++u) {
         const float z = d.depth_m[static_cast<std::size_t>(v) * d.width + u];
-        obs.rangeImage(v, u) = std::isfinite(z) && z > 0 ? static_cast<std::uint16_t>(z * 1000.f + 0.5f) : 0;
+        obs.rangeImage(v, u) =
+            std::isfinite(z) && z > 0 ? static_cast<std::uint16_t>(z * 1000.f + 0.5f) : 0;
       }
     }
     mrpt::io::CMemoryStream mem;
@@ -177,11 +179,14 @@ int run(int n_frames, int repeats, const std::string& json_path) {
       std::filesystem::temp_directory_path() / ("upd_bag_bench-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   json report = {{"frames", n_frames}, {"repeats", repeats}, {"threads", threads}};
-  std::printf("upd_bag_bench: %d frames of 640 x 480, medians of %d runs, ms a frame\n", n_frames, repeats);
-  std::printf("%-6s %10s %12s %12s %14s %10s\n", "chunks", "bag MB", "ours, 1 core", "ours, 2", "rosbag's reader", "rosbag / ours (2)");
+  std::printf("upd_bag_bench: %d frames of 640 x 480, medians of %d runs, ms a frame\n", n_frames,
+              repeats);
+  std::printf("%-6s %10s %12s %12s %14s %10s\n", "chunks", "bag MB", "ours, 1 core", "ours, 2",
+              "rosbag's reader", "rosbag / ours (2)");
   for (const auto& [name, compression] :
        std::vector<std::pair<std::string, rosbag::compression::CompressionType>>{
-           {"none", rosbag::compression::Uncompressed}, {"lz4", rosbag::compression::LZ4},
+           {"none", rosbag::compression::Uncompressed},
+           {"lz4", rosbag::compression::LZ4},
            {"bz2", rosbag::compression::BZ2}}) {
     const std::string path = (dir / (name + ".bag")).string();
     writeBag(path, compression, frames, K);
@@ -193,10 +198,11 @@ int run(int n_frames, int repeats, const std::string& json_path) {
         omp_set_num_threads(threads);
       };
     };
-    const std::vector<double> m = medians({ours(1), ours(threads), [&] { peer_frames = readByRosbag(path); }}, repeats);
+    const std::vector<double> m =
+        medians({ours(1), ours(threads), [&] { peer_frames = readByRosbag(path); }}, repeats);
     const double mb = static_cast<double>(std::filesystem::file_size(path)) / 1e6;
-    std::printf("%-6s %10.1f %12.2f %12.2f %14.2f %10.2f\n", name.c_str(), mb, m[0] / n_frames, m[1] / n_frames,
-                m[2] / n_frames, m[2] / m[1]);
+    std::printf("%-6s %10.1f %12.2f %12.2f %14.2f %10.2f\n", name.c_str(), mb, m[0] / n_frames,
+                m[1] / n_frames, m[2] / n_frames, m[2] / m[1]);
     report["read"][name] = {{"bag_mb", mb},
                             {"ours_one_core_ms_per_frame", m[0] / n_frames},
                             {"ours_all_cores_ms_per_frame", m[1] / n_frames},
@@ -217,14 +223,16 @@ int run(int n_frames, int repeats, const std::string& json_path) {
       omp_set_num_threads(threads);
     };
   };
-  const std::vector<double> w = medians({gz(1), gz(threads), [&] {
+  const std::vector<double> w = medians({gz(1), gz(threads),
+                                         [&] {
                                            mrpt::io::CFileGZOutputStream out(rawlog);
                                            writeFrames(out, scans);
                                          }},
                                         repeats);
-  std::printf("\nthe converted frames' rawlog (%.1f MB serialized), ms a frame: GzOutputStream %.2f "
-              "(1 core) / %.2f (%d), CFileGZOutputStream %.2f: %.2fx\n",
-              serialized_mb, w[0] / n_frames, w[1] / n_frames, threads, w[2] / n_frames, w[2] / w[1]);
+  std::printf(
+      "\nthe converted frames' rawlog (%.1f MB serialized), ms a frame: GzOutputStream %.2f "
+      "(1 core) / %.2f (%d), CFileGZOutputStream %.2f: %.2fx\n",
+      serialized_mb, w[0] / n_frames, w[1] / n_frames, threads, w[2] / n_frames, w[2] / w[1]);
   report["rawlog_write"] = {{"serialized_mb", serialized_mb},
                             {"ours_one_core_ms_per_frame", w[0] / n_frames},
                             {"ours_all_cores_ms_per_frame", w[1] / n_frames},

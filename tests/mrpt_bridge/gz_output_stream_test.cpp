@@ -1,8 +1,6 @@
 // GzOutputStream: the data written comes back byte for byte through MRPT's CFileGZInputStream
 // (what rawlog readers use) and through gzip, in members of any size, batch after batch; an empty
 // stream is a valid gzip file; a path that cannot be written is named.
-#include "temp_dir.h"
-
 #include "upd/mrpt_bridge/gz_output_stream.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +10,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "temp_dir.h"
 
 namespace {
 
@@ -39,7 +39,8 @@ TEST(GzOutputStream, WritesWhatGzipReadersReadBack) {
     const std::string path = dir.file("data-" + std::to_string(member_bytes) + ".gz");
     const std::vector<char> data = someData(250'000);
     GzOutputStream out(path, 1, member_bytes);
-    for (std::size_t at = 0, piece = 1; at < data.size(); at += piece, piece = piece * 3 % 1999 + 1) {
+    for (std::size_t at = 0, piece = 1; at < data.size();
+         at += piece, piece = piece * 3 % 1999 + 1) {
       piece = std::min(piece, data.size() - at);
       ASSERT_EQ(out.Write(data.data() + at, piece), piece);
     }

@@ -6,27 +6,24 @@
 // chunks, a static transform of the camera written twice, in chunks far apart, the later in time
 // written first (it replaces the earlier one), and a robot pose written twice at one stamp by
 // two publishers, the earlier in time written second (tf2 keeps the first it is given).
-#include "small_bag.h"
-#include "temp_dir.h"
-
-#include "upd/ros1/bag_reader.h"
-#include "upd/ros1/conversions.h"
-
-#include "../../libs/ros1/src/bag_walk.h"
-
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <tf2/buffer_core.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include <boost/make_shared.hpp>
-
 #include <algorithm>
+#include <boost/make_shared.hpp>
 #include <cstdint>
 #include <set>
 #include <string>
 #include <vector>
+
+#include "../../libs/ros1/src/bag_walk.h"
+#include "small_bag.h"
+#include "temp_dir.h"
+#include "upd/ros1/bag_reader.h"
+#include "upd/ros1/conversions.h"
 
 namespace {
 
@@ -46,9 +43,9 @@ tf2_msgs::TFMessage one(const Eigen::Isometry3d& pose, const std::string& parent
 }
 
 // Ten small depth frames at t = 1..10 s in chunks of about 1 kB (then, for a second recording,
-// five at t = 0.1..0.5 s), the robot 0.1 m further along x at each; the camera's mount at bag time 2 s (z 0.5, written first) and 1 s (z 0.3, written
-// after the 6th frame); at 4 s a second publisher's robot pose (x 7) with an earlier bag time than
-// the first's (x 0.3), written after it.
+// five at t = 0.1..0.5 s), the robot 0.1 m further along x at each; the camera's mount at bag time
+// 2 s (z 0.5, written first) and 1 s (z 0.3, written after the 6th frame); at 4 s a second
+// publisher's robot pose (x 7) with an earlier bag time than the first's (x 0.3), written after it.
 void writeBag(const std::string& path, rosbag::compression::CompressionType compression,
               bool second_recording = false) {
   rosbag::Bag bag(path, rosbag::bagmode::Write);
@@ -69,8 +66,10 @@ void writeBag(const std::string& path, rosbag::compression::CompressionType comp
       {"message_definition", ros::message_traits::definition<tf2_msgs::TFMessage>()}});
   for (int i = 1; i <= 10; ++i) {
     bag.write("/tf", ros::Time(i + 0.02), one(along(0.1 * (i - 1)), "map", "base_link", i));
-    if (i == 4) bag.write("/tf", ros::Time(i + 0.01), one(along(7.0), "map", "base_link", i), other);
-    if (i == 6) bag.write("/tf_static", ros::Time(1.0), one(along(0.0, 0.3), "base_link", "camera", 1.0));
+    if (i == 4)
+      bag.write("/tf", ros::Time(i + 0.01), one(along(7.0), "map", "base_link", i), other);
+    if (i == 6)
+      bag.write("/tf_static", ros::Time(1.0), one(along(0.0, 0.3), "base_link", "camera", 1.0));
     info.header.stamp = image.header.stamp = ros::Time(i);
     bag.write("/camera/depth/camera_info", ros::Time(i + 0.03), info);
     bag.write("/camera/depth/image_raw", ros::Time(i + 0.04), image);
@@ -106,14 +105,18 @@ TEST_P(BagOrder, TransformsAreRosbagsViewOfThem) {
   ASSERT_EQ(frames.size(), 10u);
   for (const ros1::BagFrame& f : frames) {
     const ros::Time stamp(f.stamp_s);
-    const auto mount = ros1::isometryFromTransform(tf.lookupTransform("base_link", "camera", stamp).transform);
-    const auto robot = ros1::isometryFromTransform(tf.lookupTransform("map", "base_link", stamp).transform);
+    const auto mount =
+        ros1::isometryFromTransform(tf.lookupTransform("base_link", "camera", stamp).transform);
+    const auto robot =
+        ros1::isometryFromTransform(tf.lookupTransform("map", "base_link", stamp).transform);
     EXPECT_TRUE(f.pose_base_sensor.isApprox(mount, 1e-12)) << "frame at " << f.stamp_s;
     ASSERT_TRUE(f.pose_world_base.has_value());
     EXPECT_TRUE(f.pose_world_base->isApprox(robot, 1e-12)) << "frame at " << f.stamp_s;
   }
-  EXPECT_DOUBLE_EQ(frames[0].pose_base_sensor.translation().z(), 0.5) << "the mount of the later time";
-  EXPECT_DOUBLE_EQ(frames[3].pose_world_base->translation().x(), 7.0) << "the pose of the earlier time";
+  EXPECT_DOUBLE_EQ(frames[0].pose_base_sensor.translation().z(), 0.5)
+      << "the mount of the later time";
+  EXPECT_DOUBLE_EQ(frames[3].pose_world_base->translation().x(), 7.0)
+      << "the pose of the earlier time";
   EXPECT_DOUBLE_EQ(frames[4].pose_world_base->translation().x(), 0.4);
 }
 
@@ -153,13 +156,18 @@ TEST_P(BagOrder, MessagesComeAsRosbagsView) {
   walk.checkChunks();
   const std::set<std::string> topics{"/tf", "/tf_static", "/camera/depth/camera_info",
                                      "/camera/depth/image_raw"};
-  for (const std::uint64_t batch : {std::uint64_t{0}, std::uint64_t{2000}, ros1::detail::BagWalk::kBatchBytes}) {
+  for (const std::uint64_t batch :
+       {std::uint64_t{0}, std::uint64_t{2000}, ros1::detail::BagWalk::kBatchBytes}) {
     std::vector<Read> read;
-    walk.readMessages(topics, [&](const ros1::detail::BagMessage& m) {
-      read.push_back({m.topic, m.time_ns, std::vector<std::uint8_t>(m.data, m.data + m.size)});
-      return true;
-    }, batch);
-    EXPECT_TRUE(read == expected) << "batches of " << batch << " bytes: " << read.size() << " messages";
+    walk.readMessages(
+        topics,
+        [&](const ros1::detail::BagMessage& m) {
+          read.push_back({m.topic, m.time_ns, std::vector<std::uint8_t>(m.data, m.data + m.size)});
+          return true;
+        },
+        batch);
+    EXPECT_TRUE(read == expected) << "batches of " << batch << " bytes: " << read.size()
+                                  << " messages";
   }
   std::vector<double> stamps;
   ros1::readBag(path, {}, [&](const ros1::BagFrame& f) { stamps.push_back(f.stamp_s); });

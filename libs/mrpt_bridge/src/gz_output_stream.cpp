@@ -33,7 +33,9 @@ bool gzipMember(const char* data, std::size_t size, int level, GzOutputStream::M
 }  // namespace
 
 GzOutputStream::GzOutputStream(const std::string& path, int level, std::size_t member_bytes)
-    : path_(path), out_(path, std::ios::binary | std::ios::trunc), level_(level),
+    : path_(path),
+      out_(path, std::ios::binary | std::ios::trunc),
+      level_(level),
       member_bytes_(std::max<std::size_t>(member_bytes, 1)) {
   if (!out_) throw std::runtime_error("cannot write " + path);
   int threads = 1;
@@ -53,7 +55,8 @@ size_t GzOutputStream::Write(const void* buffer, size_t count) {
 
 void GzOutputStream::flushMembers() {
   // (An empty stream is one empty member: a gzip file as gzip and CFileGZOutputStream write it.)
-  const std::size_t members = std::max<std::size_t>(1, (pending_.size() + member_bytes_ - 1) / member_bytes_);
+  const std::size_t members =
+      std::max<std::size_t>(1, (pending_.size() + member_bytes_ - 1) / member_bytes_);
   if (packed_.size() < members) packed_.resize(members);
   std::vector<char> sound(members, 1);
 #pragma omp parallel for schedule(dynamic) if (members > 1)

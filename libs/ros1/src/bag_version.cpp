@@ -1,7 +1,5 @@
 #include "bag_version.h"
 
-#include "bag_walk.h"
-
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -9,6 +7,8 @@
 #include <cstdlib>
 #include <limits>
 #include <optional>
+
+#include "bag_walk.h"
 
 namespace upd::ros1::detail {
 

@@ -350,7 +350,9 @@ Chunk chunkAt(const Bytes& file, const ChunkInfo& info, const Connections& decla
   c.compression = compression->second;
   c.entries = messageIndex(file, c.record.end(), info.connections, declared);
   c.size = field<std::uint32_t>(c.record.fields, "size", "a chunk", info.pos);
-  if (c.size > kMaxChunkBytes) damage("a chunk of " + std::to_string(c.size) + " bytes (more than 2^30)", info.pos);
+  if (c.size > kMaxChunkBytes) {
+    damage("a chunk of " + std::to_string(c.size) + " bytes (more than 2^30)", info.pos);
+  }
   if (c.compression == "none" && c.record.data_len != c.size) {
     damage("an uncompressed chunk of " + std::to_string(c.record.data_len) + " bytes whose size says " +
                std::to_string(c.size),

@@ -65,10 +65,10 @@ class BagWalk {
   bool hasMessages(const std::string& topic) const;
 
   /// Decompresses and checks every chunk's records (throws BagDamage), the compressed chunks
-  /// kBatchBytes of them at a time on every core. Each message on one of topics goes to on_message once its
-  /// chunk has been checked: chunk by chunk in the file's order, within a chunk by time (then by
-  /// position), as rosbag's views order a bag whose chunks follow each other in time (rosbag
-  /// record writes them so).
+  /// kBatchBytes of them at a time on every core. Each message on one of topics goes to
+  /// on_message once its chunk has been checked: chunk by chunk in the file's order, within a
+  /// chunk by time (then by position), as rosbag's views order a bag whose chunks follow each
+  /// other in time (rosbag record writes them so).
   void checkChunks(const std::set<std::string>& topics = {},
                    const std::function<void(const BagMessage&)>& on_message = {});
 

@@ -21,7 +21,8 @@ class GzOutputStream : public mrpt::io::CStream {
   /// Opens path (truncated). Throws std::runtime_error naming it when it cannot be written.
   /// Each member holds member_bytes of the data (the last one less), deflated at level (1:
   /// fastest, as CFileGZOutputStream's default).
-  explicit GzOutputStream(const std::string& path, int level = 1, std::size_t member_bytes = 1u << 20);
+  explicit GzOutputStream(const std::string& path, int level = 1,
+                          std::size_t member_bytes = 1u << 20);
   /// Without close() (an error unwinding), what is buffered is dropped and the file left.
   ~GzOutputStream() override = default;
 
@@ -30,7 +31,7 @@ class GzOutputStream : public mrpt::io::CStream {
   /// naming the file when it cannot be written.
   void close();
 
-  size_t Read(void*, size_t) override;  ///< throws: an output stream
+  size_t Read(void*, size_t) override;                              ///< throws: an output stream
   uint64_t Seek(int64_t, mrpt::io::CStream::TSeekOrigin) override;  ///< throws
   uint64_t getTotalBytesCount() const override { return written_; }
   uint64_t getPosition() const override { return written_; }
