@@ -37,6 +37,7 @@
 #include "upd/ros1/bag_reader.h"
 #include "upd/ros1/conversions.h"
 #include "upd/sim/render.h"
+#include "upd/sim/robot.h"
 #include "upd/sim/world_generator.h"
 
 namespace {
@@ -168,12 +169,7 @@ void writeFrames(mrpt::io::CStream& out, const std::vector<std::vector<std::uint
 
 int run(int n_frames, int repeats, const std::string& json_path) {
   const int threads = omp_get_max_threads();
-  core::CameraIntrinsics K;
-  K.width = 640;
-  K.height = 480;
-  K.fx = K.fy = 525;
-  K.cx = 319.5;
-  K.cy = 239.5;
+  const core::CameraIntrinsics K = sim::simulatedIntrinsics(sim::CameraMountParams{});  // Kinect
   const std::vector<core::DepthImage> frames = renderFrames(n_frames, K);
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("upd_bag_bench-" + std::to_string(::getpid()));

@@ -45,6 +45,13 @@ GzOutputStream::GzOutputStream(const std::string& path, int level, std::size_t m
   batch_members_ = 2 * static_cast<std::size_t>(threads);
 }
 
+GzOutputStream::~GzOutputStream() {
+  try {
+    close();
+  } catch (const std::exception&) {  // a destructor does not throw; close() reports it
+  }
+}
+
 size_t GzOutputStream::Write(const void* buffer, size_t count) {
   const char* p = static_cast<const char*>(buffer);
   pending_.insert(pending_.end(), p, p + count);

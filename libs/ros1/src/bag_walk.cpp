@@ -317,19 +317,6 @@ BagMessage messageAt(const Bytes& data, const IndexEntry& e, const Connection& c
   return {c.topic, c.datatype, c.md5sum, e.time_ns, reinterpret_cast<const std::uint8_t*>(at), r.data_len};
 }
 
-// The messages of a checked chunk on the topics asked for, to on_message in order of time.
-void handMessages(const Bytes& data, std::vector<IndexEntry> entries, const Connections& declared,
-                  const std::set<std::string>& topics,
-                  const std::function<void(const BagMessage&)>& on_message) {
-  const auto unasked = [&](const IndexEntry& e) { return !topics.count(declared.at(e.conn).topic); };
-  entries.erase(std::remove_if(entries.begin(), entries.end(), unasked), entries.end());
-  std::sort(entries.begin(), entries.end(), [](const IndexEntry& a, const IndexEntry& b) {
-    return a.time_ns != b.time_ns ? a.time_ns < b.time_ns : a.offset < b.offset;
-  });
-  ChunkBuffer bytes;
-  for (const IndexEntry& e : entries) on_message(messageAt(data, e, declared.at(e.conn), bytes));
-}
-
 // A chunk as its header and the index records after it give it.
 struct Chunk {
   std::uint64_t pos = 0;
@@ -361,6 +348,49 @@ Chunk chunkAt(const Bytes& file, const ChunkInfo& info, const Connections& decla
   return c;
 }
 
+// A message of the index, and the chunk it is in.
+struct Placed {
+  std::size_t chunk;
+  IndexEntry e;
+};
+
+// The messages on topics of chunks [first, end), in the order of rosbag's views: by time, then
+// by chunk, then by position.
+std::vector<Placed> inTimeOrder(const std::vector<Chunk>& chunks, std::size_t first, std::size_t end,
+                                const Connections& declared, const std::set<std::string>& topics) {
+  std::vector<Placed> order;
+  for (std::size_t i = first; i < end; ++i) {
+    for (const IndexEntry& e : chunks[i].entries) {
+      if (topics.count(declared.at(e.conn).topic)) order.push_back({i, e});
+    }
+  }
+  std::sort(order.begin(), order.end(), [](const Placed& a, const Placed& b) {
+    return std::tie(a.e.time_ns, a.chunk, a.e.offset) < std::tie(b.e.time_ns, b.chunk, b.e.offset);
+  });
+  return order;
+}
+
+// The next batch: the distinct chunks at positions from, from + 1, ... < n of a sequence
+// (chunk_at(j): the chunk at position j), in the order first met, up to budget bytes of
+// decompressed data (one chunk at least); slot maps each to its place in the batch.
+template <class ChunkAt>
+std::vector<std::size_t> nextBatch(const std::vector<Chunk>& chunks, std::size_t from,
+                                   std::size_t n, ChunkAt chunk_at, std::uint64_t budget,
+                                   std::map<std::size_t, std::size_t>& slot) {
+  std::vector<std::size_t> ids;
+  std::uint64_t total = 0;
+  slot.clear();
+  for (std::size_t j = from; j < n; ++j) {
+    const std::size_t id = chunk_at(j);
+    if (slot.count(id)) continue;
+    if (!ids.empty() && total + chunks[id].size > budget) break;
+    slot[id] = ids.size();
+    ids.push_back(id);
+    total += chunks[id].size;
+  }
+  return ids;
+}
+
 // A chunk's data: in place in the file when it is not compressed, else its decompressed bytes.
 class ChunkData {
  public:
@@ -375,13 +405,8 @@ class ChunkData {
   bool packed_;
 };
 
-// A chunk's data (unpacked: decompressed; empty when it is not compressed): every record in it,
-// and every message offset of the index on a message; then its messages on topics to on_message.
-void checkChunkData(std::ifstream& in, const Chunk& c, const ChunkBuffer& unpacked,
-                    const Connections& declared, const std::set<std::string>& topics,
-                    const std::function<void(const BagMessage&)>& on_message) {
-  const ChunkData chunk(in, c, unpacked);
-  const Bytes& data = chunk.bytes();
+// A chunk's data: every record in it, and every message offset of the index on a message.
+void checkChunkData(const Chunk& c, const Bytes& data) {
   const std::map<std::uint64_t, std::uint8_t> ops = chunkRecords(data, c.pos);
   // rosbag writes each offset at its message record. (Where one lands on a connection record,
   // rosbag reads on from inside that record's second header: a record to refuse too.)
@@ -392,7 +417,6 @@ void checkChunkData(std::ifstream& in, const Chunk& c, const ChunkBuffer& unpack
              c.pos);
     }
   }
-  if (on_message) handMessages(data, c.entries, declared, topics, on_message);
 }
 
 }  // namespace
@@ -495,17 +519,20 @@ bool BagWalk::hasMessages(const std::string& topic) const {
 void BagWalk::checkChunks(const std::set<std::string>& topics,
                           const std::function<void(const BagMessage&)>& on_message) {
   const std::vector<Chunk>& chunks = impl_->chunks;
+  std::map<std::size_t, std::size_t> slot;
+  ChunkBuffer bytes;
   // A batch's chunks are checked in order: the first damage of the file is the one reported.
   for (std::size_t first = 0; first < chunks.size();) {
-    std::vector<std::size_t> ids{first};
-    for (std::uint64_t bytes = chunks[first].size;
-         ids.back() + 1 < chunks.size() && bytes + chunks[ids.back() + 1].size <= kBatchBytes;) {
-      ids.push_back(ids.back() + 1);
-      bytes += chunks[ids.back()].size;
-    }
+    const std::vector<std::size_t> ids = nextBatch(
+        chunks, first, chunks.size(), [](std::size_t j) { return j; }, kBatchBytes, slot);
     impl_->unpack(ids);
     for (std::size_t k = 0; k < ids.size(); ++k) {
-      checkChunkData(impl_->in, chunks[ids[k]], impl_->unpacked[k], impl_->declared, topics, on_message);
+      const ChunkData data(impl_->in, chunks[ids[k]], impl_->unpacked[k]);
+      checkChunkData(chunks[ids[k]], data.bytes());
+      if (!on_message) continue;
+      for (const Placed& m : inTimeOrder(chunks, ids[k], ids[k] + 1, impl_->declared, topics)) {
+        on_message(messageAt(data.bytes(), m.e, impl_->declared.at(m.e.conn), bytes));
+      }
     }
     first = ids.back() + 1;
   }
@@ -515,44 +542,18 @@ void BagWalk::readMessages(const std::set<std::string>& topics,
                            const std::function<bool(const BagMessage&)>& on_message,
                            std::uint64_t batch_bytes) {
   const std::vector<Chunk>& chunks = impl_->chunks;
-  struct At {
-    std::uint64_t time_ns;
-    std::size_t chunk;
-    std::uint32_t offset, conn;
-  };
-  std::vector<At> order;
-  for (std::size_t i = 0; i < chunks.size(); ++i) {
-    for (const IndexEntry& e : chunks[i].entries) {
-      if (topics.count(impl_->declared.at(e.conn).topic)) order.push_back({e.time_ns, i, e.offset, e.conn});
-    }
-  }
-  std::sort(order.begin(), order.end(), [](const At& a, const At& b) {
-    return std::tie(a.time_ns, a.chunk, a.offset) < std::tie(b.time_ns, b.chunk, b.offset);
-  });
+  const std::vector<Placed> order = inTimeOrder(chunks, 0, chunks.size(), impl_->declared, topics);
   std::map<std::size_t, std::size_t> held;  // a chunk of the batch -> its buffer in unpacked
   ChunkBuffer bytes;
   for (std::size_t k = 0; k < order.size(); ++k) {
-    const Chunk& c = chunks[order[k].chunk];
-    if (c.compression != "none" && !held.count(order[k].chunk)) {
-      // The next compressed chunks the messages need, up to batch_bytes (one at least).
-      std::vector<std::size_t> ids;
-      std::uint64_t total = 0;
-      held.clear();
-      for (std::size_t j = k; j < order.size(); ++j) {
-        const std::size_t id = order[j].chunk;
-        if (chunks[id].compression == "none" || held.count(id)) continue;
-        if (!ids.empty() && total + chunks[id].size > batch_bytes) break;
-        held[id] = ids.size();
-        ids.push_back(id);
-        total += chunks[id].size;
-      }
-      impl_->unpack(ids);
+    if (!held.count(order[k].chunk)) {  // the next chunks the messages need
+      impl_->unpack(nextBatch(
+          chunks, k, order.size(), [&](std::size_t j) { return order[j].chunk; }, batch_bytes, held));
     }
-    static const ChunkBuffer in_file;
-    const ChunkData data(impl_->in, c,
-                         c.compression == "none" ? in_file : impl_->unpacked[held.at(order[k].chunk)]);
-    const IndexEntry e{order[k].time_ns, order[k].offset, order[k].conn};
-    if (!on_message(messageAt(data.bytes(), e, impl_->declared.at(e.conn), bytes))) return;
+    const ChunkData data(impl_->in, chunks[order[k].chunk], impl_->unpacked[held.at(order[k].chunk)]);
+    if (!on_message(messageAt(data.bytes(), order[k].e, impl_->declared.at(order[k].e.conn), bytes))) {
+      return;
+    }
   }
 }
 

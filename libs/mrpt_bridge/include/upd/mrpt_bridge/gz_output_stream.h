@@ -23,8 +23,9 @@ class GzOutputStream : public mrpt::io::CStream {
   /// fastest, as CFileGZOutputStream's default).
   explicit GzOutputStream(const std::string& path, int level = 1,
                           std::size_t member_bytes = 1u << 20);
-  /// Without close() (an error unwinding), what is buffered is dropped and the file left.
-  ~GzOutputStream() override = default;
+  /// Closes the file as close() does, as MRPT's streams do, but without a word when that fails:
+  /// call close() to hear of it.
+  ~GzOutputStream() override;
 
   size_t Write(const void* buffer, size_t count) override;
   /// Compresses and writes what is buffered, and closes the file. Throws std::runtime_error
