@@ -33,12 +33,11 @@
 #include <string>
 #include <vector>
 
+#include "depth_frames.h"
 #include "upd/mrpt_bridge/gz_output_stream.h"
 #include "upd/ros1/bag_reader.h"
 #include "upd/ros1/conversions.h"
-#include "upd/sim/render.h"
 #include "upd/sim/robot.h"
-#include "upd/sim/world_generator.h"
 
 namespace {
 
@@ -47,20 +46,6 @@ using json = nlohmann::json;
 
 const char* kDepth = "/camera/depth/image_raw";
 const char* kInfo = "/camera/depth/camera_info";
-
-// n frames of makeWorld("mixed") from a camera 0.6 m high moving 5 cm a frame along x.
-std::vector<core::DepthImage> renderFrames(int n, const core::CameraIntrinsics& K) {
-  const sim::WorldSpec world = sim::makeWorld("mixed");
-  sim::DepthNoise noise;
-  noise.max_range_m = 5.0;
-  std::vector<core::DepthImage> frames;
-  for (int i = 0; i < n; ++i) {
-    const double x = 0.5 + 0.05 * i;
-    const Eigen::Isometry3d pose = sim::cameraPoseLookingAt({x, 0.3, 0.6}, {x + 3.5, -0.4, 0.0});
-    frames.push_back(sim::renderDepth(world.terrain, pose, K, noise, 7 + i));
-  }
-  return frames;
-}
 
 void writeBag(const std::string& path, rosbag::compression::CompressionType compression,
               const std::vector<core::DepthImage>& frames, const core::CameraIntrinsics& K) {
@@ -137,25 +122,13 @@ std::vector<double> medians(const std::vector<std::function<void()>>& candidates
   return out;
 }
 
-// The frames as `upd playback` converts them: CObservation3DRangeScan in millimetres, each
-// serialized.
+// The frames as `upd playback` converts them (scanOf), each serialized.
 std::vector<std::vector<std::uint8_t>> serializedScans(
     const std::vector<core::DepthImage>& frames) {
   std::vector<std::vector<std::uint8_t>> all;
   for (const core::DepthImage& d : frames) {
-    mrpt::obs::CObservation3DRangeScan obs;
-    obs.hasRangeImage = true;
-    obs.rangeUnits = 1e-3f;
-    obs.rangeImage.resize(static_cast<int>(d.height), static_cast<int>(d.width));
-    for (int v = 0; v < d.height; ++v) {
-      for (int u = 0; u < d.width; ++u) {
-        const float z = d.depth_m[static_cast<std::size_t>(v) * d.width + u];
-        obs.rangeImage(v, u) =
-            std::isfinite(z) && z > 0 ? static_cast<std::uint16_t>(z * 1000.f + 0.5f) : 0;
-      }
-    }
     mrpt::io::CMemoryStream mem;
-    mrpt::serialization::archiveFrom(mem) << obs;
+    mrpt::serialization::archiveFrom(mem) << bench::scanOf(d);
     const auto* p = static_cast<const std::uint8_t*>(mem.getRawBufferData());
     all.emplace_back(p, p + mem.getTotalBytesCount());
   }
@@ -170,7 +143,7 @@ void writeFrames(mrpt::io::CStream& out, const std::vector<std::vector<std::uint
 int run(int n_frames, int repeats, const std::string& json_path) {
   const int threads = omp_get_max_threads();
   const core::CameraIntrinsics K = sim::simulatedIntrinsics(sim::CameraMountParams{});  // Kinect
-  const std::vector<core::DepthImage> frames = renderFrames(n_frames, K);
+  const std::vector<core::DepthImage> frames = bench::renderFrames(n_frames, K);
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("upd_bag_bench-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

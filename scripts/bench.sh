@@ -9,7 +9,9 @@
 # for a machine shared with other jobs) into out/bench-passive.json, since the second core's
 # gain depends on it. Last, `upd playback` of the demo run with the paper's config against the
 # realtime one (scripts/bench-playback.sh, out/bench-playback.json); with ROS 1, the read of a
-# bag against rosbag's own reader (bench/upd_bag_bench, out/bench-bag.json).
+# bag against rosbag's own reader (bench/upd_bag_bench, out/bench-bag.json); the recording of
+# `upd live --record` against MRPT's gzip stream in the loop thread (bench/upd_record_bench,
+# out/bench-record.json).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 mkdir -p "$UPD_ROOT/out"
@@ -26,4 +28,9 @@ if [ -x "$UPD_BUILD/bench/upd_bag_bench" ]; then
   echo
   echo "Reading a ROS 1 bag as upd playback RUN.bag does, against rosbag's own reader:"
   "$UPD_BUILD/bench/upd_bag_bench" --json "$UPD_ROOT/out/bench-bag.json"
+fi
+if [ -x "$UPD_BUILD/bench/upd_record_bench" ]; then
+  echo
+  echo "The recording of upd live --record, the loop thread's time a frame:"
+  "$UPD_BUILD/bench/upd_record_bench" --json "$UPD_ROOT/out/bench-record.json"
 fi

@@ -6,12 +6,16 @@
 
 #include "temp_dir.h"
 
+#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 namespace fs = std::filesystem;
 using upd::mrpt_bridge::RawlogEntry;
@@ -19,11 +23,13 @@ using upd::mrpt_bridge::RawlogReader;
 
 namespace {
 
-mrpt::obs::CObservation3DRangeScan scan(int k) {
+mrpt::obs::CObservation3DRangeScan scan(int k, int w = 5, int h = 4) {
   mrpt::obs::CObservation3DRangeScan o;
   o.hasRangeImage = true;
-  o.rangeImage.resize(4, 5);
-  o.rangeImage.fill(static_cast<uint16_t>(1000 + k));
+  o.rangeImage.resize(h, w);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) o.rangeImage(v, u) = static_cast<uint16_t>(1000 + k + (u ^ v) % 97);
+  }
   o.sensorLabel = "DEPTH";
   o.timestamp = mrpt::Clock::fromDouble(1000.0 + k);
   return o;
@@ -40,6 +46,11 @@ std::size_t readable(const std::string& path, std::vector<std::string>* classes 
   } catch (const upd::mrpt_bridge::RawlogError&) {
   }
   return reader.stats().entries;
+}
+
+std::string bytesOf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace
@@ -69,6 +80,7 @@ TEST(SensorRecording, ThePartFileIsReplayableUpToTheLastFlush) {
   {
     upd::mrpt_bridge::RawlogWriter w(path, 4);
     for (int k = 0; k < 6; ++k) w.write(scan(k));
+    w.drain();
     // A crash now: what is on disk is what a copy of the file holds.
     fs::copy_file(path + ".part", dir.file("crash.rawlog"));
   }  // unwinding without finish() leaves the .part file
@@ -82,4 +94,70 @@ TEST(SensorRecording, RejectsBadArguments) {
   EXPECT_THROW(upd::mrpt_bridge::RawlogWriter(dir.file("a.rawlog"), 0), std::invalid_argument);
   EXPECT_THROW(upd::mrpt_bridge::RawlogWriter(dir.file("no/such/dir/a.rawlog")),
                std::runtime_error);
+}
+
+// The writer thread writes what writing each object to CFileGZOutputStream in the caller's
+// thread, a member closed every flush_every objects, writes: the same bytes.
+TEST(SensorRecording, TheFileIsTheOneCFileGZOutputStreamWritesInTheCallersThread) {
+  const upd::test::TempDir dir;
+  const std::string path = dir.file("run.rawlog"), peer = dir.file("peer.rawlog");
+  constexpr int kFlushEvery = 3;
+  upd::mrpt_bridge::RawlogWriter w(path, kFlushEvery);
+  auto out = std::make_unique<mrpt::io::CFileGZOutputStream>(peer);
+  for (int k = 0; k < 8; ++k) {
+    const mrpt::obs::CObservation3DRangeScan o = scan(k, 640, 480);
+    w.write(o);
+    mrpt::serialization::archiveFrom(*out) << o;
+    if ((k + 1) % kFlushEvery == 0) {
+      out->close();
+      std::string err;
+      ASSERT_TRUE(out->open(peer, 1, err, mrpt::io::OpenMode::APPEND)) << err;
+    }
+  }
+  out.reset();
+  w.finish();
+  const std::string ours = bytesOf(path);
+  EXPECT_GT(ours.size(), 10000u);
+  EXPECT_TRUE(ours == bytesOf(peer)) << ours.size() << " bytes against " << bytesOf(peer).size();
+  EXPECT_EQ(readable(path), 8u);
+}
+
+// An observation changed after write() is recorded as it was when written.
+TEST(SensorRecording, WriteTakesTheObservationAsItIs) {
+  const upd::test::TempDir dir;
+  const std::string path = dir.file("run.rawlog");
+  upd::mrpt_bridge::RawlogWriter w(path);
+  mrpt::obs::CObservation3DRangeScan o = scan(1);
+  for (int k = 0; k < 4; ++k) {
+    o.timestamp = mrpt::Clock::fromDouble(2000.0 + k);
+    w.write(o);
+  }
+  w.finish();
+  RawlogReader reader(path);
+  RawlogEntry e;
+  for (int k = 0; k < 4; ++k) {
+    ASSERT_TRUE(reader.next(e));
+    ASSERT_TRUE(e.observation);
+    EXPECT_NEAR(e.timestamp_s, 2000.0 + k, 1e-6);
+  }
+  EXPECT_FALSE(reader.next(e));
+}
+
+// A file that cannot take the data (/dev/full: no space left): write() or finish() says so,
+// naming the .part file, which stays; no file at the path.
+TEST(SensorRecording, AFullDiskIsReportedNamingTheFile) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
+  const upd::test::TempDir dir;
+  const std::string path = dir.file("run.rawlog");
+  fs::create_symlink("/dev/full", path + ".part");
+  std::string message;
+  try {
+    upd::mrpt_bridge::RawlogWriter w(path, 2);
+    for (int k = 0; k < 20; ++k) w.write(scan(k, 640, 480));
+    w.finish();
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(message.rfind("cannot write " + path + ".part", 0), 0u) << message;
+  EXPECT_FALSE(fs::exists(path));
 }

@@ -1,29 +1,161 @@
 #include "upd/mrpt_bridge/rawlog_writer.h"
 
 #include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/io/CStream.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <cerrno>
+#include <condition_variable>
+#include <cstdint>
+#include <cstring>
+#include <deque>
 #include <filesystem>
+#include <mutex>
 #include <stdexcept>
+#include <thread>
+#include <utility>
+#include <vector>
 
 namespace upd::mrpt_bridge {
 
+namespace {
+
+// An output stream into a byte vector, which keeps its capacity from object to object.
+class ByteSink : public mrpt::io::CStream {
+ public:
+  explicit ByteSink(std::vector<std::uint8_t>& bytes) : bytes_(bytes) {}
+  size_t Write(const void* buffer, size_t count) override {
+    const auto* p = static_cast<const std::uint8_t*>(buffer);
+    bytes_.insert(bytes_.end(), p, p + count);
+    return count;
+  }
+  size_t Read(void*, size_t) override { throw std::logic_error("ByteSink cannot be read"); }
+  uint64_t Seek(int64_t, mrpt::io::CStream::TSeekOrigin) override {
+    throw std::logic_error("ByteSink cannot seek");
+  }
+  uint64_t getTotalBytesCount() const override { return bytes_.size(); }
+  uint64_t getPosition() const override { return bytes_.size(); }
+
+ private:
+  std::vector<std::uint8_t>& bytes_;
+};
+
+// One serialized observation, and whether its gzip member ends after it.
+struct Item {
+  std::vector<std::uint8_t> bytes;
+  bool end_member = false;
+};
+
+}  // namespace
+
+// The caller serializes; the writer thread compresses and writes, in order. The queue holds at
+// most kMaxQueuedBytes: beyond that write() waits for the writer (no observation is dropped).
 struct RawlogWriter::Impl {
-  mrpt::io::CFileGZOutputStream out;
+  static constexpr std::size_t kMaxQueuedBytes = std::size_t(128) << 20;
+  static constexpr std::size_t kSpareBuffers = 4;
+
   std::string part;
+  mrpt::io::CFileGZOutputStream out;  // (the writer thread's once it runs)
   bool open = false;
+
+  std::mutex m;
+  std::condition_variable changed;  // an item queued or written, or the end asked
+  std::deque<Item> queue;
+  std::vector<std::vector<std::uint8_t>> spare;  // written items' buffers, for the next ones
+  std::size_t queued_bytes = 0;
+  bool writing = false, stop = false;
+  bool ended = false;  // (the owner's: end() called)
+  std::string error;   // the writer's first failure (what follows it is not written)
+  std::thread writer;
 
   void openMember(bool append) {
     std::string err;
     const auto mode = append ? mrpt::io::OpenMode::APPEND : mrpt::io::OpenMode::TRUNCATE;
-    if (!out.open(part, 1, err, mode)) throw std::runtime_error("cannot write " + part + ": " + err);
+    if (!out.open(part, 1, err, mode))
+      throw std::runtime_error("cannot write " + part + ": " + err);
     open = true;
   }
   void close() {
     if (open) out.close();
     open = false;
+  }
+
+  // The writer thread: each item compressed into the file, a member closed (complete on disk)
+  // where one ends.
+  void run() {
+    std::unique_lock<std::mutex> lock(m);
+    for (;;) {
+      changed.wait(lock, [&] { return stop || !queue.empty(); });
+      if (queue.empty()) return;
+      Item item = std::move(queue.front());
+      queue.pop_front();
+      writing = true;
+      const bool failed = !error.empty();
+      lock.unlock();
+      std::string failure;
+      if (!failed) {
+        try {
+          errno = 0;
+          if (out.Write(item.bytes.data(), item.bytes.size()) != item.bytes.size()) {
+            throw std::runtime_error(errno != 0 ? std::strerror(errno) : "zlib failed");
+          }
+          if (item.end_member) close(), openMember(true);
+        } catch (const std::exception& e) {
+          failure = "cannot write " + part + ": " + e.what();
+        }
+      }
+      lock.lock();
+      if (error.empty()) error = failure;
+      queued_bytes -= item.bytes.size();
+      if (spare.size() < kSpareBuffers) spare.push_back(std::move(item.bytes));
+      writing = false;
+      changed.notify_all();
+    }
+  }
+
+  void throwIfFailed() {
+    std::lock_guard<std::mutex> lock(m);
+    if (!error.empty()) throw std::runtime_error(error);
+  }
+
+  std::vector<std::uint8_t> buffer() {
+    std::lock_guard<std::mutex> lock(m);
+    if (spare.empty()) return {};
+    std::vector<std::uint8_t> b = std::move(spare.back());
+    spare.pop_back();
+    b.clear();
+    return b;
+  }
+
+  void push(Item item) {
+    std::unique_lock<std::mutex> lock(m);
+    // (An item larger than the queue waits for the queue to empty.)
+    changed.wait(lock, [&] {
+      return queued_bytes == 0 || queued_bytes + item.bytes.size() <= kMaxQueuedBytes ||
+             !error.empty();
+    });
+    queued_bytes += item.bytes.size();
+    queue.push_back(std::move(item));
+    changed.notify_all();
+  }
+
+  void drain() {
+    std::unique_lock<std::mutex> lock(m);
+    changed.wait(lock, [&] { return queue.empty() && !writing; });
+  }
+
+  // Everything queued written, the writer thread ended, the file closed.
+  void end() {
+    ended = true;
+    {
+      std::lock_guard<std::mutex> lock(m);
+      stop = true;
+    }
+    changed.notify_all();
+    if (writer.joinable()) writer.join();
+    close();
   }
 };
 
@@ -35,17 +167,19 @@ RawlogWriter::RawlogWriter(const std::string& path, int flush_every)
   }
   impl_->part = partPath();
   impl_->openMember(false);
+  impl_->writer = std::thread([impl = impl_.get()] { impl->run(); });
 }
 
-RawlogWriter::~RawlogWriter() { impl_->close(); }
+RawlogWriter::~RawlogWriter() { impl_->end(); }
 
 void RawlogWriter::write(const mrpt::obs::CObservation& obs) {
-  if (!impl_->open) throw std::logic_error("RawlogWriter::write after finish()");
-  mrpt::serialization::archiveFrom(impl_->out) << obs;
-  if (++written_ % static_cast<std::size_t>(flush_every_) == 0) {
-    impl_->close();  // a complete gzip member on disk
-    impl_->openMember(true);
-  }
+  if (impl_->ended) throw std::logic_error("RawlogWriter::write after finish()");
+  impl_->throwIfFailed();
+  Item item{impl_->buffer(), false};
+  ByteSink sink(item.bytes);
+  mrpt::serialization::archiveFrom(sink) << obs;
+  item.end_member = ++written_ % static_cast<std::size_t>(flush_every_) == 0;
+  impl_->push(std::move(item));
 }
 
 void RawlogWriter::writeOdometry(double x_m, double y_m, double yaw_rad, double time_s) {
@@ -56,8 +190,14 @@ void RawlogWriter::writeOdometry(double x_m, double y_m, double yaw_rad, double 
   write(odo);
 }
 
+void RawlogWriter::drain() {
+  impl_->drain();
+  impl_->throwIfFailed();
+}
+
 void RawlogWriter::finish() {
-  impl_->close();
+  impl_->end();
+  impl_->throwIfFailed();
   std::filesystem::rename(impl_->part, path_);
 }
 
