@@ -76,9 +76,10 @@ const char* const kLiveUsage =
     "                     by upd calibrate-mount --output); applies to every source\n"
     "  --auto-mount       measure the mount from the floor in the first frames (robot on a\n"
     "                     level floor); no floor found: one line, exit status 1, no run\n\n"
-    "exit status: 0 done; 1 error (a source that cannot be opened, ...); 2 usage error;\n"
-    "3 --navigate did not reach the goal; 4 the source stopped (the robot was stopped); 5 the\n"
-    "robot base stopped answering (an emergency stop was sent). --output is written in each.\n";
+    "exit status: 0 done; 1 error (a source that cannot be opened, ...; a recording that\n"
+    "stopped, a full disk say: the run goes on without it); 2 usage error; 3 --navigate did not\n"
+    "reach the goal; 4 the source stopped (the robot was stopped); 5 the robot base stopped\n"
+    "answering (an emergency stop was sent). --output is written whenever the run took place.\n";
 
 namespace {
 
@@ -96,6 +97,7 @@ struct LiveTally {
   std::optional<SourceStall> stall;
   std::optional<BaseFault> base_fault;
   std::size_t recorded = 0;
+  std::string record_error;  ///< why the recording stopped early ("" when it did not)
   nav::NavOutcome outcome;
 };
 
@@ -143,7 +145,12 @@ void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTa
                        {"robot_stopped", t.base_fault->robot_stopped},
                        {"message", t.base_fault->line()}};
   }
-  if (o.record) j["recording"] = {{"path", *o.record}, {"observations", t.recorded}};
+  if (o.record) {
+    const bool whole = t.record_error.empty();
+    j["recording"] = {{"path", whole ? *o.record : *o.record + ".part"},
+                      {"observations", t.recorded},
+                      {"error", whole ? nlohmann::json() : nlohmann::json(t.record_error)}};
+  }
   if (o.goal) {
     j["goal_xy_m"] = {o.goal->x(), o.goal->y()};
     j["navigator"] = {{"state", nav::toString(t.outcome.state)},
@@ -193,16 +200,31 @@ struct LiveRun {
   double score_ms = 0;
   std::map<std::string, std::size_t> skipped;
   std::optional<BaseFault> base_fault;  ///< set when the base stopped answering
+  std::string record_error;             ///< why the recording stopped (the run went on)
+  std::size_t recorded = 0;             ///< the observations handed to the recording
 };
+
+// A recording that fails (a full disk) stops, as rosbag's does, and the run goes on: one line
+// now, exit status 1 at the end. The .part file keeps what was written up to its last flush.
+void stopRecording(LiveRun& run, const std::string& error) {
+  run.recorded = run.recorder->written();
+  run.record_error = error;
+  run.recorder.reset();  // (what is queued is dropped by the failed writer; the file closed)
+  std::fprintf(stderr, "upd live: recording stopped: %s; the run goes on\n", error.c_str());
+}
 
 // The base's pose at the frame (before it) and the observation, into the recording.
 void recordFrame(LiveRun& run, const mrpt::obs::CObservation& obs, const nav::BaseState& s) {
   if (!run.recorder) return;
   const double t = obs.timestamp == INVALID_TIMESTAMP ? mrpt::Clock::toDouble(mrpt::Clock::now())
                                                        : mrpt::Clock::toDouble(obs.timestamp);
-  run.recorder->writeOdometry(s.pose_world_robot.x_m, s.pose_world_robot.y_m,
-                              s.pose_world_robot.yaw_rad, t);
-  run.recorder->write(obs);
+  try {
+    run.recorder->writeOdometry(s.pose_world_robot.x_m, s.pose_world_robot.y_m,
+                                s.pose_world_robot.yaw_rad, t);
+    run.recorder->write(obs);
+  } catch (const std::runtime_error& e) {
+    stopRecording(run, e.what());
+  }
 }
 
 // Scores one observation into the map at the base's pose, advanced to the frame's arrival;
@@ -303,11 +325,18 @@ std::string runFrames(LiveRun& run, LiveSource& source, LiveTally& t) {
 int finishLive(const LiveOptions& o, const LiveTally& t, const maps::TraversabilityGrid& grid) {
   const auto stats = maps::computeStats(grid);
   printSummary(t, stats);
-  if (o.record) std::printf("  recorded %zu observations to %s\n", t.recorded, o.record->c_str());
+  if (o.record && t.record_error.empty()) {
+    std::printf("  recorded %zu observations to %s\n", t.recorded, o.record->c_str());
+  }
   if (o.out) writeLiveOutputs(*o.out, o, t, grid, stats);
   if (t.base_fault) return kExitBaseFault;
   if (t.stall) return kExitSourceStopped;
-  if (o.goal) return t.outcome.target_reached ? 0 : 3;
+  if (o.goal && !t.outcome.target_reached) return 3;
+  if (!t.record_error.empty()) {
+    std::fprintf(stderr, "upd live: error: the recording stopped after %zu observations: %s\n",
+                 t.recorded, t.record_error.c_str());
+    return 1;
+  }
   return 0;
 }
 
@@ -347,9 +376,15 @@ int runSource(const LiveOptions& o, nav::NavConfig config, const RunConfig& run_
     run.loop.finish();
   }
   if (run.recorder) {
-    t.recorded = run.recorder->written();
-    run.recorder->finish();
+    try {
+      run.recorded = run.recorder->written();
+      run.recorder->finish();
+    } catch (const std::runtime_error& e) {
+      stopRecording(run, e.what());
+    }
   }
+  t.recorded = run.recorded;
+  t.record_error = run.record_error;
   if (run.view && o.screenshot && run.view->isOpen()) {
     run.view->saveScreenshot(*o.screenshot);
     std::printf("  screenshot %s\n", o.screenshot->c_str());

@@ -131,6 +131,39 @@ TEST(Kinect, FakenectFramesArriveWithTheirDepth) {
   EXPECT_GT(summary["map_known_cells"].get<int>(), 100);
 }
 
+// A recording the disk refuses (/dev/full) stops with one line, as rosbag's does; the run
+// goes on to the end of the source, its outputs are written, and the exit status is 1.
+TEST(Kinect, ARecordingTheDiskRefusesStopsAndTheRunGoesOn) {
+  if (!fs::exists(kFakenect)) GTEST_SKIP() << kFakenect << " not installed (libfreenect-bin)";
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
+  const upd::test::TempDir dir;
+  const fs::path rec = dir.path() / "rec";
+  fs::create_directories(rec);
+  for (int i = 0; i < 4; ++i) {
+    fn::writeFakenectDepth(rec.string(), floorFrame(i), 0.01 * i, 1000 + 33 * i);
+  }
+  const std::string run = dir.file("run.rawlog");
+  fs::create_symlink("/dev/full", run + ".part");
+  const auto r =
+      liveUnderFakenect(dir, rec.string(), "--record " + run + " --output " + dir.file("out"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("upd live: recording stopped: cannot write " + run +
+                          ".part: No space left on device; the run goes on"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("end of the recording: 4 frames"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("upd live: error: the recording stopped after "), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(run));
+  std::ifstream in(dir.path() / "out" / "summary.json");
+  ASSERT_TRUE(in) << r.output;
+  const auto summary = nlohmann::json::parse(in);
+  EXPECT_EQ(summary["frames"], 4);
+  EXPECT_EQ(summary["recording"]["path"], run + ".part");
+  EXPECT_EQ(summary["recording"]["error"],
+            "cannot write " + run + ".part: No space left on device");
+}
+
 TEST(Kinect, ADeviceRepeatingItsFrameStopsTheRobot) {
   if (!fs::exists(kFakenect)) GTEST_SKIP() << kFakenect << " not installed (libfreenect-bin)";
   const upd::test::TempDir dir;

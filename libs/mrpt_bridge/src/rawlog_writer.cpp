@@ -1,10 +1,10 @@
 #include "upd/mrpt_bridge/rawlog_writer.h"
 
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CStream.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/serialization/CArchive.h>
+#include <zlib.h>
 
 #include <cerrno>
 #include <condition_variable>
@@ -57,8 +57,7 @@ struct RawlogWriter::Impl {
   static constexpr std::size_t kSpareBuffers = 4;
 
   std::string part;
-  mrpt::io::CFileGZOutputStream out;  // (the writer thread's once it runs)
-  bool open = false;
+  gzFile out = nullptr;  // (the writer thread's once it runs)
 
   std::mutex m;
   std::condition_variable changed;  // an item queued or written, or the end asked
@@ -70,16 +69,30 @@ struct RawlogWriter::Impl {
   std::string error;   // the writer's first failure (what follows it is not written)
   std::thread writer;
 
+  // zlib's calls as CFileGZOutputStream makes them (gzopen "wb1" / "ab1", gzwrite, gzclose):
+  // the same bytes. Unlike it, a gzclose that fails (the last of a member's data not written)
+  // is an error, not silence.
   void openMember(bool append) {
-    std::string err;
-    const auto mode = append ? mrpt::io::OpenMode::APPEND : mrpt::io::OpenMode::TRUNCATE;
-    if (!out.open(part, 1, err, mode))
-      throw std::runtime_error("cannot write " + part + ": " + err);
-    open = true;
+    errno = 0;
+    out = gzopen(part.c_str(), append ? "ab1" : "wb1");
+    if (out == nullptr) fail();
   }
-  void close() {
-    if (open) out.close();
-    open = false;
+  void write(const std::vector<std::uint8_t>& bytes) {
+    errno = 0;
+    const int n = static_cast<int>(bytes.size());
+    if (n > 0 && gzwrite(out, bytes.data(), static_cast<unsigned>(n)) != n) fail();
+  }
+  // Closes the member; throws where its data did not reach the file.
+  void closeMember() {
+    if (out == nullptr) return;
+    errno = 0;
+    const int status = gzclose(out);
+    out = nullptr;
+    if (status != Z_OK) fail();
+  }
+  [[noreturn]] void fail() const {
+    throw std::runtime_error("cannot write " + part + ": " +
+                             (errno != 0 ? std::strerror(errno) : "zlib failed"));
   }
 
   // The writer thread: each item compressed into the file, a member closed (complete on disk)
@@ -97,13 +110,10 @@ struct RawlogWriter::Impl {
       std::string failure;
       if (!failed) {
         try {
-          errno = 0;
-          if (out.Write(item.bytes.data(), item.bytes.size()) != item.bytes.size()) {
-            throw std::runtime_error(errno != 0 ? std::strerror(errno) : "zlib failed");
-          }
-          if (item.end_member) close(), openMember(true);
+          write(item.bytes);
+          if (item.end_member) closeMember(), openMember(true);
         } catch (const std::exception& e) {
-          failure = "cannot write " + part + ": " + e.what();
+          failure = e.what();
         }
       }
       lock.lock();
@@ -146,7 +156,8 @@ struct RawlogWriter::Impl {
     changed.wait(lock, [&] { return queue.empty() && !writing; });
   }
 
-  // Everything queued written, the writer thread ended, the file closed.
+  // Everything queued written, the writer thread ended, the file closed (a failure to close
+  // kept as the writer's error).
   void end() {
     ended = true;
     {
@@ -155,7 +166,11 @@ struct RawlogWriter::Impl {
     }
     changed.notify_all();
     if (writer.joinable()) writer.join();
-    close();
+    try {
+      closeMember();
+    } catch (const std::exception& e) {
+      if (error.empty()) error = e.what();
+    }
   }
 };
 

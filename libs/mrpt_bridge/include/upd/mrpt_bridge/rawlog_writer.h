@@ -6,7 +6,9 @@
 // compresses it (~5 ms for a 640 x 480 depth frame) while the caller goes on: the loop of
 // `upd live` does not wait for zlib. Up to 128 MB of observations wait for the writer; beyond
 // that write() waits (none is dropped). The file is byte for byte what writing each object to
-// CFileGZOutputStream in the caller's thread gives.
+// CFileGZOutputStream in the caller's thread gives (zlib's gz calls as it makes them), but a
+// member whose close fails (its last data not written: a full disk) is an error, where MRPT's
+// stream says nothing.
 //
 // Crash safety: the objects go to `<path>.part`; every flush_every observations the gzip member
 // is closed and a new one appended (a gzip file may hold several members, read as one stream),
