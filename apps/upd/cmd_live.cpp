@@ -76,10 +76,10 @@ const char* const kLiveUsage =
     "                     by upd calibrate-mount --output); applies to every source\n"
     "  --auto-mount       measure the mount from the floor in the first frames (robot on a\n"
     "                     level floor); no floor found: one line, exit status 1, no run\n\n"
-    "exit status: 0 done; 1 error (a source that cannot be opened, ...; a recording that\n"
-    "stopped, a full disk say: the run goes on without it); 2 usage error; 3 --navigate did not\n"
-    "reach the goal; 4 the source stopped (the robot was stopped); 5 the robot base stopped\n"
-    "answering (an emergency stop was sent). --output is written whenever the run took place.\n";
+    "exit status: 0 done; 1 error (a source that cannot be opened, ...), or a recording that\n"
+    "stopped (a full disk) while the run went on; 2 usage error; 3 --navigate did not reach the\n"
+    "goal; 4 the source stopped (the robot was stopped); 5 the robot base stopped answering (an\n"
+    "emergency stop was sent). --output is written whenever the run took place.\n";
 
 namespace {
 
@@ -327,17 +327,15 @@ int finishLive(const LiveOptions& o, const LiveTally& t, const maps::Traversabil
   printSummary(t, stats);
   if (o.record && t.record_error.empty()) {
     std::printf("  recorded %zu observations to %s\n", t.recorded, o.record->c_str());
+  } else if (o.record) {
+    std::fprintf(stderr, "upd live: error: the recording stopped after %zu observations: %s\n",
+                 t.recorded, t.record_error.c_str());
   }
   if (o.out) writeLiveOutputs(*o.out, o, t, grid, stats);
   if (t.base_fault) return kExitBaseFault;
   if (t.stall) return kExitSourceStopped;
   if (o.goal && !t.outcome.target_reached) return 3;
-  if (!t.record_error.empty()) {
-    std::fprintf(stderr, "upd live: error: the recording stopped after %zu observations: %s\n",
-                 t.recorded, t.record_error.c_str());
-    return 1;
-  }
-  return 0;
+  return t.record_error.empty() ? 0 : 1;
 }
 
 // `--auto-mount`: the mount measured from the floor in the source's first frames; throws (no

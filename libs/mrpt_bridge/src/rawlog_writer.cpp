@@ -111,7 +111,10 @@ struct RawlogWriter::Impl {
       if (!failed) {
         try {
           write(item.bytes);
-          if (item.end_member) closeMember(), openMember(true);
+          if (item.end_member) {
+            closeMember();  // (a complete member on disk)
+            openMember(true);
+          }
         } catch (const std::exception& e) {
           failure = e.what();
         }
