@@ -14,8 +14,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 
 namespace fs = std::filesystem;
 using upd::mrpt_bridge::RawlogEntry;
@@ -46,11 +44,6 @@ std::size_t readable(const std::string& path, std::vector<std::string>* classes 
   } catch (const upd::mrpt_bridge::RawlogError&) {
   }
   return reader.stats().entries;
-}
-
-std::string bytesOf(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace
@@ -116,9 +109,9 @@ TEST(SensorRecording, TheFileIsTheOneCFileGZOutputStreamWritesInTheCallersThread
   }
   out.reset();
   w.finish();
-  const std::string ours = bytesOf(path);
+  const std::string ours = upd::test::readFileBytes(path), theirs = upd::test::readFileBytes(peer);
   EXPECT_GT(ours.size(), 10000u);
-  EXPECT_TRUE(ours == bytesOf(peer)) << ours.size() << " bytes against " << bytesOf(peer).size();
+  EXPECT_TRUE(ours == theirs) << ours.size() << " bytes against " << theirs.size();
   EXPECT_EQ(readable(path), 8u);
 }
 
