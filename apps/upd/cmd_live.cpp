@@ -96,7 +96,8 @@ struct LiveTally {
   std::map<std::string, std::size_t> skipped;  ///< observations that gave no cloud, by reason
   std::optional<SourceStall> stall;
   std::optional<BaseFault> base_fault;
-  std::size_t recorded = 0;
+  std::size_t recorded = 0;  ///< the observations handed to the recording
+  std::size_t saved = 0;     ///< those of them in its file's complete members
   std::string record_error;  ///< why the recording stopped early ("" when it did not)
   nav::NavOutcome outcome;
 };
@@ -148,7 +149,8 @@ void writeLiveOutputs(const std::string& dir, const LiveOptions& o, const LiveTa
   if (o.record) {
     const bool whole = t.record_error.empty();
     j["recording"] = {{"path", whole ? *o.record : *o.record + ".part"},
-                      {"observations", t.recorded},
+                      {"observations", t.saved},
+                      {"observations_handed", t.recorded},
                       {"error", whole ? nlohmann::json() : nlohmann::json(t.record_error)}};
   }
   if (o.goal) {
@@ -202,12 +204,14 @@ struct LiveRun {
   std::optional<BaseFault> base_fault;  ///< set when the base stopped answering
   std::string record_error;             ///< why the recording stopped (the run went on)
   std::size_t recorded = 0;             ///< the observations handed to the recording
+  std::size_t saved = 0;                ///< those of them in its file's complete members
 };
 
 // A recording that fails (a full disk) stops, as rosbag's does, and the run goes on: one line
 // now, exit status 1 at the end. The .part file keeps what was written up to its last flush.
 void stopRecording(LiveRun& run, const std::string& error) {
   run.recorded = run.recorder->written();
+  run.saved = run.recorder->saved();  // (final: a failed writer writes nothing more)
   run.record_error = error;
   run.recorder.reset();  // (what is queued is dropped by the failed writer; the file closed)
   std::fprintf(stderr, "upd live: recording stopped: %s; the run goes on\n", error.c_str());
@@ -328,8 +332,10 @@ int finishLive(const LiveOptions& o, const LiveTally& t, const maps::Traversabil
   if (o.record && t.record_error.empty()) {
     std::printf("  recorded %zu observations to %s\n", t.recorded, o.record->c_str());
   } else if (o.record) {
-    std::fprintf(stderr, "upd live: error: the recording stopped after %zu observations: %s\n",
-                 t.recorded, t.record_error.c_str());
+    std::fprintf(stderr,
+                 "upd live: error: the recording stopped: %s; %s.part holds the first %zu of the "
+                 "%zu observations recorded\n",
+                 t.record_error.c_str(), o.record->c_str(), t.saved, t.recorded);
   }
   if (o.out) writeLiveOutputs(*o.out, o, t, grid, stats);
   if (t.base_fault) return kExitBaseFault;
@@ -377,11 +383,13 @@ int runSource(const LiveOptions& o, nav::NavConfig config, const RunConfig& run_
     try {
       run.recorded = run.recorder->written();
       run.recorder->finish();
+      run.saved = run.recorder->saved();
     } catch (const std::runtime_error& e) {
       stopRecording(run, e.what());
     }
   }
   t.recorded = run.recorded;
+  t.saved = run.saved;
   t.record_error = run.record_error;
   if (run.view && o.screenshot && run.view->isOpen()) {
     run.view->saveScreenshot(*o.screenshot);

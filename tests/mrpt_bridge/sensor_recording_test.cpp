@@ -13,6 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
+#include <csignal>
 #include <filesystem>
 
 namespace fs = std::filesystem;
@@ -25,6 +28,9 @@ mrpt::obs::CObservation3DRangeScan scan(int k, int w = 5, int h = 4) {
   mrpt::obs::CObservation3DRangeScan o;
   o.hasRangeImage = true;
   o.rangeImage.resize(h, w);
+  o.cameraParams.ncols = static_cast<uint32_t>(w);
+  o.cameraParams.nrows = static_cast<uint32_t>(h);
+  o.cameraParamsIntensity = o.cameraParams;
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) o.rangeImage(v, u) = static_cast<uint16_t>(1000 + k + (u ^ v) % 97);
   }
@@ -156,4 +162,35 @@ TEST(SensorRecording, AFullDiskIsReportedNamingTheFile) {
     EXPECT_EQ(message, "cannot write " + path + ".part: No space left on device") << width;
     EXPECT_FALSE(fs::exists(path)) << width;
   }
+}
+
+// A disk that fills part way (the process's file size limit): the writer reports it, and
+// saved() counts the observations of the members closed before, which a reader of the .part
+// file gets (the cut member after them may give up to its own).
+TEST(SensorRecording, SavedCountsTheObservationsOfTheCompleteMembers) {
+  const upd::test::TempDir dir;
+  const std::string path = dir.file("run.rawlog");
+  rlimit before{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &before), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);  // (a write past it fails with EFBIG)
+  rlimit limit = before;
+  limit.rlim_cur = 48 << 10;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limit), 0);
+  upd::mrpt_bridge::RawlogWriter w(path, 3);
+  std::string message;
+  try {
+    for (int k = 0; k < 400; ++k) w.write(scan(k, 64, 48));
+    w.finish();
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  setrlimit(RLIMIT_FSIZE, &before);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_EQ(message, "cannot write " + path + ".part: File too large");
+  const std::size_t saved = w.saved(), read = readable(path + ".part");
+  EXPECT_GT(saved, 0u);
+  EXPECT_EQ(saved % 3, 0u);  // (whole members)
+  EXPECT_GE(read, saved);
+  EXPECT_LE(read, saved + 3);  // (at most the cut member's)
+  EXPECT_LT(saved, w.written());
 }

@@ -66,6 +66,8 @@ struct RawlogWriter::Impl {
   std::size_t queued_bytes = 0;
   bool writing = false, stop = false;
   bool ended = false;  // (the owner's: end() called)
+  std::size_t done = 0;   // the observations compressed into the file
+  std::size_t saved = 0;  // of those, the ones in members closed without error
   std::string error;   // the writer's first failure (what follows it is not written)
   std::thread writer;
 
@@ -108,11 +110,13 @@ struct RawlogWriter::Impl {
       const bool failed = !error.empty();
       lock.unlock();
       std::string failure;
+      bool closed = false;
       if (!failed) {
         try {
           write(item.bytes);
           if (item.end_member) {
             closeMember();  // (a complete member on disk)
+            closed = true;
             openMember(true);
           }
         } catch (const std::exception& e) {
@@ -121,6 +125,8 @@ struct RawlogWriter::Impl {
       }
       lock.lock();
       if (error.empty()) error = failure;
+      if (!failed) ++done;
+      if (closed) saved = done;
       queued_bytes -= item.bytes.size();
       if (spare.size() < kSpareBuffers) spare.push_back(std::move(item.bytes));
       writing = false;
@@ -171,6 +177,7 @@ struct RawlogWriter::Impl {
     if (writer.joinable()) writer.join();
     try {
       closeMember();
+      if (error.empty()) saved = done;
     } catch (const std::exception& e) {
       if (error.empty()) error = e.what();
     }
@@ -206,6 +213,11 @@ void RawlogWriter::writeOdometry(double x_m, double y_m, double yaw_rad, double 
   odo.odometry = mrpt::poses::CPose2D(x_m, y_m, yaw_rad);
   odo.timestamp = mrpt::Clock::fromDouble(time_s);
   write(odo);
+}
+
+std::size_t RawlogWriter::saved() const {
+  std::lock_guard<std::mutex> lock(impl_->m);
+  return impl_->saved;
 }
 
 void RawlogWriter::drain() {

@@ -53,7 +53,11 @@ class RawlogWriter {
   /// std::runtime_error naming the .part file (left in place) when it could not be written.
   void finish();
 
+  /// The observations handed to write().
   std::size_t written() const { return written_; }
+  /// The observations in the file's complete members: those a reader of the .part file gets
+  /// (after a failure too); after finish(), all.
+  std::size_t saved() const;
   const std::string& path() const { return path_; }
   std::string partPath() const { return path_ + ".part"; }
 
