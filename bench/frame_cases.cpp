@@ -25,7 +25,7 @@ json frameTimingCase(const Frame& fr, const Options& o, Report& report, core::Pi
   const auto [t1, t2] = timeOneAndTwoCores(fr, p, o.repeats, &result, &probe);
   c["points"] = t1.points;
   c["points_scored"] = t1.scored;
-  c["starts_from"] = fr.depth ? "depth image" : "organized cloud (PCD)";
+  c["starts_from"] = fr.depth ? "depth image" : "organized cloud";
   c["one_core_ms"] = num(t1.total_ms);
   c["one_core_stages"] = t1.stages;
   c["two_core_ms"] = num(t2.total_ms);

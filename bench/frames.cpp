@@ -13,6 +13,10 @@
 #include "upd/sim/terrain.h"
 #include "upd/io/cloud_io.h"
 
+#ifdef UPD_BENCH_HAVE_DEPTH_FILES
+#include "upd/mrpt_bridge/depth_files.h"
+#endif
+
 #ifdef UPD_BENCH_HAVE_MAPS
 #include "upd/maps/grid_fusion.h"
 #include "upd/maps/traversability_grid.h"
@@ -214,7 +218,55 @@ std::vector<Frame> kinectFrames(const Options& o) {
   frames.push_back(pcdFrame(o, "region_growing_rgb_tutorial",
                             "pcl-data/region_growing_rgb_tutorial.pcd", {0.06f, -0.85f, -0.53f}));
   frames.push_back(generatedFrame());
+  for (const std::string& path : o.frames) frames.push_back(userFrame(o, path));
   return frames;
+}
+
+Frame userFrame(const Options& o, const std::string& path) {
+  Frame f;
+  f.name = std::filesystem::path(path).stem().string();
+  f.source = path;
+  f.up = Eigen::Vector3f(o.up[0], o.up[1], o.up[2]).normalized();
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".png") {
+#ifdef UPD_BENCH_HAVE_DEPTH_FILES
+    core::DepthImage depth = mrpt_bridge::readDepthPng(path, o.depth_scale);
+    if (!o.intrinsics.empty()) {
+      const auto calibration = mrpt_bridge::loadDepthCalibration(o.intrinsics);
+      f.intrinsics = calibration.K;
+      if (calibration.camera_on_robot && !o.up_given) {  // (the robot's z in the camera frame)
+        f.up = (calibration.camera_on_robot->linear().transpose() * Eigen::Vector3d::UnitZ())
+                   .cast<float>()
+                   .normalized();
+      }
+      if (f.intrinsics.width != depth.width || f.intrinsics.height != depth.height) {
+        throw std::runtime_error(path + ": " + std::to_string(depth.width) + " x " +
+                                 std::to_string(depth.height) + " pixels, where " +
+                                 o.intrinsics + " is for " + std::to_string(f.intrinsics.width) +
+                                 " x " + std::to_string(f.intrinsics.height));
+      }
+    } else {  // (the Kinect's focal length, the centre of the image)
+      f.intrinsics.width = depth.width, f.intrinsics.height = depth.height;
+      f.intrinsics.cx = (depth.width - 1) / 2.0, f.intrinsics.cy = (depth.height - 1) / 2.0;
+    }
+    f.cloud = core::depthToCloud(depth, f.intrinsics);
+    f.depth = std::move(depth);
+#else
+    throw std::runtime_error(path + ": depth PNGs need libs/mrpt_bridge, which this build has not");
+#endif
+  } else {
+    f.cloud = io::readCloud(path);
+    if (!f.cloud.isOrganized()) {
+      throw std::runtime_error(path + ": not an organized cloud (" +
+                               std::to_string(f.cloud.size()) +
+                               " points in one row): the frame tables take a camera's image");
+    }
+  }
+  f.available = true;
+  f.pose_world_cloud.linear() =
+      Eigen::Quaternionf::FromTwoVectors(f.up, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+  return f;
 }
 
 const char* mapStageKind() {

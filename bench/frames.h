@@ -40,8 +40,13 @@ Frame generatedFrame();
 /// The frame as the pipeline takes it: its depth image converted, or its organized cloud.
 core::PointCloud inputCloud(const Frame& f);
 
-/// The three Kinect frames of the report, in its order.
+/// The three Kinect frames of the report, in its order, then the user's (Options::frames).
 std::vector<Frame> kinectFrames(const Options& o);
+
+/// A frame of the user's: an organized cloud (.pcd, .ply) or a 16-bit depth PNG (with
+/// o.intrinsics, else the Kinect's at the image's size, and o.depth_scale). Throws
+/// std::runtime_error naming the file when it cannot be read or is not organized.
+Frame userFrame(const Options& o, const std::string& path);
 
 /// What the map-update stage of the frame loop does (it depends on whether libs/maps is built).
 const char* mapStageKind();

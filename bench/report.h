@@ -27,6 +27,12 @@ struct Options {
   bool frames_only = false;  // the frame pipeline timings alone (one core, two cores, memory)
   std::string only;          // "paper", "sensor-rate" or "octree": that table alone
   int repeats = 15;
+  // The user's frames (--frame), after the three of the report: organized clouds or depth PNGs.
+  std::vector<std::string> frames;
+  std::string intrinsics;     // a depth PNG's calibration YAML ("" the Kinect's)
+  double depth_scale = 0.001;  // a depth PNG's metres per unit
+  float up[3] = {0.f, -1.f, 0.f};  // gravity-up in the user's frames (a level camera)
+  bool up_given = false;           // --up (else a calibration's local_transform gives it)
 };
 
 // The performance targets the report checks (docs/PERFORMANCE.md, "Targets").

@@ -3,7 +3,8 @@
 // docs/PERFORMANCE.md.
 //
 // Usage: upd_bench [--data DIR] [--json OUT.json] [--quick] [--frames-only] [--only TABLE]
-//                  [--repeats N]
+//                  [--repeats N] [--frame FILE]... [--intrinsics F.yaml] [--depth-scale M]
+//                  [--up X,Y,Z]
 //   --data DIR   the shared real data (default: the build's UPD_SHARED_DATA_DIR); a missing
 //                file makes its case "skipped" in the report, never a failure
 //   --json OUT   also write the report as JSON (the same numbers as the printed tables)
@@ -13,6 +14,14 @@
 //   --only paper | sensor-rate | octree   that table alone: the paper's whole pipeline against
 //                PCL's, the sensor-rate path against PCL's integral-image normals, or the
 //                OctoMap update against OctoMap's own insert
+//   --frame FILE a frame of one's own, after the report's three in every frame table (the
+//                frame pipeline, the paper's pipeline, the sensor-rate path, ...) with its
+//                targets: an organized .pcd or .ply (a camera's image, NaN pixels kept) or a
+//                16-bit depth .png (--intrinsics F.yaml, an OpenCV or ROS calibration, else
+//                the Kinect's focal length of 525 px at the image's centre; --depth-scale M
+//                metres a unit, default 0.001: 0.0002 for TUM RGB-D); --up X,Y,Z is gravity-up
+//                in its camera frame (default: the calibration's local_transform where it has
+//                one, else 0,-1,0, a level camera's optical frame)
 //
 // What is timed, per case (medians over the runs after one warm-up run):
 //  - frame pipeline (organized 640 x 480): depth image (or organized cloud) -> normals -> UPD
@@ -26,6 +35,7 @@
 // every point and the exact UPD for every point or, where that would take minutes, for an evenly
 // spaced sample of points (the sample size is printed; agreement.cpp). The program exits 0
 // whether or not the targets are met: the report says which are.
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <stdexcept>
@@ -67,9 +77,41 @@ int run(const Options& o) {
   root["octree"] = octreeCases(frames, o);
   root["pcl_settings"] = pclSettingsCases(frames, o, report);
   root["growth_with_size"] = growthWithSizeCases(o, report);
-  root["growth_with_radius"] = growthWithRadiusCases(frames.back(), o, report);
+  root["growth_with_radius"] = growthWithRadiusCases(frames[2], o, report);  // (the generated)
   root["frames"] = frame_cases;
   return finish(report, o, bandwidth);
+}
+
+// text as a number, or std::invalid_argument "what: not a number".
+double number(const std::string& what, const std::string& text) {
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(v)) {
+    throw std::invalid_argument(what + ": not a number");
+  }
+  return v;
+}
+
+// --up X,Y,Z into up: three numbers, not all 0.
+void parseUp(const std::string& text, float up[3]) {
+  std::size_t start = 0;
+  for (int i = 0; i < 3; ++i) {
+    const std::size_t comma = text.find(',', start);
+    if ((i < 2) != (comma != std::string::npos)) {
+      throw std::invalid_argument("--up " + text + ": three numbers X,Y,Z");
+    }
+    const std::string part = text.substr(start, comma - start);
+    up[i] = static_cast<float>(number("--up " + text + " (" + part + ")", part));
+    start = comma + 1;
+  }
+  if (up[0] == 0 && up[1] == 0 && up[2] == 0) {
+    throw std::invalid_argument("--up " + text + ": the zero vector has no direction");
+  }
 }
 
 // Fills o from the command line; false when --help was printed.
@@ -96,10 +138,22 @@ bool parseOptions(int argc, char** argv, Options& o) {
     } else if (a == "--repeats") {
       o.repeats = std::stoi(value());
       if (o.repeats < 1) throw std::invalid_argument("--repeats must be >= 1");
+    } else if (a == "--frame") {
+      o.frames.push_back(value());
+    } else if (a == "--intrinsics") {
+      o.intrinsics = value();
+    } else if (a == "--depth-scale") {
+      const std::string v = value();
+      o.depth_scale = number(a + " " + v, v);
+      if (!(o.depth_scale > 0)) throw std::invalid_argument("--depth-scale must be > 0");
+    } else if (a == "--up") {
+      parseUp(value(), o.up);
+      o.up_given = true;
     } else if (a == "--help" || a == "-h") {
       std::printf(
           "usage: upd_bench [--data DIR] [--json OUT.json] [--quick] [--frames-only] "
-          "[--only paper|sensor-rate|octree] [--repeats N]\n");
+          "[--only paper|sensor-rate|octree] [--repeats N] [--frame FILE]... "
+          "[--intrinsics F.yaml] [--depth-scale M] [--up X,Y,Z]\n");
       return false;
     } else {
       throw std::invalid_argument("unknown option " + a + " (see --help)");
