@@ -8,7 +8,9 @@
 #include "depth_input.h"
 #include "run_config.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <iostream>
 
 namespace upd::app {
@@ -43,6 +45,31 @@ const char* const kAnalyzeUsage =
     "                        organized input keeps them with --no-preprocess)\n"
     "  --stats-json OUT.json summary: counts, zeta statistics, labels, per-stage timings and\n"
     "                        the method used (fast or exact path)\n";
+
+namespace {
+
+// Where the range cut-off removed every finite point (a georeferenced or airborne cloud, far
+// from its sensor origin), one line says how far the points lie, so that the fix is at hand.
+void noteRangeCutAll(const core::PointCloud& cloud, const core::PreprocessParams& p,
+                     const core::PreprocessStats& s) {
+  if (!p.range_enabled || s.range_removed == 0 || s.range_removed + s.non_finite < s.points_in) {
+    return;
+  }
+  double lo = std::numeric_limits<double>::infinity(), hi = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (!cloud.isFinite(i)) continue;
+    const double d = (cloud.point(i) - cloud.sensor_origin).cast<double>().norm();
+    lo = std::min(lo, d), hi = std::max(hi, d);
+  }
+  const Eigen::Vector3f& o = cloud.sensor_origin;
+  std::fprintf(stderr,
+               "upd analyze: note: the range cut-off (%.3g-%.3g m from the sensor origin %g,%g,%g) "
+               "removed every point: they lie %.4g-%.4g m from it; set [Preprocess] range_max_m "
+               "or range_enabled = false, or --no-preprocess\n",
+               p.range_min_m, p.range_max_m, o.x(), o.y(), o.z(), lo, hi);
+}
+
+}  // namespace
 
 int runAnalyze(const std::vector<std::string>& argv) {
   const Args args(argv,
@@ -95,6 +122,7 @@ int runAnalyze(const std::vector<std::string>& argv) {
                  "cloud in a camera's optical frame (y down) needs --up 0,-1,0 or --mount "
                  "MOUNT.ini\n");
   }
+  noteRangeCutAll(cloud, params.preprocess, result.preprocess_stats);
   return 0;
 }
 

@@ -177,6 +177,30 @@ TEST_F(Cli, CameraFrameCloudWithTheDefaultUpGetsANote) {
   EXPECT_NE(up.output.find(" 0 non-traversable"), std::string::npos) << up.output;
 }
 
+// A cloud far from its sensor origin (georeferenced, airborne) under a camera's range cut-off:
+// nothing is left to score, and one line says how far the points lie and what to set.
+TEST_F(Cli, ARangeCutOffThatRemovesEveryPointGetsANote) {
+  {
+    std::ofstream xyz(path("far.xyz"));
+    for (int i = 0; i <= 20; ++i) {
+      for (int j = 0; j <= 20; ++j) xyz << 1000 + 0.1 * i << " " << 0.1 * j << " 0\n";
+    }
+  }
+  const std::string config = std::string(UPD_SOURCE_DIR) + "/config/dune-kinect.ini";
+  const CmdResult cut = runUpd("analyze " + path("far.xyz") + " --config " + config);
+  ASSERT_EQ(cut.exit_code, 0) << cut.output;
+  EXPECT_NE(cut.output.find("441 points in, 0 scored"), std::string::npos) << cut.output;
+  EXPECT_NE(cut.output.find("upd analyze: note: the range cut-off (0.4-5 m from the sensor "
+                            "origin 0,0,0) removed every point: they lie 1000-1002 m from it"),
+            std::string::npos)
+      << cut.output;
+  const CmdResult kept =
+      runUpd("analyze " + path("far.xyz") + " --config " + config + " --no-preprocess");
+  ASSERT_EQ(kept.exit_code, 0) << kept.output;
+  EXPECT_EQ(kept.output.find("range cut-off"), std::string::npos) << kept.output;
+  EXPECT_NE(kept.output.find("441 points in, 441 scored"), std::string::npos) << kept.output;
+}
+
 TEST_F(Cli, MissingInputNamesTheFileAndWritesNothing) {
   const CmdResult r = runUpd("analyze " + path("nope.pcd") + " --output " + path("o.ply"));
   EXPECT_EQ(r.exit_code, 1);
