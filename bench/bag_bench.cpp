@@ -33,7 +33,9 @@
 #include <string>
 #include <vector>
 
+#include "cli_args.h"
 #include "depth_frames.h"
+#include "upd/io/json_io.h"
 #include "upd/mrpt_bridge/gz_output_stream.h"
 #include "upd/ros1/bag_reader.h"
 #include "upd/ros1/conversions.h"
@@ -208,31 +210,33 @@ int run(int n_frames, int repeats, const std::string& json_path) {
                             {"cfilegz_ms_per_frame", w[2] / n_frames},
                             {"cfilegz_over_ours", w[2] / w[1]}};
   std::filesystem::remove_all(dir);
-  if (!json_path.empty()) std::ofstream(json_path) << report.dump(2) << "\n";
+  if (!json_path.empty()) upd::io::writeJsonAtomically(json_path, report);
   return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  int frames = 100, repeats = 7;
-  std::string json_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 < argc && a == "--frames") {
-      frames = std::stoi(argv[++i]);
-    } else if (i + 1 < argc && a == "--repeats") {
-      repeats = std::stoi(argv[++i]);
-    } else if (i + 1 < argc && a == "--json") {
-      json_path = argv[++i];
-    } else {
-      std::fprintf(stderr, "usage: upd_bag_bench [--frames N] [--repeats N] [--json OUT.json]\n");
-      return a == "--help" ? 0 : 2;
+  try {
+    int frames = 100, repeats = 7;
+    std::string json_path;
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (i + 1 < argc && a == "--frames") {
+        frames = upd::bench::positiveCount(a, argv[++i]);
+      } else if (i + 1 < argc && a == "--repeats") {
+        repeats = upd::bench::positiveCount(a, argv[++i]);
+      } else if (i + 1 < argc && a == "--json") {
+        json_path = argv[++i];
+      } else {
+        std::fprintf(stderr,
+                     "usage: upd_bag_bench [--frames N] [--repeats N] [--json OUT.json]\n");
+        return a == "--help" ? 0 : 2;
+      }
     }
+    return run(frames, repeats, json_path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "upd_bag_bench: %s\n", e.what());
+    return 1;
   }
-  if (frames < 1 || repeats < 1) {
-    std::fprintf(stderr, "upd_bag_bench: --frames and --repeats must be at least 1\n");
-    return 2;
-  }
-  return run(frames, repeats, json_path);
 }

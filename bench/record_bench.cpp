@@ -25,7 +25,9 @@
 #include <thread>
 #include <vector>
 
+#include "cli_args.h"
 #include "depth_frames.h"
+#include "upd/io/json_io.h"
 #include "upd/mrpt_bridge/rawlog_writer.h"
 #include "upd/sim/robot.h"
 
@@ -153,31 +155,33 @@ int run(int n_frames, int rounds, const std::string& json_path) {
                                  {"rawlog_writer", side(ours)},
                                  {"cfilegz_in_loop", side(peer)},
                                  {"peer_over_ours", peer_median / ours_median}};
-  if (!json_path.empty()) std::ofstream(json_path) << report.dump(2) << "\n";
+  if (!json_path.empty()) upd::io::writeJsonAtomically(json_path, report);
   return same ? 0 : 1;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  int frames = 100, rounds = 3;
-  std::string json_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 < argc && a == "--frames") {
-      frames = std::stoi(argv[++i]);
-    } else if (i + 1 < argc && a == "--rounds") {
-      rounds = std::stoi(argv[++i]);
-    } else if (i + 1 < argc && a == "--json") {
-      json_path = argv[++i];
-    } else {
-      std::fprintf(stderr, "usage: upd_record_bench [--frames N] [--rounds N] [--json OUT.json]\n");
-      return a == "--help" ? 0 : 2;
+  try {
+    int frames = 100, rounds = 3;
+    std::string json_path;
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      if (i + 1 < argc && a == "--frames") {
+        frames = upd::bench::positiveCount(a, argv[++i]);
+      } else if (i + 1 < argc && a == "--rounds") {
+        rounds = upd::bench::positiveCount(a, argv[++i]);
+      } else if (i + 1 < argc && a == "--json") {
+        json_path = argv[++i];
+      } else {
+        std::fprintf(stderr,
+                     "usage: upd_record_bench [--frames N] [--rounds N] [--json OUT.json]\n");
+        return a == "--help" ? 0 : 2;
+      }
     }
+    return run(frames, rounds, json_path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "upd_record_bench: %s\n", e.what());
+    return 1;
   }
-  if (frames < 1 || rounds < 1) {
-    std::fprintf(stderr, "upd_record_bench: --frames and --rounds must be at least 1\n");
-    return 2;
-  }
-  return run(frames, rounds, json_path);
 }

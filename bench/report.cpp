@@ -15,6 +15,7 @@
 
 #include "upd/core/stopwatch.h"
 #include "upd/core/version.h"
+#include "upd/io/json_io.h"
 
 namespace core = upd::core;
 
@@ -224,10 +225,7 @@ int finish(Report& report, const Options& o, double bandwidth) {
   root["targets_met"] = met;
   root["targets_total"] = report.targets.size();
   if (!o.json_path.empty()) {
-    std::ofstream out(o.json_path);
-    if (!out) throw std::runtime_error("cannot write " + o.json_path);
-    out << root.dump(2) << "\n";
-    if (!out) throw std::runtime_error("error writing " + o.json_path);
+    io::writeJsonAtomically(o.json_path, root);
     std::printf("report written to %s\n", o.json_path.c_str());
   }
   return 0;

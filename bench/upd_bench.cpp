@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "cases.h"
+#include "cli_args.h"
 #include "frames.h"
 #include "report.h"
 
@@ -80,21 +81,6 @@ int run(const Options& o) {
   root["growth_with_radius"] = growthWithRadiusCases(frames[2], o, report);  // (the generated)
   root["frames"] = frame_cases;
   return finish(report, o, bandwidth);
-}
-
-// text as a number, or std::invalid_argument "what: not a number".
-double number(const std::string& what, const std::string& text) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(v)) {
-    throw std::invalid_argument(what + ": not a number");
-  }
-  return v;
 }
 
 // --up X,Y,Z into up: three numbers, not all 0.
@@ -136,8 +122,7 @@ bool parseOptions(int argc, char** argv, Options& o) {
         throw std::invalid_argument("--only takes paper, sensor-rate or octree, not " + o.only);
       }
     } else if (a == "--repeats") {
-      o.repeats = std::stoi(value());
-      if (o.repeats < 1) throw std::invalid_argument("--repeats must be >= 1");
+      o.repeats = positiveCount(a, value());
     } else if (a == "--frame") {
       o.frames.push_back(value());
     } else if (a == "--intrinsics") {
