@@ -5,13 +5,17 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
+#include <string>
+#include <thread>
 
 #include "upd/core/stopwatch.h"
 #include "upd/core/version.h"
@@ -178,20 +182,55 @@ std::string cpuModel() {
 
 }  // namespace
 
+namespace {
+
+// The other threads ready to run beside this one (/proc/stat's procs_running less this one),
+// averaged over 20 looks 10 ms apart before the benchmark starts its own; NaN where it cannot be
+// read. The load average would lag: a run right after another reads the first one's load.
+double otherRunnable() {
+  double sum = 0;
+  int looks = 0;
+  for (int i = 0; i < 20; ++i) {
+    std::ifstream in("/proc/stat");
+    std::string key;
+    double running = 0;
+    while (in >> key) {
+      if (key == "procs_running" && in >> running) {
+        sum += running - 1, ++looks;
+        break;
+      }
+      in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return looks > 0 ? sum / looks : kNaN;
+}
+
+}  // namespace
+
 void describeMachine(Report& report, double bandwidth) {
   // The OpenMP wait policy changes the two-core timings: threads woken from sleep for each
   // parallel region (passive) cost more than threads that spin a while first (the default).
   const char* policy_env = std::getenv("OMP_WAIT_POLICY");
   const std::string policy = policy_env && *policy_env ? policy_env : "default";
+  const double others = otherRunnable();
   report.root["machine"] = {{"cpu", cpuModel()},
                             {"logical_cpus", omp_get_num_procs()},
                             {"copy_bandwidth_GBps", bandwidth},
                             {"compiler", __VERSION__},
                             {"omp_wait_policy", policy},
-                            {"upd_nav_version", core::version()}};
+                            {"upd_nav_version", core::version()},
+                            {"other_runnable_threads_at_start", num(others)}};
   std::printf("machine: %s, %d logical CPUs, copy bandwidth %.1f GB/s, OMP_WAIT_POLICY %s; "
               "UPD-Nav %s\n",
               cpuModel().c_str(), omp_get_num_procs(), bandwidth, policy.c_str(), core::version());
+  // Other jobs on the CPUs slow both sides and make the two-core figures meaningless.
+  if (others > 0.3) {
+    std::printf("note: %.1f other threads ready to run on average at the start: other jobs share "
+                "the CPUs; the times, and the two-core figures most, mean little "
+                "(docs/PERFORMANCE.md, \"The machine\")\n",
+                others);
+  }
 }
 
 int finish(Report& report, const Options& o, double bandwidth) {
