@@ -334,7 +334,7 @@ int finishLive(const LiveOptions& o, const LiveTally& t, const maps::Traversabil
   } else if (o.record) {
     std::fprintf(stderr,
                  "upd live: error: the recording stopped: %s; %s.part holds the first %zu of the "
-                 "%zu observations recorded\n",
+                 "%zu observations the run gave it\n",
                  t.record_error.c_str(), o.record->c_str(), t.saved, t.recorded);
   }
   if (o.out) writeLiveOutputs(*o.out, o, t, grid, stats);
