@@ -3,6 +3,7 @@
 #include <omp.h>
 #include <sched.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>

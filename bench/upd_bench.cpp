@@ -35,7 +35,6 @@
 // every point and the exact UPD for every point or, where that would take minutes, for an evenly
 // spaced sample of points (the sample size is printed; agreement.cpp). The program exits 0
 // whether or not the targets are met: the report says which are.
-#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <stdexcept>
