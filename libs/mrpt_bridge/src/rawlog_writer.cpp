@@ -125,7 +125,7 @@ struct RawlogWriter::Impl {
       }
       lock.lock();
       if (error.empty()) error = failure;
-      if (!failed) ++done;
+      if (!failed && failure.empty()) ++done;
       if (closed) saved = done;
       queued_bytes -= item.bytes.size();
       if (spare.size() < kSpareBuffers) spare.push_back(std::move(item.bytes));
