@@ -3,6 +3,7 @@
 #include <omp.h>
 #include <sched.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -219,7 +220,17 @@ std::vector<Frame> kinectFrames(const Options& o) {
   frames.push_back(pcdFrame(o, "region_growing_rgb_tutorial",
                             "pcl-data/region_growing_rgb_tutorial.pcd", {0.06f, -0.85f, -0.53f}));
   frames.push_back(generatedFrame());
-  for (const std::string& path : o.frames) frames.push_back(userFrame(o, path));
+  for (const std::string& path : o.frames) {
+    frames.push_back(userFrame(o, path));
+    // (A name met before, as office1 given again, is numbered: each target keeps its own line.)
+    Frame& added = frames.back();
+    const auto taken = [&](const std::string& name) {
+      return std::any_of(frames.begin(), frames.end() - 1,
+                         [&](const Frame& f) { return f.name == name; });
+    };
+    const std::string stem = added.name;
+    for (int n = 2; taken(added.name); ++n) added.name = stem + "#" + std::to_string(n);
+  }
   return frames;
 }
 

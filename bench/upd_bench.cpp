@@ -51,6 +51,26 @@ namespace core = upd::core;
 namespace upd::bench {
 namespace {
 
+// The user's frames (--frame) as read: what each starts from, its size and its up, printed and
+// as JSON (a wrong up or scale shows here before the tables).
+json describeYourFrames(const std::vector<Frame>& frames, const Options& o) {
+  json all = json::array();
+  for (std::size_t i = frames.size() - o.frames.size(); i < frames.size(); ++i) {
+    const Frame& f = frames[i];
+    const char* kind = f.depth ? "depth image" : "organized cloud";
+    std::printf("your frame %s: %s, %s of %zu x %zu, up %.3f,%.3f,%.3f\n", f.name.c_str(),
+                f.source.c_str(), kind, f.cloud.width, f.cloud.height, f.up.x(), f.up.y(),
+                f.up.z());
+    all.push_back({{"name", f.name},
+                   {"source", f.source},
+                   {"starts_from", kind},
+                   {"width", f.cloud.width},
+                   {"height", f.cloud.height},
+                   {"up", {f.up.x(), f.up.y(), f.up.z()}}});
+  }
+  return all;
+}
+
 int run(const Options& o) {
   Report report;
   json& root = report.root;
@@ -60,6 +80,7 @@ int run(const Options& o) {
   root["map_stage"] = mapStageKind();
 
   const std::vector<Frame> frames = kinectFrames(o);
+  root["your_frames"] = describeYourFrames(frames, o);
   if (o.only == "paper") root["paper_pipeline"] = paperPipelineCases(frames, o, report);
   if (o.only == "sensor-rate") root["sensor_rate"] = sensorRateCases(frames, o, report);
   if (o.only == "octree") root["octree"] = octreeCases(frames, o);

@@ -60,6 +60,12 @@ TEST(BenchFrame, AUsersDepthPngIsTimedBesideTheReportsFrames) {
   EXPECT_GT(ours["one_core_ms"].get<double>(), 0) << ours.dump();
   EXPECT_NE(r.output.find("floor_wall: frame pipeline, one core (median)"), std::string::npos)
       << r.output;
+  // (As read, before the tables: a wrong up or scale shows there.)
+  EXPECT_NE(r.output.find("your frame floor_wall: " + png +
+                          ", depth image of 640 x 480, up 0.000,-1.000,0.000"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(j["your_frames"][0]["up"], json::array({0.0, -1.0, 0.0}));
 }
 
 TEST(BenchFrame, AFrameItCannotTakeIsAOneLineError) {
