@@ -180,10 +180,6 @@ std::string cpuModel() {
   return "unknown";
 }
 
-}  // namespace
-
-namespace {
-
 // The other threads ready to run beside this one (/proc/stat's procs_running less this one),
 // averaged over 20 looks 10 ms apart before the benchmark starts its own; NaN where it cannot be
 // read. The load average would lag: a run right after another reads the first one's load.
