@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <limits>
 #include <iostream>
+#include <limits>
 
 namespace upd::app {
 

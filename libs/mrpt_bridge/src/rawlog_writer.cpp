@@ -110,10 +110,11 @@ struct RawlogWriter::Impl {
       const bool failed = !error.empty();
       lock.unlock();
       std::string failure;
-      bool closed = false;
+      bool wrote = false, closed = false;
       if (!failed) {
         try {
           write(item.bytes);
+          wrote = true;
           if (item.end_member) {
             closeMember();  // (a complete member on disk)
             closed = true;
@@ -125,8 +126,8 @@ struct RawlogWriter::Impl {
       }
       lock.lock();
       if (error.empty()) error = failure;
-      if (!failed && failure.empty()) ++done;
-      if (closed) saved = done;
+      if (wrote) ++done;
+      if (closed) saved = done;  // (a member that could not be reopened after it still counts)
       queued_bytes -= item.bytes.size();
       if (spare.size() < kSpareBuffers) spare.push_back(std::move(item.bytes));
       writing = false;
