@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "chunk_deal.h"
 #include "fast_cell_map.h"
 #include "fast_cell_ranks.h"
 #include "fast_normals_internal.h"
@@ -463,17 +464,20 @@ void computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
   const float inv_2s2 = 1.f / (2.f * sigma * sigma);
   std::size_t invalid = N - g.points.order.size();
   const NormalOrienter orient(cloud.sensor_origin, up, params.vertical_band_rad);
-  const auto n_cells = static_cast<std::ptrdiff_t>(g.n_cells);
+  // (Chunks of 16 cells dealt by ChunkDeal: a cell's points are spread over the cloud, and the
+  // normals are written by point.)
+  detail::ChunkDeal deal(g.n_cells, 16, openmp::maxThreads());
 #pragma omp parallel reduction(+ : invalid)
   {
     std::vector<float> cx, cy, cz;
     NormalBatch batch;
-#pragma omp for schedule(dynamic, 16)
-    for (std::ptrdiff_t cc = 0; cc < n_cells; ++cc) {
-      const auto c = static_cast<std::size_t>(cc);
-      invalid += gaussian ? cellNormalsWith<true>(g, c, radius2, inv_2s2, cx, cy, cz, batch,
-                                                  cloud, orient, out)
-                          : cellNormals(g, c, radius2, cx, cy, cz, batch, cloud, orient, out);
+    detail::ChunkDeal::Hand hand(deal, openmp::threadIndex());
+    for (std::size_t b, e; hand.next(b, e);) {
+      for (std::size_t c = b; c < e; ++c) {
+        invalid += gaussian ? cellNormalsWith<true>(g, c, radius2, inv_2s2, cx, cy, cz, batch,
+                                                    cloud, orient, out)
+                            : cellNormals(g, c, radius2, cx, cy, cz, batch, cloud, orient, out);
+      }
     }
     invalid += batch.flush(cloud, orient, out);
   }

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "chunk_deal.h"
 #include "fast_normals_internal.h"
 #include "upd/core/fast_normals.h"
 #include "upd/core/openmp.h"
@@ -421,14 +422,30 @@ std::size_t blockRowPixels(const PixelPass& p, std::ptrdiff_t bv, std::vector<fl
   return invalid;
 }
 
+// The normal of pixel i by a scan of its own into out; returns 1 where it has none.
+std::size_t pixelNormal(const PixelPass& p, const WindowScan& scan, std::size_t i, Normals& out) {
+  const std::size_t W = p.im.W;
+  const auto u = static_cast<std::ptrdiff_t>(i % W), v = static_cast<std::ptrdiff_t>(i / W);
+  Eigen::Vector3f n;
+  float curvature;
+  const Moments m = scan(u, v, i);
+  if (!(m.n >= 3 && detail::normalFromMoments(m, n, curvature))) {
+    detail::setUnset(out, i);
+    return 1;
+  }
+  detail::setNormal(out, i, p.orient(n, p.cloud.point(i)), curvature);
+  return 0;
+}
+
 // Pass 2. The pixels that need a scan of their own (no block centre on their surface) gather in
-// per-thread lists and are scanned after the rows, shared out dynamically: they cluster at
-// depth edges, and a static share of them left one thread with most of the work.
+// per-thread lists and are scanned after the rows, dealt by ChunkDeal: they cluster at depth
+// edges, and a static share of them left one thread with most of the work.
 std::size_t pixelNormals(const PixelPass& p, const WindowScan& scan, Normals& out) {
   const std::size_t W = p.im.W;
   std::size_t invalid = 0;
   std::vector<std::vector<std::uint32_t>> own_scan(static_cast<std::size_t>(openmp::maxThreads()));
   std::vector<std::uint32_t> to_scan;
+  detail::ChunkDeal deal;  // (a thread starts at its end of to_scan: its own rows' pixels)
 #pragma omp parallel reduction(+ : invalid)
   {
     std::vector<std::uint8_t> taken(W);
@@ -441,20 +458,11 @@ std::size_t pixelNormals(const PixelPass& p, const WindowScan& scan, Normals& ou
 #pragma omp single
     {
       for (const auto& list : own_scan) to_scan.insert(to_scan.end(), list.begin(), list.end());
+      deal.reset(to_scan.size(), 16, openmp::teamSize());
     }
-#pragma omp for schedule(dynamic, 16)
-    for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(to_scan.size()); ++k) {
-      const std::size_t i = to_scan[static_cast<std::size_t>(k)];
-      const auto u = static_cast<std::ptrdiff_t>(i % W), v = static_cast<std::ptrdiff_t>(i / W);
-      Eigen::Vector3f n;
-      float curvature;
-      const Moments m = scan(u, v, i);
-      if (!(m.n >= 3 && detail::normalFromMoments(m, n, curvature))) {
-        detail::setUnset(out, i);
-        ++invalid;
-        continue;
-      }
-      detail::setNormal(out, i, p.orient(n, p.cloud.point(i)), curvature);
+    detail::ChunkDeal::Hand hand(deal, openmp::threadIndex());
+    for (std::size_t b, e; hand.next(b, e);) {
+      for (std::size_t k = b; k < e; ++k) invalid += pixelNormal(p, scan, to_scan[k], out);
     }
   }
   return invalid;

@@ -12,6 +12,7 @@
 #include <numeric>
 #include <vector>
 
+#include "chunk_deal.h"
 #include "fast_cell_map.h"
 #include "fast_cell_ranks.h"
 #include "fast_simd.h"
@@ -293,23 +294,22 @@ UPD_NOIPA void searchCells(CellSearch& search, const PointGrid& g,
 }
 
 // The k + 1 nearest of every point by the grid g, their mean distance into mean_dist (cells
-// in dynamic shares: their cost varies); the points not settled within 3 rings go to rest
-// (their grid positions).
+// dealt in shares by ChunkDeal: their cost varies); the points not settled within 3 rings go to
+// rest (their grid positions).
 void gridMeanDistances(const PointGrid& g, std::size_t want, std::vector<double>& mean_dist,
                        std::vector<std::uint32_t>& rest) {
   const std::size_t n_cells = g.n_cells;
   constexpr std::size_t kCellsPerShare = 16;
-  const std::size_t n_shares = (n_cells + kCellsPerShare - 1) / kCellsPerShare;
+  // (Dealt by ChunkDeal: a cell's points are spread over the cloud, and their means are
+  // written by point.)
+  detail::ChunkDeal deal(n_cells, kCellsPerShare, openmp::maxThreads());
 #pragma omp parallel
   {
     thread_local CellSearch search;  // (its blocks' buffers kept from call to call)
     search.start(g, want);
     std::vector<std::uint32_t> my_rest;
-#pragma omp for schedule(dynamic, 1)
-    for (std::ptrdiff_t sh = 0; sh < static_cast<std::ptrdiff_t>(n_shares); ++sh) {
-      const std::size_t c0 = static_cast<std::size_t>(sh) * kCellsPerShare;
-      searchCells(search, g, c0, std::min(n_cells, c0 + kCellsPerShare), mean_dist, my_rest);
-    }
+    detail::ChunkDeal::Hand hand(deal, openmp::threadIndex());
+    for (std::size_t c0, c1; hand.next(c0, c1);) searchCells(search, g, c0, c1, mean_dist, my_rest);
 #pragma omp critical(upd_outlier_rest)
     rest.insert(rest.end(), my_rest.begin(), my_rest.end());
   }
