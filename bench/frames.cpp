@@ -302,20 +302,27 @@ FrameTiming timeFramePipeline(const Frame& f, const core::PipelineParams& params
   return t;
 }
 
+void oneAndTwoCoresInBlocks(int repeats, CoreProbe* probe, const std::function<void(bool)>& one,
+                            const std::function<void(bool)>& two) {
+  for (int timed = 0; timed < repeats; timed += kTimedInBlock) {
+    const int n = std::min(kTimedInBlock, repeats - timed);
+    if (probe) probe->sample();
+    omp_set_num_threads(1);
+    {
+      const PinnedToThisCpu pin;
+      for (int frame = -1; frame < n; ++frame) one(frame >= 0);
+    }
+    omp_set_num_threads(2);
+    for (int frame = -1; frame < n; ++frame) two(frame >= 0);
+  }
+}
+
 std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const core::PipelineParams& params,
                                                        int repeats, core::PipelineResult* last,
                                                        CoreProbe* probe) {
   FrameLoop one(f, params), two(f, params);
-  for (int run = -1; run < repeats; ++run) {
-    if (probe && run >= 0) probe->sample();
-    omp_set_num_threads(1);
-    {
-      const PinnedToThisCpu pin;
-      one.run(run >= 0);
-    }
-    omp_set_num_threads(2);
-    two.run(run >= 0);
-  }
+  oneAndTwoCoresInBlocks(
+      repeats, probe, [&](bool record) { one.run(record); }, [&](bool record) { two.run(record); });
   std::pair<FrameTiming, FrameTiming> t{one.timing(), two.timing()};
   if (last) *last = std::move(one.result());
   return t;

@@ -62,9 +62,20 @@ struct FrameTiming {
 FrameTiming timeFramePipeline(const Frame& f, const core::PipelineParams& params, int repeats,
                               core::PipelineResult* last = nullptr);
 
-/// The same on one core and on two, frame by frame in turn: on a shared machine whose speed
-/// drifts, both medians then see the same conditions and their ratio is the second core's gain.
-/// With a probe, it is sampled beside each timed pair (the machine's own second core then).
+/// Frames on one core and on two in turn, a block of each at a time: a frame to warm up, then
+/// kTimedInBlock timed ones (one(record) and two(record) run a frame and keep its time when
+/// record), until repeats of each are timed. On a shared machine whose speed drifts both
+/// medians then see the same conditions, and their ratio is the second core's gain. A block,
+/// not a single frame: each thread keeps its share of the buffers in its own core's cache from
+/// frame to frame, as a sensor loop at one team size does, and a two-core frame right after a
+/// one-core one finds them in the other core's (office1's paper frame 0.3-0.5 ms longer). The
+/// one-core frames are pinned to the CPU they start on (PinnedToThisCpu). With a probe, it is
+/// sampled before each pair of blocks (the machine's own second core then).
+constexpr int kTimedInBlock = 3;
+void oneAndTwoCoresInBlocks(int repeats, CoreProbe* probe, const std::function<void(bool)>& one,
+                            const std::function<void(bool)>& two);
+
+/// The frame pipeline on one core and on two (oneAndTwoCoresInBlocks).
 std::pair<FrameTiming, FrameTiming> timeOneAndTwoCores(const Frame& f, const core::PipelineParams& params,
                                                        int repeats,
                                                        core::PipelineResult* last = nullptr,

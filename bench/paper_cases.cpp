@@ -37,7 +37,7 @@ struct StageMedians {
 // run); the stage medians of each into stages and two_stages.
 struct PaperTiming {
   double one_ms = kNaN, two_ms = kNaN;
-  CoreProbe probe;  // sampled beside each pair
+  CoreProbe probe;  // sampled before each pair of blocks
   json stages, two_stages;
   std::size_t scored = 0;
 };
@@ -48,29 +48,24 @@ PaperTiming timePaperPipeline(const core::PointCloud& cloud, const core::Pipelin
   std::vector<double> t1, t2;
   StageMedians s1, s2;
   PaperTiming t;
-  for (int run = -1; run < repeats; ++run) {
-    if (run >= 0) t.probe.sample();
-    omp_set_num_threads(1);
-    const core::Stopwatch w1;
-    core::runPipeline(cloud, p, one);
-    const double ms1 = w1.elapsedMs();
-    omp_set_num_threads(2);
-    const core::Stopwatch w2;
-    core::runPipeline(cloud, p, two);
-    const double ms2 = w2.elapsedMs();
-    if (run < 0) continue;
-    t1.push_back(ms1), t2.push_back(ms2);
-    s1.add(one.timings), s2.add(two.timings);
-  }
+  // (Each side's frame timed with its own result, kept from frame to frame.)
+  const auto frame = [&](core::PipelineResult& r, std::vector<double>& ms, StageMedians& s,
+                         bool record) {
+    const core::Stopwatch w;
+    core::runPipeline(cloud, p, r);
+    if (!record) return;
+    ms.push_back(w.elapsedMs());
+    s.add(r.timings);
+  };
+  oneAndTwoCoresInBlocks(
+      repeats, &t.probe, [&](bool record) { frame(one, t1, s1, record); },
+      [&](bool record) { frame(two, t2, s2, record); });
   t.one_ms = median(t1), t.two_ms = median(t2);
   t.stages = s1.toJson(), t.two_stages = s2.toJson();
   t.scored = one.cloud.size();
   return t;
 }
 
-// The PCL side: the same cut-off (applied before its clock starts: PCL has no range filter of
-// its own), then VoxelGrid, StatisticalOutlierRemoval, NormalEstimation and the UPD by a radius
-// search, one core.
 json pclPaperPipeline(const core::PointCloud& cloud, const core::PipelineParams& p,
                       double& total_ms) {
   core::PreprocessParams cut = p.preprocess;

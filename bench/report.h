@@ -88,7 +88,7 @@ double copyBandwidthGBs();
 /// What this machine's second core gives at the moment, as a peer for the pipelines' second
 /// core: work of compute alone (independent multiply-adds, no memory, no serial part) in 24
 /// parallel regions of equal halves, as many regions a run as a frame's stages, run on one
-/// thread and then on two beside each frame pair of a timing loop. Where the second CPU is
+/// thread and then on two before each pair of blocks of a timing loop. Where the second CPU is
 /// shared (a VM's vCPU whose sibling or host is busy), a region waits for the slower thread
 /// and the probe falls below 2 with the pipelines; the two read together tell the code's
 /// scaling from the machine's.
