@@ -174,10 +174,13 @@ bool makeDense(RadiusGrid& g, const std::int32_t (&lo)[3], const std::int32_t (&
 
 // The most points in a cell and the grid's point rows sized (slack for gatherAround's copies,
 // 8 at a time; the candidate rows have kScanLanes = 8 more), once the points are listed by cell.
+// (Only the slack is filled here: copyByCell writes the rest on the team, each thread its share,
+// and the rows keep their size from call to call.)
 void sizeRows(RadiusGrid& g) {
   g.max_cell_points = g.points.mostInACell();
   const std::size_t n = g.points.order.size();
-  g.x.assign(n + 8, kFar), g.y.assign(n + 8, kFar), g.z.assign(n + 8, kFar);
+  g.x.resize(n + 8), g.y.resize(n + 8), g.z.resize(n + 8);
+  detail::fillEight(kFar, g.x.data() + n, g.y.data() + n, g.z.data() + n);
 }
 
 // Grid points [s0, s1) (cloud points of the cells in id order) copied, relative to ref.
@@ -191,28 +194,50 @@ void copyByCell(const PointCloud& cloud, const Eigen::Vector3d& ref, RadiusGrid&
 }
 
 // Where the cells are numbered by rank: the cells of the finite points (cell_of not kNoIndex;
-// their cells' coordinates in cell_xyz, 3 per point) marked, the points listed by cell and
-// copied, on the team from 16,384 points (the same grid on any number of threads).
+// their cells' coordinates in rows) marked, the points listed by cell and copied, on the team
+// from 16,384 points (the same grid on any number of threads).
 void rankAndCopy(const PointCloud& cloud, std::size_t first, const Eigen::Vector3d& ref,
-                 const std::int32_t* cell_xyz, std::vector<std::uint32_t>& cell_of,
-                 RadiusGrid& g) {
+                 const detail::CellRows& rows, std::uint32_t* cell_of, RadiusGrid& g) {
   const std::size_t N = cloud.size();
-  const detail::CellRows rows{cell_xyz, cell_xyz + 1, cell_xyz + 2, 3};
 #pragma omp parallel if (N - first > 16384)
   detail::rankListAndCopyTeam(
-      g.dense, rows, N, cell_of.data(), g.points, g.team_counts, g.xyz,
+      g.dense, rows, N, cell_of, g.points, g.team_counts, g.xyz,
       [&](std::size_t n_cells) { g.n_cells = n_cells, sizeRows(g); },
       [&](std::size_t s0, std::size_t s1) { copyByCell(cloud, ref, g, s0, s1); });
 }
 
-void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, RadiusGrid& g) {
+// The cells of edge 1 / inv of points [0, n) relative to ref: floor((double(x) - ref) * inv)
+// along each axis into cx, cy and cz, clamped to +-2^30 (NaN to -2^30), which fails keyFits as
+// any cell beyond the keys' range does. (Cloned: a vector of doubles at a time.)
+UPD_VECTOR_CLONES
+void cellsOfPoints(const float* __restrict x, const float* __restrict y,
+                   const float* __restrict z, std::size_t n, double rx, double ry, double rz,
+                   double inv, std::int32_t* __restrict cx, std::int32_t* __restrict cy,
+                   std::int32_t* __restrict cz) {
+  constexpr double kLimit = 1073741824.0;
+  const auto cell = [&](float v, double r) {
+    double c = std::floor((static_cast<double>(v) - r) * inv);
+    c = c > -kLimit ? c : -kLimit;
+    return static_cast<std::int32_t>(c < kLimit ? c : kLimit);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    cx[i] = cell(x[i], rx), cy[i] = cell(y[i], ry), cz[i] = cell(z[i], rz);
+  }
+}
+
+// The grid g of the finite points of cloud (from first, the first of them) in cells of edge
+// radius_m; the other points' normals in out set unset.
+void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, RadiusGrid& g,
+                 Normals& out) {
   const std::size_t N = cloud.size();
   const Eigen::Vector3d ref = cloud.point(first).cast<double>();
   const double inv = 1.0 / radius_m;
-  // Every finite point's cell and the cells' box.
-  // (Not zeroed: only the finite points' cells are written and read.)
-  const std::unique_ptr<std::int32_t[]> cell_xyz(new std::int32_t[3 * N]);
-  std::vector<std::uint32_t> cell_of(N, kNoIndex);
+  // Every point's cell (by axis; a non-finite point's is not read) and the finite points' box.
+  // (Not initialized: each thread writes its share, which stays in its core's cache.)
+  const std::unique_ptr<std::int32_t[]> cells(new std::int32_t[3 * N]);
+  std::int32_t *cx = cells.get(), *cy = cx + N, *cz = cy + N;
+  const std::unique_ptr<std::uint32_t[]> cell_of_points(new std::uint32_t[N]);
+  std::uint32_t* cell_of = cell_of_points.get();
   std::int32_t lo[3], hi[3];
   for (int a = 0; a < 3; ++a) {
     lo[a] = std::numeric_limits<std::int32_t>::max();
@@ -221,24 +246,29 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   std::size_t n_finite = 0;
   bool fits = true;
   // (In static shares on the team: each point's cell by itself, the box by min and max.)
-#pragma omp parallel for if (N > 16384) schedule(static) reduction(min : lo[:3]) \
-    reduction(max : hi[:3]) reduction(+ : n_finite) reduction(&& : fits)
-  for (std::size_t i = first; i < N; ++i) {
-    if (!cloud.isFinite(i)) continue;
-    const Eigen::Vector3d p = (cloud.point(i).cast<double>() - ref) * inv;
-    const std::int64_t c[3] = {detail::floorToInt(p.x()), detail::floorToInt(p.y()),
-                               detail::floorToInt(p.z())};
-    if (!detail::keyFits(c[0], c[1], c[2])) {
-      fits = false;
-      continue;
+#pragma omp parallel if (N > 16384) reduction(min : lo[:3]) reduction(max : hi[:3]) \
+    reduction(+ : n_finite) reduction(&& : fits)
+  {
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    const std::size_t b = detail::RankedCells::share(N, team, me);
+    const std::size_t e = detail::RankedCells::share(N, team, me + 1);
+    cellsOfPoints(&cloud.x[b], &cloud.y[b], &cloud.z[b], e - b, ref.x(), ref.y(), ref.z(), inv,
+                  cx + b, cy + b, cz + b);
+    for (std::size_t i = b; i < e; ++i) {
+      cell_of[i] = kNoIndex;
+      if (!cloud.isFinite(i)) {
+        detail::setUnset(out, i);
+        continue;
+      }
+      if (!detail::keyFits(cx[i], cy[i], cz[i])) {
+        fits = false;
+        continue;
+      }
+      const std::int32_t c[3] = {cx[i], cy[i], cz[i]};
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+      cell_of[i] = 0;  // (finite: numbered below)
+      ++n_finite;
     }
-    std::int32_t* o = &cell_xyz[3 * i];
-    for (int a = 0; a < 3; ++a) {
-      o[a] = static_cast<std::int32_t>(c[a]);
-      lo[a] = std::min(lo[a], o[a]), hi[a] = std::max(hi[a], o[a]);
-    }
-    cell_of[i] = 0;  // (finite: numbered below)
-    ++n_finite;
   }
   if (!fits) {
     throw std::invalid_argument("NormalParams.radius_m = " + std::to_string(radius_m) +
@@ -246,14 +276,13 @@ void binByRadius(const PointCloud& cloud, std::size_t first, double radius_m, Ra
   }
   g.has_dense = makeDense(g, lo, hi, n_finite);
   if (g.has_dense) {
-    rankAndCopy(cloud, first, ref, cell_xyz.get(), cell_of, g);
+    rankAndCopy(cloud, first, ref, detail::CellRows{cx, cy, cz, 1}, cell_of, g);
     return;
   }
   g.grid = detail::CellGrid(N / 8 + 64);
   for (std::size_t i = first; i < N; ++i) {
     if (cell_of[i] == kNoIndex) continue;
-    const std::int32_t* c = &cell_xyz[3 * i];
-    cell_of[i] = g.grid.insert(c[0], c[1], c[2]);
+    cell_of[i] = g.grid.insert(cx[i], cy[i], cz[i]);
   }
   g.xyz = g.grid.coords(), g.n_cells = g.grid.size();
   detail::listByCell(
@@ -374,6 +403,7 @@ class NormalBatch {
     for (std::size_t b = 0; b < size_; ++b) {
       const std::size_t i = index_[b];
       if (!ok_[b]) {
+        detail::setUnset(out, i);
         ++failed;
         continue;
       }
@@ -415,6 +445,7 @@ __attribute__((always_inline)) inline std::size_t cellNormalsWith(
                                              n_candidates - 1, 1, p.x(), p.y(), p.z(), radius2);
     if (!kGaussian) count = static_cast<std::size_t>(m.n);
     if (count < 3) {
+      detail::setUnset(out, g.points.order[s]);
       ++invalid;
       continue;
     }
@@ -449,15 +480,19 @@ void computeNormalsGrid(const PointCloud& cloud, const NormalParams& params,
   requireParam(params.knn == 0, "NormalParams", "knn", params.knn,
                "computeNormalsGrid finds radius neighbourhoods: it needs knn = 0");
   const std::size_t N = cloud.size();
-  out.setUnset(N);
   std::size_t first = 0;
   while (first < N && !cloud.isFinite(first)) ++first;
   if (first == N) {
-    out.invalid = N;
+    out.setUnset(N);
     return;
   }
-  RadiusGrid g;
-  binByRadius(cloud, first, params.radius_m, g);
+  // Every point's normal is written below, on the team (a normal, or NaN): the buffers are not
+  // filled first, as a fill on one thread would leave the other threads' points in its core's
+  // cache. The grid keeps its buffers from call to call (the calling thread's).
+  out.nx.resize(N), out.ny.resize(N), out.nz.resize(N), out.curvature.resize(N);
+  thread_local RadiusGrid kept;
+  RadiusGrid& g = kept;
+  binByRadius(cloud, first, params.radius_m, g, out);
   const float radius2 = static_cast<float>(params.radius_m * params.radius_m);
   const bool gaussian = params.weighting == NormalWeighting::Gaussian;
   const float sigma = 0.5f * static_cast<float>(params.radius_m);
