@@ -53,15 +53,21 @@ void sizeRows(PointGrid& g, std::size_t n_finite) {
 // copied, on the team from kTeamPoints points (the same grid on any number of threads).
 void rankAndCopy(const PointCloud& in, const std::vector<std::uint32_t>& finite, PointGrid& g) {
   const std::size_t n = finite.size();
-  std::vector<std::uint32_t>& cell_of = g.cell_of;
-  std::fill(cell_of.begin(), cell_of.end(), 0u);  // (every point has a cell)
+  std::uint32_t* cell_of = g.cell_of.data();
   const CellCoords& k = g.coords;
   const CellRows rows{k.x.data(), k.y.data(), k.z.data(), 1};
 #pragma omp parallel if (n >= CellCoords::kTeamPoints)
-  rankListAndCopyTeam(
-      g.dense, rows, n, cell_of.data(), g.by_cell, g.team_counts, g.cell_xyz,
-      [&](std::size_t n_cells) { g.n_cells = n_cells, sizeRows(g, n); },
-      [&](std::size_t j0, std::size_t j1) { copyByCell(in, finite, g, j0, j1); });
+  {
+    // Every point has a cell. (Each thread marks its static share, which the team's marking
+    // reads first on the same thread: no barrier, and the share stays in its core's cache.)
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    std::fill(cell_of + RankedCells::share(n, team, me), cell_of + RankedCells::share(n, team, me + 1),
+              0u);
+    rankListAndCopyTeam(
+        g.dense, rows, n, cell_of, g.by_cell, g.team_counts, g.cell_xyz,
+        [&](std::size_t n_cells) { g.n_cells = n_cells, sizeRows(g, n); },
+        [&](std::size_t j0, std::size_t j1) { copyByCell(in, finite, g, j0, j1); });
+  }
 }
 
 }  // namespace

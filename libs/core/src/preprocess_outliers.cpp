@@ -274,11 +274,8 @@ UPD_NOIPA void searchCells(CellSearch& search, const PointGrid& g,
                            std::vector<double>& mean_dist,
                            std::vector<std::uint32_t>& rest) {
   const auto store = [&](std::uint32_t q, double mean) {
-    if (std::isnan(mean)) {
-      rest.push_back(q);
-    } else {
-      mean_dist[g.index[q]] = mean;
-    }
+    if (std::isnan(mean)) rest.push_back(q);  // (NaN until rest has its answer)
+    mean_dist[g.index[q]] = mean;
   };
   const bool two = detail::selectsSorted();
   for (std::size_t c = c0; c < c1; ++c) {
@@ -416,20 +413,29 @@ UPD_NOIPA void meanNeighbourDistances(const PointCloud& in, int k,
                                       std::vector<std::uint32_t>& finite,
                                       std::vector<std::uint32_t>& rest,
                                       PointGrid& g) {
-  mean_dist.assign(in.size(), std::numeric_limits<double>::quiet_NaN());
+  // Every point's mean distance is written below, or NaN: the buffer is not filled first (the
+  // search writes by cell on the team, and a fill on one thread would leave the other's points
+  // in its core's cache).
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  mean_dist.resize(in.size());
   finite.clear();
   if (in.countFinite() == in.size()) {  // (as the voxel grid's centroids: by a vector scan)
     finite.resize(in.size());
     std::iota(finite.begin(), finite.end(), 0u);
   } else {
     for (std::size_t i = 0; i < in.size(); ++i) {
-      if (in.isFinite(i)) finite.push_back(static_cast<std::uint32_t>(i));
+      if (in.isFinite(i)) {
+        finite.push_back(static_cast<std::uint32_t>(i));
+      } else {
+        mean_dist[i] = kNaN;
+      }
     }
   }
   if (finite.empty()) return;
   const std::size_t want = static_cast<std::size_t>(k) + 1;  // the point itself comes first
   // (A k beyond NearestK's capacity, or a cloud beyond the keys' range: the k-d tree alone.)
   if (want > NearestK::kMax || !buildGrid(in, finite, gridCellEdge(in, finite, k, g.coords), g)) {
+    for (const std::uint32_t i : finite) mean_dist[i] = kNaN;  // (where it finds no neighbour)
     kdTreeMeanDistances(in, k, finite, mean_dist);
     return;
   }
