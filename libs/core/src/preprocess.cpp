@@ -142,31 +142,64 @@ PointCloud voxelDownsample(const PointCloud& in, double voxel_m) {
 }
 
 namespace {
+// The count, sum and sum of squares of the finite values of v[b, e), in order.
+struct MeanSums {
+  std::size_t n = 0;
+  double s = 0, s2 = 0;
+  void add(const double* v, std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      if (std::isnan(v[i])) continue;
+      s += v[i], s2 += v[i] * v[i], ++n;
+    }
+  }
+};
+
 // The outlier filter's verdict per point: its mean neighbour distance within mu + std_mul sigma
-// (the calling thread's buffer, valid until its next call).
+// (the calling thread's buffer, valid until its next call). On the team from 16,384 points:
+// the sums by blocks of kSumBlock points, each block's in order and the blocks' in order (the
+// same limit on any number of threads), then each thread's share of the verdicts, the share
+// compactInPlace reads on the same thread.
 const std::vector<char>& outlierKeepMask(const PointCloud& in, int k, double std_mul) {
   requireParam(k >= 1, "PreprocessParams", "outlier_k", k, "must be >= 1");
   thread_local std::vector<double> mean_dist;  // (kept from call to call, as keep)
   thread_local std::vector<char> keep;
+  thread_local std::vector<MeanSums> block_sums;
   meanNeighbourDistances(in, k, mean_dist);
-  double s = 0, s2 = 0;
-  std::size_t n = 0;
-  for (const double d : mean_dist) {
-    if (std::isnan(d)) continue;
-    s += d;
-    s2 += d * d;
-    ++n;
-  }
-  keep.assign(in.size(), 0);
-  if (n == 0) return keep;
-  const double mu = s / n;
-  const double sigma = std::sqrt(std::max(0.0, s2 / n - mu * mu));
-  const double limit = mu + std_mul * sigma;
-  const double* m = mean_dist.data();  // (plain pointers: char stores alias the vectors)
+  const std::size_t N = in.size();
+  constexpr std::size_t kSumBlock = 4096;
+  const std::size_t n_blocks = (N + kSumBlock - 1) / kSumBlock;
+  keep.resize(N);
+  block_sums.assign(n_blocks, MeanSums{});
+  // (Plain pointers: char stores alias the vectors, and the thread_locals are the calling
+  // thread's.)
+  const double* m = mean_dist.data();
   char* k_out = keep.data();
-  for (std::size_t i = 0; i < in.size(); ++i) {
-    // A point alone has no neighbour distance: it is an outlier by definition.
-    k_out[i] = !std::isnan(m[i]) && m[i] <= limit;
+  MeanSums* sums = block_sums.data();
+  double limit = 0;
+#pragma omp parallel if (N > 16384)
+  {
+#pragma omp for schedule(static)
+    for (std::size_t b = 0; b < n_blocks; ++b) {
+      sums[b].add(m, b * kSumBlock, std::min(N, (b + 1) * kSumBlock));
+    }
+#pragma omp single
+    {
+      MeanSums all;
+      for (std::size_t b = 0; b < n_blocks; ++b) {
+        all.n += sums[b].n, all.s += sums[b].s, all.s2 += sums[b].s2;
+      }
+      const double n = static_cast<double>(all.n);
+      const double mu = all.s / n;
+      // (No finite value: no point is kept.)
+      limit = all.n == 0 ? -std::numeric_limits<double>::infinity()
+                         : mu + std_mul * std::sqrt(std::max(0.0, all.s2 / n - mu * mu));
+    }
+    const auto team = static_cast<std::size_t>(openmp::teamSize());
+    const auto me = static_cast<std::size_t>(openmp::threadIndex());
+    for (std::size_t i = N * me / team; i < N * (me + 1) / team; ++i) {
+      // A point alone has no neighbour distance: it is an outlier by definition.
+      k_out[i] = !std::isnan(m[i]) && m[i] <= limit;
+    }
   }
   return keep;
 }

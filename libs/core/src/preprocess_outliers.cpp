@@ -419,7 +419,17 @@ UPD_NOIPA void meanNeighbourDistances(const PointCloud& in, int k,
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   mean_dist.resize(in.size());
   finite.clear();
-  if (in.countFinite() == in.size()) {  // (as the voxel grid's centroids: by a vector scan)
+  // (Counted by a vector scan, on the team from CellCoords::kTeamPoints: each thread its static
+  // share, the share it wrote of a compacted cloud.)
+  const std::size_t N = in.size();
+  std::size_t n_finite = 0;
+#pragma omp parallel if (N > detail::CellCoords::kTeamPoints) reduction(+ : n_finite)
+  {
+    const int team = openmp::teamSize(), me = openmp::threadIndex();
+    n_finite += countFinite(in, detail::RankedCells::share(N, team, me),
+                            detail::RankedCells::share(N, team, me + 1));
+  }
+  if (n_finite == N) {  // (as the voxel grid's centroids)
     finite.resize(in.size());
     std::iota(finite.begin(), finite.end(), 0u);
   } else {
