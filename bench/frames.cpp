@@ -234,14 +234,18 @@ std::vector<Frame> kinectFrames(const Options& o) {
   return frames;
 }
 
+bool isDepthPng(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".png";
+}
+
 Frame userFrame(const Options& o, const std::string& path) {
   Frame f;
   f.name = std::filesystem::path(path).stem().string();
   f.source = path;
   f.up = Eigen::Vector3f(o.up[0], o.up[1], o.up[2]).normalized();
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".png") {
+  if (isDepthPng(path)) {
 #ifdef UPD_BENCH_HAVE_DEPTH_FILES
     core::DepthImage depth = mrpt_bridge::readDepthPng(path, o.depth_scale);
     if (!o.intrinsics.empty()) {

@@ -48,6 +48,9 @@ std::vector<Frame> kinectFrames(const Options& o);
 /// std::runtime_error naming the file when it cannot be read or is not organized.
 Frame userFrame(const Options& o, const std::string& path);
 
+/// Whether a frame's file is read as a depth image (a .png, in any case).
+bool isDepthPng(const std::string& path);
+
 /// What the map-update stage of the frame loop does (it depends on whether libs/maps is built).
 const char* mapStageKind();
 

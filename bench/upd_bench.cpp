@@ -35,6 +35,7 @@
 // every point and the exact UPD for every point or, where that would take minutes, for an evenly
 // spaced sample of points (the sample size is printed; agreement.cpp). The program exits 0
 // whether or not the targets are met: the report says which are.
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <stdexcept>
@@ -163,6 +164,11 @@ bool parseOptions(int argc, char** argv, Options& o) {
     } else {
       throw std::invalid_argument("unknown option " + a + " (see --help)");
     }
+  }
+  // (The calibration of a depth image: with none to apply it to, it would be left unread.)
+  if (!o.intrinsics.empty() && std::none_of(o.frames.begin(), o.frames.end(), isDepthPng)) {
+    throw std::invalid_argument("--intrinsics " + o.intrinsics +
+                                ": a calibration for depth images, and no --frame is a .png");
   }
   return true;
 }

@@ -1,5 +1,6 @@
 // upd_bench --frame: a frame of the user's (a depth PNG, an organized cloud) is timed in the
-// frame tables beside the report's own, and a frame it cannot take is a one-line error.
+// frame tables beside the report's own, and a frame it cannot take (or a calibration with no depth
+// image to apply it to) is a one-line error.
 #include "run_upd.h"
 #include "temp_dir.h"
 
@@ -81,6 +82,9 @@ TEST(BenchFrame, AFrameItCannotTakeIsAOneLineError) {
       {"--frame " + xyz + " --up 0,0,0", "--up 0,0,0: the zero vector has no direction"},
       {"--frame " + xyz + " --up 0,1", "--up 0,1: three numbers X,Y,Z"},
       {"--frame " + xyz + " --depth-scale -1", "--depth-scale must be > 0"},
+      {"--frame " + xyz + " --intrinsics " + dir.file("k.yaml"),
+       "--intrinsics " + dir.file("k.yaml") + ": a calibration for depth images, and no --frame "
+       "is a .png"},
   };
   for (const auto& c : cases) {
     const CmdResult r = bench(c.args + data);
