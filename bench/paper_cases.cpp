@@ -33,8 +33,9 @@ struct StageMedians {
   }
 };
 
-// One core and two in turn, run by run, on the paper's pipeline (our buffers kept from run to
-// run); the stage medians of each into stages and two_stages.
+// One core and two in turn, a block of runs at a time (oneAndTwoCoresInBlocks), on the paper's
+// pipeline (our buffers kept from run to run); the stage medians of each into stages and
+// two_stages.
 struct PaperTiming {
   double one_ms = kNaN, two_ms = kNaN;
   CoreProbe probe;  // sampled before each pair of blocks
@@ -66,6 +67,9 @@ PaperTiming timePaperPipeline(const core::PointCloud& cloud, const core::Pipelin
   return t;
 }
 
+// The PCL side: the same cut-off (applied before its clock starts: PCL has no range filter of
+// its own), then VoxelGrid, StatisticalOutlierRemoval, NormalEstimation and the UPD by a radius
+// search, one core.
 json pclPaperPipeline(const core::PointCloud& cloud, const core::PipelineParams& p,
                       double& total_ms) {
   core::PreprocessParams cut = p.preprocess;
