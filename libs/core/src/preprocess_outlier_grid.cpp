@@ -61,8 +61,8 @@ void rankAndCopy(const PointCloud& in, const std::vector<std::uint32_t>& finite,
     // Every point has a cell. (Each thread marks its static share, which the team's marking
     // reads first on the same thread: no barrier, and the share stays in its core's cache.)
     const int team = openmp::teamSize(), me = openmp::threadIndex();
-    std::fill(cell_of + RankedCells::share(n, team, me), cell_of + RankedCells::share(n, team, me + 1),
-              0u);
+    std::fill(cell_of + RankedCells::share(n, team, me),
+              cell_of + RankedCells::share(n, team, me + 1), 0u);
     rankListAndCopyTeam(
         g.dense, rows, n, cell_of, g.by_cell, g.team_counts, g.cell_xyz,
         [&](std::size_t n_cells) { g.n_cells = n_cells, sizeRows(g, n); },
