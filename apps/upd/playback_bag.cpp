@@ -13,6 +13,8 @@
 #include <mrpt/poses/CPose3D.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <malloc.h>
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -102,6 +104,9 @@ std::optional<BagInput> convertBagInput(const std::string& path,
       });
       file.close();
     }
+    // The bag's chunks, kept decompressed for the read, are freed now; the heap keeps freed
+    // blocks for the frame loop (main's mallopt), so hand these back to the kernel.
+    malloc_trim(0);
     if (stats.frames == 0) {
       std::string why;
       for (const auto& [reason, n] : stats.skipped) {

@@ -1,7 +1,8 @@
 // A bag's messages are read from its checked chunks in the order rosbag's views give them: by
 // their times in the bag, whatever the order they were written in, a batch of chunks at a time.
 // The transforms are read in the walk that checks the chunks (one decompression of each chunk
-// for the walk and the transforms together). They must be the transforms rosbag's view of /tf
+// for the walk and the transforms together), and the chunks it decompressed are kept for the
+// read after it, up to a budget. They must be the transforms rosbag's view of /tf
 // and /tf_static gives, in its order of time: a bag whose transforms span many
 // chunks, a static transform of the camera written twice, in chunks far apart, the later in time
 // written first (it replaces the earlier one), and a robot pose written twice at one stamp by
@@ -143,6 +144,22 @@ std::vector<Read> readByView(const std::string& path) {
   return all;
 }
 
+const std::set<std::string> kAllTopics{"/tf", "/tf_static", "/camera/depth/camera_info",
+                                       "/camera/depth/image_raw"};
+
+// Every message on kAllTopics as walk reads them after its check, batch bytes at a time.
+std::vector<Read> readAll(ros1::detail::BagWalk& walk, std::uint64_t batch) {
+  std::vector<Read> read;
+  walk.readMessages(
+      kAllTopics,
+      [&](const ros1::detail::BagMessage& m) {
+        read.push_back({m.topic, m.time_ns, std::vector<std::uint8_t>(m.data, m.data + m.size)});
+        return true;
+      },
+      batch);
+  return read;
+}
+
 // The bag above, and the frames of a second recording written after it with earlier bag
 // times (a bag merged from two: its chunks do not follow each other in time), read a chunk at
 // a time, two chunks' bytes at a time and all at once: the messages of rosbag's view.
@@ -154,18 +171,9 @@ TEST_P(BagOrder, MessagesComeAsRosbagsView) {
   ASSERT_GT(expected.size(), 40u);
   ros1::detail::BagWalk walk(path);
   walk.checkChunks();
-  const std::set<std::string> topics{"/tf", "/tf_static", "/camera/depth/camera_info",
-                                     "/camera/depth/image_raw"};
   for (const std::uint64_t batch :
        {std::uint64_t{0}, std::uint64_t{2000}, ros1::detail::BagWalk::kBatchBytes}) {
-    std::vector<Read> read;
-    walk.readMessages(
-        topics,
-        [&](const ros1::detail::BagMessage& m) {
-          read.push_back({m.topic, m.time_ns, std::vector<std::uint8_t>(m.data, m.data + m.size)});
-          return true;
-        },
-        batch);
+    const std::vector<Read> read = readAll(walk, batch);
     EXPECT_TRUE(read == expected) << "batches of " << batch << " bytes: " << read.size()
                                   << " messages";
   }
@@ -173,6 +181,44 @@ TEST_P(BagOrder, MessagesComeAsRosbagsView) {
   ros1::readBag(path, {}, [&](const ros1::BagFrame& f) { stamps.push_back(f.stamp_s); });
   EXPECT_TRUE(std::is_sorted(stamps.begin(), stamps.end()));
   EXPECT_EQ(stamps.size(), 15u);
+}
+
+// The compressed chunks the check decompressed are kept for the read after it, in the file's
+// order up to the budget: with none kept every chunk is decompressed twice, with all kept once,
+// with a budget of a few chunks in between; the messages are rosbag's view's in every case.
+TEST_P(BagOrder, CheckedChunksAreKeptWithinTheBudget) {
+  test::TempDir dir("bag_keep");
+  const std::string path = dir.file("run.bag");
+  writeBag(path, GetParam(), /*second_recording=*/true);
+  const std::vector<Read> expected = readByView(path);
+  const bool compressed = GetParam() != rosbag::compression::Uncompressed;
+  std::size_t chunks = 0;
+  for (const std::uint64_t keep :
+       {std::uint64_t{0}, std::uint64_t{4000}, ros1::detail::BagWalk::defaultKeepBytes()}) {
+    ros1::detail::BagWalk walk(path, keep);
+    walk.checkChunks();
+    if (keep == 0) chunks = walk.decompressions();
+    EXPECT_EQ(walk.decompressions(), chunks) << "the check decompresses every chunk once";
+    for (const std::uint64_t batch : {std::uint64_t{0}, ros1::detail::BagWalk::kBatchBytes}) {
+      const std::size_t before = walk.decompressions();
+      EXPECT_TRUE(readAll(walk, batch) == expected) << "keep " << keep << ", batch " << batch;
+      const std::size_t again = walk.decompressions() - before;
+      if (keep == 0) {
+        // (A chunk at a time, a chunk of the merged bag is met twice.)
+        EXPECT_GE(again, chunks) << "nothing kept: every chunk decompressed again";
+      } else if (keep == 4000 && compressed) {
+        EXPECT_GT(again, 0u) << "a few chunks kept, the rest decompressed again";
+        EXPECT_LT(again, chunks) << "a few chunks kept";
+      } else {
+        EXPECT_EQ(again, 0u) << "every chunk kept";
+      }
+    }
+  }
+  if (compressed) {
+    EXPECT_GT(chunks, 10u);
+  } else {
+    EXPECT_EQ(chunks, 0u) << "uncompressed chunks are read in place";
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Compressions, BagOrder,

@@ -4,6 +4,7 @@
 
 #include <bzlib.h>
 #include <roslz4/lz4s.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -373,20 +374,22 @@ std::vector<Placed> inTimeOrder(const std::vector<Chunk>& chunks, std::size_t fi
 // The next batch: the distinct chunks at positions from, from + 1, ... < n of a sequence
 // (chunk_at(j): the chunk at position j), in the order first met, up to budget bytes of
 // decompressed data (one chunk at least); slot maps each to its place in the batch.
-template <class ChunkAt>
+// (A chunk kept decompressed costs nothing.)
+template <class ChunkAt, class Kept>
 std::vector<std::size_t> nextBatch(const std::vector<Chunk>& chunks, std::size_t from,
-                                   std::size_t n, ChunkAt chunk_at, std::uint64_t budget,
-                                   std::map<std::size_t, std::size_t>& slot) {
+                                   std::size_t n, ChunkAt chunk_at, Kept kept,
+                                   std::uint64_t budget, std::map<std::size_t, std::size_t>& slot) {
   std::vector<std::size_t> ids;
   std::uint64_t total = 0;
   slot.clear();
   for (std::size_t j = from; j < n; ++j) {
     const std::size_t id = chunk_at(j);
     if (slot.count(id)) continue;
-    if (!ids.empty() && total + chunks[id].size > budget) break;
+    const std::uint64_t size = kept(id) ? 0 : chunks[id].size;
+    if (!ids.empty() && total + size > budget) break;
     slot[id] = ids.size();
     ids.push_back(id);
-    total += chunks[id].size;
+    total += size;
   }
   return ids;
 }
@@ -431,24 +434,46 @@ struct BagWalk::Impl {
   // mapped and cleared by the kernel again.
   std::vector<ChunkBuffer> packed, unpacked;
 
-  // The data of chunks ids in unpacked (the k-th of ids[k]; empty where not compressed), the
-  // compressed ones decompressed on the team; damage at the first (in the order of ids) that
-  // does not decompress to its size.
+  // Compressed chunks the walk checked, kept decompressed for the reads after it (up to
+  // keep_bytes of them, in the file's order), and the decompressions so far.
+  std::map<std::size_t, ChunkBuffer> kept;
+  std::uint64_t keep_bytes = 0, kept_bytes = 0;
+  std::size_t decompressions = 0;
+  bool isKept(std::size_t id) const { return kept.count(id) != 0; }
+  // The decompressed data of chunk id, the k-th of the batch unpack was given last.
+  const ChunkBuffer& unpackedOf(std::size_t id, std::size_t k) const {
+    const auto it = kept.find(id);
+    return it != kept.end() ? it->second : unpacked[k];
+  }
+
+  // Chunk id, the k-th of the batch just checked, kept decompressed if it is compressed and
+  // within keep_bytes.
+  void keep(std::size_t id, std::size_t k) {
+    if (chunks[id].compression == "none" || kept_bytes + chunks[id].size > keep_bytes) return;
+    kept_bytes += chunks[id].size;
+    kept[id].swap(unpacked[k]);
+  }
+
+  // The data of chunks ids in unpacked (the k-th of ids[k]; empty where not compressed or
+  // kept), the compressed ones decompressed on the team; damage at the first (in the order of
+  // ids) that does not decompress to its size.
   void unpack(const std::vector<std::size_t>& ids) {
     const FileBytes file(in, 0, file_size);
     if (packed.size() < ids.size()) packed.resize(ids.size()), unpacked.resize(ids.size());
+    std::vector<char> due(ids.size(), 0), sound(ids.size(), 1);
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const Record& r = chunks[ids[k]].record;
       unpacked[k].clear();
-      if (chunks[ids[k]].compression == "none") continue;
+      if (chunks[ids[k]].compression == "none" || isKept(ids[k])) continue;
+      due[k] = 1;
+      ++decompressions;
       packed[k].resize(r.data_len);
       file.read(r.data_pos, r.data_len, packed[k].data());
     }
-    std::vector<char> sound(ids.size(), 1);
 #pragma omp parallel for schedule(dynamic) if (ids.size() > 1)
     for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(ids.size()); ++k) {
       const Chunk& c = chunks[ids[static_cast<std::size_t>(k)]];
-      if (c.compression != "none") sound[k] = decompress(packed[k], c.compression, c.size, unpacked[k]);
+      if (due[k]) sound[k] = decompress(packed[k], c.compression, c.size, unpacked[k]);
     }
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const Chunk& c = chunks[ids[k]];
@@ -461,7 +486,15 @@ struct BagWalk::Impl {
   }
 };
 
-BagWalk::BagWalk(const std::string& path) : impl_(std::make_unique<Impl>()) {
+std::uint64_t BagWalk::defaultKeepBytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  const std::uint64_t most = std::uint64_t{512} << 20;
+  return pages > 0 && page > 0 ? std::min(most, std::uint64_t(pages) * page / 8) : most;
+}
+
+BagWalk::BagWalk(const std::string& path, std::uint64_t keep_bytes)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->keep_bytes = keep_bytes;
   std::ifstream& in = impl_->in;
   in.open(path, std::ios::binary);
   if (!in) throw NotABag(std::string("cannot read it: ") + std::strerror(errno));
@@ -524,15 +557,18 @@ void BagWalk::checkChunks(const std::set<std::string>& topics,
   // A batch's chunks are checked in order: the first damage of the file is the one reported.
   for (std::size_t first = 0; first < chunks.size();) {
     const std::vector<std::size_t> ids = nextBatch(
-        chunks, first, chunks.size(), [](std::size_t j) { return j; }, kBatchBytes, slot);
+        chunks, first, chunks.size(), [](std::size_t j) { return j; },
+        [](std::size_t) { return false; }, kBatchBytes, slot);
     impl_->unpack(ids);
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const ChunkData data(impl_->in, chunks[ids[k]], impl_->unpacked[k]);
       checkChunkData(chunks[ids[k]], data.bytes());
-      if (!on_message) continue;
-      for (const Placed& m : inTimeOrder(chunks, ids[k], ids[k] + 1, impl_->declared, topics)) {
-        on_message(messageAt(data.bytes(), m.e, impl_->declared.at(m.e.conn), bytes));
+      if (on_message) {
+        for (const Placed& m : inTimeOrder(chunks, ids[k], ids[k] + 1, impl_->declared, topics)) {
+          on_message(messageAt(data.bytes(), m.e, impl_->declared.at(m.e.conn), bytes));
+        }
       }
+      impl_->keep(ids[k], k);
     }
     first = ids.back() + 1;
   }
@@ -548,13 +584,17 @@ void BagWalk::readMessages(const std::set<std::string>& topics,
   for (std::size_t k = 0; k < order.size(); ++k) {
     if (!held.count(order[k].chunk)) {  // the next chunks the messages need
       impl_->unpack(nextBatch(
-          chunks, k, order.size(), [&](std::size_t j) { return order[j].chunk; }, batch_bytes, held));
+          chunks, k, order.size(), [&](std::size_t j) { return order[j].chunk; },
+          [&](std::size_t id) { return impl_->isKept(id); }, batch_bytes, held));
     }
-    const ChunkData data(impl_->in, chunks[order[k].chunk], impl_->unpacked[held.at(order[k].chunk)]);
+    const std::size_t chunk = order[k].chunk;
+    const ChunkData data(impl_->in, chunks[chunk], impl_->unpackedOf(chunk, held.at(chunk)));
     if (!on_message(messageAt(data.bytes(), order[k].e, impl_->declared.at(order[k].e.conn), bytes))) {
       return;
     }
   }
 }
+
+std::size_t BagWalk::decompressions() const { return impl_->decompressions; }
 
 }  // namespace upd::ros1::detail

@@ -6,7 +6,8 @@
 // record of its chunk, and each connection is declared; then the messages are read from the
 // checked chunks in the order of their times, as rosbag's views give them. The walk hands the
 // messages of the topics asked for to the caller as it checks them, so that a topic read whole
-// before the others (the transforms) costs no decompression of its own.
+// before the others (the transforms) costs no decompression of its own, and keeps the chunks it
+// decompressed (up to a memory budget) for the reads after it.
 #pragma once
 
 #include <cstddef>
@@ -49,11 +50,17 @@ class BagWalk {
   /// The decompressed bytes of the chunks decompressed at a time (one chunk at least).
   static constexpr std::uint64_t kBatchBytes = 64u << 20;
 
+  /// The compressed chunks' decompressed bytes that checkChunks keeps for the reads after it:
+  /// 512 MiB, or an eighth of the machine's memory where that is less.
+  static std::uint64_t defaultKeepBytes();
+
   /// Reads the bag's header, its index and every chunk's header and index records. Throws
   /// NotABag for a file that cannot be read or has no bag's version line; BagDamage for a bag
   /// of another format than 2.0, one without an index (its recording did not end), and a damaged
-  /// length or offset.
-  explicit BagWalk(const std::string& path);
+  /// length or offset. checkChunks keeps the compressed chunks it checks decompressed, in the
+  /// file's order up to keep_bytes of their data, so that readMessages does not decompress them
+  /// again.
+  explicit BagWalk(const std::string& path, std::uint64_t keep_bytes = defaultKeepBytes());
   ~BagWalk();
   BagWalk(const BagWalk&) = delete;
   BagWalk& operator=(const BagWalk&) = delete;
@@ -78,6 +85,9 @@ class BagWalk {
   void readMessages(const std::set<std::string>& topics,
                     const std::function<bool(const BagMessage&)>& on_message,
                     std::uint64_t batch_bytes = kBatchBytes);
+
+  /// The compressed chunks decompressed so far (a chunk as often as it was decompressed).
+  std::size_t decompressions() const;
 
  private:
   struct Impl;
